@@ -1,0 +1,12 @@
+//! Frames and rigid transforms.
+//!
+//! Names say which frame a value lives in and which way a transform maps:
+//! `world_from_base * point_in_base == point_in_world` (the convention of rerun and Drake).
+//! The grid is 2D, so the pipeline works in SE(2); a sensor's full 3D mounting pose is
+//! reduced to the planar transform once, in [`mount`].
+
+mod mount;
+mod pose2;
+
+pub use mount::{Mount3, MountError, PlanarMount};
+pub use pose2::{normalize_angle, Point2, Pose2};

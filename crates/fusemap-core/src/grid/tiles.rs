@@ -1,0 +1,160 @@
+//! Sparse tiled storage shared by every layer.
+//!
+//! The map is a hash map from full-width [`TileKey`]s to fixed-size tiles of
+//! `TILE_SIZE × TILE_SIZE` cells, so it grows in any direction as the robot explores and
+//! unobserved tiles cost nothing (the "fixed-size maps" and "20-bit key" lessons of
+//! Hector mapping and Bonxai). Hot loops resolve a tile once and then index inside it;
+//! the hash map is touched only when a ray crosses into another tile.
+
+use super::{CellIndex, TileKey};
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A multiply-rotate hasher for tile keys (the FxHash recipe): tile keys are small
+/// integers, not attacker-controlled, and SipHash would cost more than the walk inside a
+/// tile.
+#[derive(Default, Clone, Copy)]
+pub struct TileKeyHasher(u64);
+
+impl Hasher for TileKeyHasher {
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.write_u64(*b as u64);
+        }
+    }
+
+    #[inline]
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+
+    #[inline]
+    fn write_i64(&mut self, i: i64) {
+        self.write_u64(i as u64);
+    }
+}
+
+/// Something that can be stored as a tile of a layer.
+pub trait Tile {
+    /// A tile in which every cell is unobserved.
+    fn empty() -> Self;
+}
+
+/// Sparse tiles keyed by [`TileKey`]. Tiles live in a `Vec` and the hash map holds their
+/// index, so iteration order is insertion order and deterministic.
+pub struct TileMap<T> {
+    index: HashMap<TileKey, u32, BuildHasherDefault<TileKeyHasher>>,
+    keys: Vec<TileKey>,
+    tiles: Vec<Box<T>>,
+}
+
+impl<T: Tile> Default for TileMap<T> {
+    fn default() -> Self {
+        Self {
+            index: HashMap::default(),
+            keys: Vec::new(),
+            tiles: Vec::new(),
+        }
+    }
+}
+
+impl<T: Tile> TileMap<T> {
+    /// An empty map.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Number of allocated tiles.
+    pub fn len(&self) -> usize {
+        self.tiles.len()
+    }
+
+    /// True when no tile is allocated.
+    pub fn is_empty(&self) -> bool {
+        self.tiles.is_empty()
+    }
+
+    /// The tile at `key`, if allocated.
+    #[inline]
+    pub fn get(&self, key: TileKey) -> Option<&T> {
+        self.index.get(&key).map(|&i| &*self.tiles[i as usize])
+    }
+
+    /// The tile at `key`, allocating an empty one if needed.
+    #[inline]
+    pub fn get_or_insert(&mut self, key: TileKey) -> &mut T {
+        let i = match self.index.get(&key) {
+            Some(&i) => i as usize,
+            None => {
+                let i = self.tiles.len();
+                self.tiles.push(Box::new(T::empty()));
+                self.keys.push(key);
+                self.index.insert(key, i as u32);
+                i
+            }
+        };
+        &mut self.tiles[i]
+    }
+
+    /// The tile holding `cell`, if allocated, and the cell's offset in it.
+    pub fn get_cell(&self, cell: CellIndex) -> Option<(&T, usize)> {
+        self.get(cell.tile()).map(|t| (t, cell.offset_in_tile()))
+    }
+
+    /// All tiles with their keys, in allocation order.
+    pub fn iter(&self) -> impl Iterator<Item = (TileKey, &T)> {
+        self.keys
+            .iter()
+            .copied()
+            .zip(self.tiles.iter().map(|b| &**b))
+    }
+
+    /// Bytes held by tiles (not counting the index).
+    pub fn tile_bytes(&self) -> usize {
+        self.tiles.len() * std::mem::size_of::<T>()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Counter([u8; 4]);
+    impl Tile for Counter {
+        fn empty() -> Self {
+            Counter([0; 4])
+        }
+    }
+
+    #[test]
+    fn tiles_are_allocated_on_demand_with_wide_keys() {
+        let mut m: TileMap<Counter> = TileMap::new();
+        assert!(m.is_empty());
+        let far = TileKey {
+            x: i64::MAX >> 7,
+            y: i64::MIN >> 7,
+        };
+        m.get_or_insert(far).0[0] = 7;
+        m.get_or_insert(TileKey { x: -1, y: 0 }).0[1] = 3;
+        assert_eq!(m.len(), 2);
+        assert_eq!(m.get(far).unwrap().0[0], 7);
+        // A key that differs only in the high bits is a different tile.
+        assert!(m
+            .get(TileKey {
+                x: (i64::MAX >> 7) ^ (1 << 40),
+                y: i64::MIN >> 7
+            })
+            .is_none());
+        m.get_or_insert(far).0[0] += 1;
+        assert_eq!(m.len(), 2);
+        assert_eq!(m.get(far).unwrap().0[0], 8);
+        let keys: Vec<_> = m.iter().map(|(k, _)| k).collect();
+        assert_eq!(keys, vec![far, TileKey { x: -1, y: 0 }]);
+    }
+}

@@ -1,0 +1,41 @@
+//! # fusemap-core
+//!
+//! The pure computation of fusemap: no files, no network, no ROS types. Formats live in
+//! `fusemap-io`, the command line in `fusemap-cli`.
+//!
+//! | concept | module |
+//! |---|---|
+//! | SE(2) poses, sensor mounts | [`geometry`] |
+//! | time stamps | [`time`] |
+//! | grid geometry, log-odds, tiles, ray traversal | [`grid`] |
+//! | the measurement every sensor model produces | [`measurement`] |
+//! | sensor models (lidar inverse model) | [`sensor`] |
+//! | the engine taking time-ordered measurements | [`fusion`] |
+//! | entropy, precision / recall | [`metrics`] |
+//! | simulated worlds and scanners | [`sim`] |
+//! | the validated run configuration | [`config`] |
+//!
+//! ```
+//! use fusemap_core::{config::Config, fusion::Engine, grid::OccupancyGrid, sim::SimulatedRun};
+//! let plan = Config::default().validate().unwrap();
+//! let mut engine = Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy));
+//! let (name, model) = plan.lidars[0].clone();
+//! let laser = engine.add_lidar(name, model);
+//! let run = SimulatedRun::document_corridor();
+//! for (scan, pose) in run.scans.iter().zip(&run.poses) {
+//!     engine.insert_scan(laser, scan, *pose).unwrap();
+//! }
+//! assert!(engine.grid().known_box().is_some());
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod config;
+pub mod fusion;
+pub mod geometry;
+pub mod grid;
+pub mod measurement;
+pub mod metrics;
+pub mod sensor;
+pub mod sim;
+pub mod time;

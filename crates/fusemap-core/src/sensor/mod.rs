@@ -1,0 +1,7 @@
+//! Sensor models: each turns one sensor's raw reading into the sensor-agnostic
+//! [`RangeData`](crate::measurement::RangeData) the grid consumes. The model, not the
+//! grid, holds the sensor's parameters, so one map can take many sensors.
+
+pub mod lidar;
+
+pub use lidar::{LaserScan, LidarModel, LidarParams, MaxRangePolicy, ReturnCounts};

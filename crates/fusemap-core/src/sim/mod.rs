@@ -1,0 +1,10 @@
+//! Simulated worlds and scanners: the design document's corridor (§3.1) and the larger
+//! worlds benchmarks and tests need, with exact ground truth.
+
+mod rng;
+mod scanner;
+mod world;
+
+pub use rng::SplitMix64;
+pub use scanner::{simulate_scan, ScannerSpec, SimulatedRun};
+pub use world::{box_world, corridor, BoxWorld, Segment, World};
