@@ -8,5 +8,5 @@
 mod mount;
 mod pose2;
 
-pub use mount::{Mount3, MountError, PlanarMount};
+pub use mount::{quaternion_to_rpy, quaternion_yaw, Mount3, MountError, PlanarMount};
 pub use pose2::{normalize_angle, Point2, Pose2};

@@ -52,6 +52,21 @@ pub enum MountError {
 }
 
 impl Mount3 {
+    /// A mount from a translation and a unit quaternion `(x, y, z, w)` (as ROS
+    /// `geometry_msgs/Transform` carries it). The quaternion is normalised first; a zero
+    /// or non-finite quaternion gives NaN angles, which [`Mount3::to_planar`] refuses.
+    pub fn from_translation_quaternion(t: [f64; 3], q: [f64; 4]) -> Self {
+        let (roll, pitch, yaw) = quaternion_to_rpy(q);
+        Self {
+            x: t[0],
+            y: t[1],
+            z: t[2],
+            roll,
+            pitch,
+            yaw,
+        }
+    }
+
     /// The rotation matrix `R = Rz(yaw)·Ry(pitch)·Rx(roll)`, row-major.
     pub fn rotation(&self) -> [[f64; 3]; 3] {
         let (sr, cr) = self.roll.sin_cos();
@@ -96,6 +111,34 @@ impl Mount3 {
             base_from_sensor: Pose2::new(self.x, self.y, normalize_angle(yaw)),
             handedness,
         })
+    }
+}
+
+/// Roll, pitch, yaw (ROS REP 103 fixed-axis X-Y-Z) of a quaternion `(x, y, z, w)`.
+/// The quaternion is normalised first; a zero or non-finite one gives NaN angles.
+pub fn quaternion_to_rpy(q: [f64; 4]) -> (f64, f64, f64) {
+    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    if !(n.is_finite() && n > 0.0) {
+        return (f64::NAN, f64::NAN, f64::NAN);
+    }
+    let [x, y, z, w] = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
+    let roll = (2.0 * (w * x + y * z)).atan2(1.0 - 2.0 * (x * x + y * y));
+    let pitch = (2.0 * (w * y - z * x)).clamp(-1.0, 1.0).asin();
+    let yaw = (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z));
+    (roll, pitch, yaw)
+}
+
+/// The yaw of a quaternion `(x, y, z, w)`: the heading of its x axis projected on the
+/// x-y plane (what a planar robot's odometry orientation means). NaN for a zero or
+/// non-finite quaternion.
+pub fn quaternion_yaw(q: [f64; 4]) -> f64 {
+    let [x, y, z, w] = q;
+    let yaw = (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z));
+    let n2 = x * x + y * y + z * z + w * w;
+    if n2.is_finite() && n2 > 0.0 {
+        yaw
+    } else {
+        f64::NAN
     }
 }
 
@@ -190,6 +233,23 @@ mod tests {
             let want = by.atan2(bx);
             assert!(normalize_angle(p.beam_angle_in_base(a) - want).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn quaternions() {
+        let h = std::f64::consts::FRAC_PI_4;
+        // Yaw of 90°: q = (0, 0, sin 45°, cos 45°).
+        let q = [0.0, 0.0, h.sin(), h.cos()];
+        assert!((quaternion_yaw(q) - FRAC_PI_2).abs() < 1e-12);
+        let (r, p, y) = quaternion_to_rpy(q);
+        assert!(r.abs() < 1e-12 && p.abs() < 1e-12 && (y - FRAC_PI_2).abs() < 1e-12);
+        // Upside down (roll = π): q = (1, 0, 0, 0); unnormalised input is fine.
+        let m = Mount3::from_translation_quaternion([0.1, 0.0, 0.2], [2.0, 0.0, 0.0, 0.0]);
+        assert_eq!(m.to_planar(0.01).unwrap().handedness, -1.0);
+        assert!(quaternion_yaw([0.0; 4]).is_nan());
+        assert!(Mount3::from_translation_quaternion([0.0; 3], [0.0; 4])
+            .to_planar(0.1)
+            .is_err());
     }
 
     #[test]
