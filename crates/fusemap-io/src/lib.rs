@@ -9,3 +9,5 @@ pub mod error;
 pub mod log;
 
 pub use error::{Error, Location, Result};
+#[doc(hidden)]
+pub mod testdata;

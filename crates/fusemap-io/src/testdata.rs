@@ -1,0 +1,52 @@
+//! Locating the shared datasets for tests and benchmarks.
+//!
+//! Tests that need `../shared` (the real logs beside the checkout) call [`shared_dir`]:
+//! on a user's fresh clone without it they print a notice and skip; with
+//! `FUSEMAP_NO_SKIP=1` (set by `.ci/run`) a missing directory is a failure, so CI can
+//! never pass by skipping.
+
+use std::path::PathBuf;
+
+/// The environment variable that turns skips into failures.
+pub const NO_SKIP_ENV: &str = "FUSEMAP_NO_SKIP";
+
+/// True when skips must fail (`FUSEMAP_NO_SKIP=1`).
+pub fn no_skip() -> bool {
+    std::env::var(NO_SKIP_ENV).is_ok_and(|v| v == "1")
+}
+
+/// The shared data directory: `$FUSEMAP_SHARED`, or `shared/` beside the workspace
+/// checkout. `None` (after printing why) when absent and skipping is allowed; panics
+/// when absent under `FUSEMAP_NO_SKIP=1`.
+pub fn shared_dir() -> Option<PathBuf> {
+    let candidates = [
+        std::env::var_os("FUSEMAP_SHARED").map(PathBuf::from),
+        Some(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared")),
+    ];
+    for c in candidates.into_iter().flatten() {
+        if c.join("datasets").is_dir() {
+            return Some(c);
+        }
+    }
+    skip("the shared datasets (../shared beside the checkout, or $FUSEMAP_SHARED) are not present");
+    None
+}
+
+/// A file under `shared/datasets/`, or `None` (after the notice) when absent.
+pub fn dataset(relative: &str) -> Option<PathBuf> {
+    let p = shared_dir()?.join("datasets").join(relative);
+    if p.exists() {
+        Some(p)
+    } else {
+        skip(&format!("dataset {} is missing", p.display()));
+        None
+    }
+}
+
+/// Prints a skip notice, or panics with it under `FUSEMAP_NO_SKIP=1`.
+pub fn skip(reason: &str) {
+    if no_skip() {
+        panic!("{reason}, and {NO_SKIP_ENV}=1 forbids skipping");
+    }
+    eprintln!("SKIPPED: {reason}");
+}
