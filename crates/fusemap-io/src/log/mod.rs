@@ -146,3 +146,15 @@ impl ReadStats {
         }
     }
 }
+
+/// A log opened for reading: messages in file order.
+///
+/// After an `Err` the reader may not be able to go on (a truncated file); callers stop
+/// at the first error unless they know the reader resynchronises.
+pub trait LogReader {
+    /// The next message, `None` at the end of the log.
+    fn next_message(&mut self) -> Option<crate::Result<LogMessage>>;
+
+    /// What was skipped so far.
+    fn stats(&self) -> &ReadStats;
+}
