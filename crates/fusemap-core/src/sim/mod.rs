@@ -3,8 +3,10 @@
 
 mod rng;
 mod scanner;
+mod workloads;
 mod world;
 
 pub use rng::SplitMix64;
 pub use scanner::{simulate_scan, ScannerSpec, SimulatedRun};
+pub use workloads::{workload, Workload, WORKLOADS};
 pub use world::{box_world, corridor, BoxWorld, Segment, World};

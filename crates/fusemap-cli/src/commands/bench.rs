@@ -1,0 +1,155 @@
+//! `fusemap bench`: insertion throughput on the fixed synthetic workloads.
+//!
+//! Without `--workload`, each workload runs in its own child process (this binary with
+//! `--workload X --json`) so that every peak-RSS figure is that workload's whole run,
+//! its scans included, and not the high-water mark of an earlier one.
+
+use anyhow::{bail, Context, Result};
+use fusemap_core::fusion::Engine;
+use fusemap_core::geometry::PlanarMount;
+use fusemap_core::grid::{GridGeometry, OccupancyGrid, OccupancyParams};
+use fusemap_core::sensor::LidarModel;
+use fusemap_core::sim::{workload, WORKLOADS};
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// One workload's figures.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct BenchRow {
+    /// `a`, `b` or `c`.
+    pub workload: String,
+    /// What it is.
+    pub description: String,
+    /// Scans inserted.
+    pub scans: u64,
+    /// Beams inserted (valid or not).
+    pub beams: u64,
+    /// Rays walked.
+    pub rays: u64,
+    /// Cells visited by the walks.
+    pub cell_visits: u64,
+    /// Mean cells visited per walked ray.
+    pub cell_visits_per_ray: f64,
+    /// Seconds simulating the scans (not part of the rates).
+    pub simulate_s: f64,
+    /// Seconds inserting (the rates' denominator).
+    pub insert_s: f64,
+    /// Scans per second of insertion.
+    pub scans_per_s: f64,
+    /// Beams per second of insertion.
+    pub beams_per_s: f64,
+    /// Cell visits per second of insertion.
+    pub cell_visits_per_s: f64,
+    /// Peak resident memory of the whole process (VmHWM), bytes.
+    pub peak_rss_bytes: u64,
+    /// Allocated tiles at the end.
+    pub tiles: u64,
+}
+
+/// Runs workload `name` in this process.
+pub fn run_one(name: char) -> Result<BenchRow> {
+    let t0 = Instant::now();
+    let Some(w) = workload(name) else {
+        bail!("unknown workload `{name}` (expected a, b or c)")
+    };
+    let simulate_s = t0.elapsed().as_secs_f64();
+    let grid = OccupancyGrid::new(
+        GridGeometry::centered(w.resolution)?,
+        OccupancyParams::default(),
+    );
+    let mut engine = Engine::new(grid);
+    let laser = engine.add_lidar("laser", LidarModel::new(w.lidar, PlanarMount::default()));
+    let t1 = Instant::now();
+    for (scan, pose) in w.run.scans.iter().zip(&w.run.poses) {
+        engine.insert_scan(laser, scan, *pose)?;
+    }
+    let insert_s = t1.elapsed().as_secs_f64();
+    let st = engine.stats().insert;
+    let scans = w.run.scans.len() as u64;
+    let beams: u64 = w.run.scans.iter().map(|s| s.ranges.len() as u64).sum();
+    Ok(BenchRow {
+        workload: name.to_string(),
+        description: w.description.to_string(),
+        scans,
+        beams,
+        rays: st.rays,
+        cell_visits: st.cell_visits,
+        cell_visits_per_ray: st.cell_visits as f64 / st.rays.max(1) as f64,
+        simulate_s,
+        insert_s,
+        scans_per_s: scans as f64 / insert_s,
+        beams_per_s: beams as f64 / insert_s,
+        cell_visits_per_s: st.cell_visits as f64 / insert_s,
+        peak_rss_bytes: peak_rss_bytes(),
+        tiles: engine.grid().tile_count() as u64,
+    })
+}
+
+/// Peak resident set size of this process (`VmHWM` in `/proc/self/status`), 0 where
+/// unavailable.
+pub fn peak_rss_bytes() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<u64>().ok())
+        })
+        .map_or(0, |kb| kb * 1024)
+}
+
+/// `fusemap bench`.
+pub fn run(which: Option<char>, json: bool) -> Result<()> {
+    let rows = match which {
+        Some(w) => vec![run_one(w)?],
+        None => {
+            let exe = std::env::current_exe()
+                .context("cannot find the fusemap executable to run workloads")?;
+            let mut rows = Vec::new();
+            for w in WORKLOADS {
+                let out = std::process::Command::new(&exe)
+                    .args(["bench", "--json", "--workload", &w.to_string()])
+                    .output()
+                    .with_context(|| format!("running workload {w}"))?;
+                if !out.status.success() {
+                    bail!(
+                        "workload {w} failed: {}",
+                        String::from_utf8_lossy(&out.stderr).trim()
+                    );
+                }
+                let line = String::from_utf8_lossy(&out.stdout);
+                rows.push(
+                    serde_json::from_str(line.trim())
+                        .with_context(|| format!("workload {w} printed `{line}`"))?,
+                );
+            }
+            rows
+        }
+    };
+    if json {
+        for r in &rows {
+            println!("{}", serde_json::to_string(r)?);
+        }
+    } else {
+        println!(
+            "| workload | scans | beams | cells/ray | insert s | scans/s | beams/s | cell visits/s | peak RSS MiB |"
+        );
+        println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+        for r in &rows {
+            println!(
+                "| {} | {} | {} | {:.1} | {:.3} | {:.0} | {:.0} | {:.3e} | {:.1} |",
+                r.workload,
+                r.scans,
+                r.beams,
+                r.cell_visits_per_ray,
+                r.insert_s,
+                r.scans_per_s,
+                r.beams_per_s,
+                r.cell_visits_per_s,
+                r.peak_rss_bytes as f64 / 1048576.0
+            );
+        }
+    }
+    Ok(())
+}
