@@ -1,0 +1,127 @@
+//! `summary.json`: what a mapping run did, in figures a user can check.
+
+use fusemap_core::grid::{InsertStats, Raster};
+use fusemap_core::metrics::EntropyReport;
+use fusemap_core::sensor::ReturnCounts;
+use serde::Serialize;
+
+/// The summary of one mapping run.
+#[derive(Debug, Serialize)]
+pub struct Summary {
+    /// fusemap's version.
+    pub fusemap_version: &'static str,
+    /// What was mapped: `world` (simulated) or a log format.
+    pub source_kind: String,
+    /// The input file.
+    pub source: String,
+    /// Scans inserted into the map.
+    pub scans: u64,
+    /// Beams in those scans.
+    pub beams: u64,
+    /// Beams by kind of return (invalid kinds are never evidence).
+    pub returns: ReturnCounts,
+    /// Rays walked through the grid.
+    pub rays_walked: u64,
+    /// Rays the grid refused (non-finite or absurdly long).
+    pub rays_rejected: u64,
+    /// Cells visited by the walks (a cell counts once per ray crossing it).
+    pub cell_visits: u64,
+    /// Cell updates applied (at most one per cell per scan).
+    pub cells_updated: CellsUpdated,
+    /// The exported raster.
+    pub map: MapInfo,
+    /// Entropy over the known bounding box.
+    pub entropy: Option<EntropyReport>,
+    /// Wall time of the whole run, seconds.
+    pub wall_time_s: f64,
+    /// Facts about the input a user should know (skipped records, clock faults…).
+    pub notes: Vec<String>,
+    /// Extra counters of log input (absent for simulated runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub log: Option<serde_json::Value>,
+}
+
+/// Cell updates by kind.
+#[derive(Debug, Serialize)]
+pub struct CellsUpdated {
+    /// Occupied (hit) updates.
+    pub occupied: u64,
+    /// Free (miss) updates.
+    pub free: u64,
+    /// Both.
+    pub total: u64,
+}
+
+impl From<&InsertStats> for CellsUpdated {
+    fn from(s: &InsertStats) -> Self {
+        Self { occupied: s.hit_updates, free: s.miss_updates, total: s.hit_updates + s.miss_updates }
+    }
+}
+
+/// The exported raster's placement.
+#[derive(Debug, Serialize)]
+pub struct MapInfo {
+    /// Cell side, metres.
+    pub resolution: f64,
+    /// Lower-left corner of the raster, metres.
+    pub origin: [f64; 2],
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// Allocated tiles of 64 × 64 cells.
+    pub tiles: usize,
+}
+
+impl MapInfo {
+    /// From a raster and the tile count.
+    pub fn new(r: Option<&Raster>, resolution: f64, tiles: usize) -> Self {
+        match r {
+            Some(r) => Self { resolution, origin: [r.origin.x, r.origin.y], width: r.width, height: r.height, tiles },
+            None => Self { resolution, origin: [0.0, 0.0], width: 0, height: 0, tiles },
+        }
+    }
+}
+
+impl Summary {
+    /// Prints the summary for a person.
+    pub fn print(&self) {
+        println!("source        {} ({})", self.source, self.source_kind);
+        println!("scans         {}", self.scans);
+        let r = &self.returns;
+        println!(
+            "beams         {} (valid {}, no return {}, invalid {}: nan {}, inf {}, zero {}, negative {}, below min {})",
+            self.beams,
+            r.valid,
+            r.no_return,
+            r.invalid(),
+            r.nan,
+            r.infinite,
+            r.zero,
+            r.negative,
+            r.below_min
+        );
+        println!(
+            "cells updated {} (occupied {}, free {}); {} cell visits by {} rays",
+            self.cells_updated.total, self.cells_updated.occupied, self.cells_updated.free, self.cell_visits, self.rays_walked
+        );
+        if self.rays_rejected > 0 {
+            println!("rays refused  {}", self.rays_rejected);
+        }
+        println!(
+            "map           {} x {} cells at {} m, origin ({:.3}, {:.3}), {} tiles",
+            self.map.width, self.map.height, self.map.resolution, self.map.origin[0], self.map.origin[1], self.map.tiles
+        );
+        if let Some(e) = &self.entropy {
+            println!(
+                "entropy       {:.4} nats mean over the known box; {:.1} % of its cells known",
+                e.mean_entropy_nats,
+                100.0 * e.known_share
+            );
+        }
+        for n in &self.notes {
+            println!("note          {n}");
+        }
+        println!("wall time     {:.3} s", self.wall_time_s);
+    }
+}

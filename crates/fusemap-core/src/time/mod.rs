@@ -1,0 +1,8 @@
+//! Time: stamps, the pose buffer that answers "where was the robot at t?", and the
+//! synchronisation modes of the design document's §4.1.
+
+mod pose_buffer;
+mod stamp;
+
+pub use pose_buffer::{NoPose, PoseBuffer, PushOutcome, SyncMode};
+pub use stamp::Stamp;
