@@ -170,6 +170,41 @@ impl Engine {
         Ok(s)
     }
 
+    /// Inserts a scan with the sensor's own stated range limits (see
+    /// [`LidarModel::limited_to`]) and the robot pose per beam.
+    pub fn insert_scan_limited(
+        &mut self,
+        sensor: SensorId,
+        scan: &LaserScan,
+        range_min: f32,
+        range_max: f32,
+        pose_of_beam: impl FnMut(usize) -> Pose2,
+    ) -> Result<InsertStats, EngineError> {
+        if self.lidars.get(sensor.0 as usize).is_none() {
+            return Err(EngineError::UnknownSensor(sensor));
+        }
+        self.check_order(sensor, scan.stamp)?;
+        let slot = &mut self.lidars[sensor.0 as usize];
+        let model = slot.model.limited_to(range_min, range_max);
+        model.scan_to_range_data_with(
+            sensor,
+            scan,
+            pose_of_beam,
+            &mut self.scratch,
+            &mut slot.stats.returns,
+        );
+        slot.stats.scans += 1;
+        let s = self.grid.insert(&self.scratch);
+        self.stats.measurements += 1;
+        self.stats.insert.add(&s);
+        Ok(s)
+    }
+
+    /// The model registered for `sensor`.
+    pub fn lidar_model(&self, sensor: SensorId) -> Option<&LidarModel> {
+        self.lidars.get(sensor.0 as usize).map(|s| &s.model)
+    }
+
     /// Inserts range data a sensor model outside the engine produced.
     pub fn insert_range_data(&mut self, data: &RangeData) -> Result<InsertStats, EngineError> {
         self.check_order(data.sensor, data.stamp)?;

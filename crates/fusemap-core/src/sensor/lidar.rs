@@ -164,6 +164,30 @@ impl LidarModel {
         &self.mount
     }
 
+    /// This model restricted to the limits a message states for its sensor
+    /// (`sensor_msgs/LaserScan` `range_min` / `range_max`): the valid interval becomes
+    /// `[max(min_range, range_min), min(max_range, range_max))`. Readings at or beyond
+    /// the sensor's own `range_max` are its "no return" values (CARMEN's 81.91, a ROS
+    /// driver's `range_max + 1`) and must never become obstacles. Non-finite or
+    /// non-positive limits mean "not stated" and are ignored.
+    pub fn limited_to(&self, range_min: f32, range_max: f32) -> LidarModel {
+        let mut p = self.params;
+        if range_min.is_finite() && range_min > 0.0 {
+            p.min_range = p.min_range.max(range_min as f64);
+        }
+        if range_max.is_finite() && range_max > 0.0 {
+            p.max_range = p.max_range.min(range_max as f64);
+        }
+        if p.min_range >= p.max_range {
+            // A message claiming an empty interval: nothing it reports is valid.
+            p.min_range = p.max_range;
+        }
+        LidarModel {
+            params: p,
+            mount: self.mount,
+        }
+    }
+
     /// The evidence probabilities of this model.
     pub fn evidence(&self) -> Evidence {
         Evidence {
@@ -332,6 +356,28 @@ mod tests {
             assert!((m.end.distance(m.origin) - 10.0).abs() < 1e-9);
         }
         assert_eq!(c.invalid(), 6);
+    }
+
+    #[test]
+    fn message_limits_narrow_the_model() {
+        let m = LidarModel::new(
+            LidarParams {
+                max_range: 40.0,
+                ..Default::default()
+            },
+            PlanarMount::default(),
+        );
+        let l = m.limited_to(0.2, 30.0);
+        assert_eq!(l.params().min_range, 0.2f32 as f64);
+        assert_eq!(l.params().max_range, 30.0);
+        // Limits wider than the model's, or unstated, change nothing.
+        assert_eq!(m.limited_to(0.0, f32::INFINITY), m);
+        assert_eq!(m.limited_to(f32::NAN, 80.0).params().max_range, 40.0);
+        // CARMEN's 81.91 no-return under a line's range_max of 81 is a no-return.
+        assert_eq!(m.limited_to(0.0, 81.0).classify(81.91), Kind::NoReturn);
+        let empty = m.limited_to(50.0, 20.0);
+        assert_eq!(empty.classify(25.0), Kind::NoReturn);
+        assert_eq!(empty.classify(15.0), Kind::BelowMin);
     }
 
     #[test]
