@@ -3,6 +3,8 @@
 
 mod pose_buffer;
 mod stamp;
+mod timing;
 
 pub use pose_buffer::{NoPose, PoseBuffer, PushOutcome, SyncMode};
 pub use stamp::Stamp;
+pub use timing::{DelayStats, StreamTiming, TimingLimits};
