@@ -14,10 +14,7 @@ fn main() {
 }
 
 fn map_all(w: &Workload, scans: usize) -> u64 {
-    let grid = OccupancyGrid::new(
-        GridGeometry::centered(w.resolution).unwrap(),
-        OccupancyParams::default(),
-    );
+    let grid = OccupancyGrid::new(GridGeometry::centered(w.resolution).unwrap(), OccupancyParams::default());
     let mut e = Engine::new(grid);
     let id = e.add_lidar("laser", LidarModel::new(w.lidar, PlanarMount::default()));
     for (s, p) in w.run.scans.iter().zip(&w.run.poses).take(scans) {
@@ -30,16 +27,12 @@ fn map_all(w: &Workload, scans: usize) -> u64 {
 fn corridor_a(bencher: divan::Bencher) {
     static W: OnceLock<Workload> = OnceLock::new();
     let w = W.get_or_init(|| workload('a').unwrap());
-    bencher
-        .counter(divan::counter::ItemsCount::new(40usize * 181))
-        .bench(|| map_all(w, 40));
+    bencher.counter(divan::counter::ItemsCount::new(40usize * 181)).bench(|| map_all(w, 40));
 }
 
 #[divan::bench]
 fn box_c_first_200_scans(bencher: divan::Bencher) {
     static W: OnceLock<Workload> = OnceLock::new();
     let w = W.get_or_init(|| workload('c').unwrap());
-    bencher
-        .counter(divan::counter::ItemsCount::new(200usize * 1081))
-        .bench(|| map_all(w, 200));
+    bencher.counter(divan::counter::ItemsCount::new(200usize * 1081)).bench(|| map_all(w, 200));
 }

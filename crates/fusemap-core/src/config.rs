@@ -21,13 +21,103 @@ pub struct Config {
     /// The lidars (one table per sensor: `[[lidar]]`).
     #[serde(default = "default_lidars")]
     pub lidar: Vec<LidarConfig>,
+    /// How robot logs are read: topics, pose source, time synchronisation.
+    #[serde(default)]
+    pub log: LogConfig,
 }
 
 impl Default for Config {
     fn default() -> Self {
+        Self { map: MapConfig::default(), lidar: default_lidars(), log: LogConfig::default() }
+    }
+}
+
+/// Where a log's scans get their poses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PoseSource {
+    /// The pose written on the scan line if the log has one (CARMEN), else the odometry
+    /// topic, else TF to the base frame.
+    #[default]
+    Auto,
+    /// The pose on each scan line (CARMEN corrected logs).
+    ScanLine,
+    /// The odometry topic, interpolated at each scan's stamp.
+    Odometry,
+    /// Dynamic TF transforms to the base frame, interpolated at each scan's stamp.
+    Tf,
+}
+
+/// How the pose at a scan's stamp is found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SyncConfig {
+    /// Interpolate between the poses around the stamp.
+    #[default]
+    Interpolate,
+    /// The nearest pose within `nearest_tolerance_s` (the design document's prototype).
+    Nearest,
+}
+
+/// Where the laser's mount comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ExtrinsicsSource {
+    /// `/tf_static` base → laser when the log has it, else the config's mount.
+    #[default]
+    Auto,
+    /// Always the log's TF; a log without it is an error.
+    Tf,
+    /// Always the config's mount (TF, if present, is still compared and reported).
+    Config,
+}
+
+/// How robot logs are read.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LogConfig {
+    /// The LaserScan topic (ROS logs). If absent from the log and the log has exactly one
+    /// scan topic, that one is used.
+    pub scan_topic: String,
+    /// The odometry topic (ROS logs).
+    pub odom_topic: String,
+    /// The robot's base frame.
+    pub base_frame: String,
+    /// Where scan poses come from.
+    pub pose_source: PoseSource,
+    /// Interpolation or nearest neighbour.
+    pub sync: SyncConfig,
+    /// Nearest-neighbour tolerance, seconds; 0 means half the median scan period.
+    pub nearest_tolerance_s: f64,
+    /// Longest gap in the pose track to interpolate across, seconds.
+    pub max_pose_gap_s: f64,
+    /// Place each beam with the pose at its own time (needs `time_increment`).
+    pub deskew: bool,
+    /// Where the laser mount comes from.
+    pub extrinsics: ExtrinsicsSource,
+    /// Largest accepted difference between TF and config mount translation, metres.
+    pub extrinsics_tolerance_m: f64,
+    /// Largest accepted difference between TF and config mount yaw, degrees.
+    pub extrinsics_tolerance_deg: f64,
+    /// A header stamp further than this from its receive time is reported, seconds.
+    pub far_delay_s: f64,
+}
+
+impl Default for LogConfig {
+    fn default() -> Self {
         Self {
-            map: MapConfig::default(),
-            lidar: default_lidars(),
+            scan_topic: "/scan".into(),
+            odom_topic: "/odom".into(),
+            base_frame: "base_link".into(),
+            pose_source: PoseSource::Auto,
+            sync: SyncConfig::Interpolate,
+            nearest_tolerance_s: 0.0,
+            max_pose_gap_s: 0.5,
+            deskew: true,
+            extrinsics: ExtrinsicsSource::Auto,
+            extrinsics_tolerance_m: 0.02,
+            extrinsics_tolerance_deg: 1.0,
+            far_delay_s: 1.0,
         }
     }
 }
@@ -121,10 +211,7 @@ pub struct ConfigError {
 }
 
 fn err(field: impl Into<String>, message: impl Into<String>) -> ConfigError {
-    ConfigError {
-        field: field.into(),
-        message: message.into(),
-    }
+    ConfigError { field: field.into(), message: message.into() }
 }
 
 fn finite(field: &str, v: f64) -> Result<f64, ConfigError> {
@@ -140,10 +227,7 @@ fn probability(field: &str, v: f64) -> Result<f64, ConfigError> {
     if v > 0.0 && v < 1.0 {
         Ok(v)
     } else {
-        Err(err(
-            field,
-            format!("must be a probability strictly between 0 and 1, got {v}"),
-        ))
+        Err(err(field, format!("must be a probability strictly between 0 and 1, got {v}")))
     }
 }
 
@@ -156,6 +240,8 @@ pub struct Plan {
     pub occupancy: OccupancyParams,
     /// Each lidar's name and model.
     pub lidars: Vec<(String, LidarModel)>,
+    /// How logs are read.
+    pub log: LogConfig,
 }
 
 impl Config {
@@ -164,10 +250,7 @@ impl Config {
         let m = &self.map;
         let res = finite("map.resolution", m.resolution)?;
         if res <= 0.0 {
-            return Err(err(
-                "map.resolution",
-                format!("must be > 0 metres, got {res}"),
-            ));
+            return Err(err("map.resolution", format!("must be > 0 metres, got {res}")));
         }
         let geometry = match m.origin {
             Some([x, y]) => {
@@ -182,18 +265,12 @@ impl Config {
         let cmin = probability("map.clamp_min", m.clamp_min)?;
         let cmax = probability("map.clamp_max", m.clamp_max)?;
         if !(cmin < prior && prior < cmax) {
-            return Err(err(
-                "map",
-                format!("need clamp_min < prior < clamp_max, got {cmin} / {prior} / {cmax}"),
-            ));
+            return Err(err("map", format!("need clamp_min < prior < clamp_max, got {cmin} / {prior} / {cmax}")));
         }
         let occ_t = probability("map.occupied_threshold", m.occupied_threshold)?;
         let free_t = probability("map.free_threshold", m.free_threshold)?;
         if free_t >= occ_t {
-            return Err(err(
-                "map.free_threshold",
-                format!("must be below occupied_threshold ({occ_t}), got {free_t}"),
-            ));
+            return Err(err("map.free_threshold", format!("must be below occupied_threshold ({occ_t}), got {free_t}")));
         }
         let occupancy = OccupancyParams {
             prior,
@@ -213,24 +290,15 @@ impl Config {
                 return Err(err(f("name"), "must not be empty"));
             }
             if self.lidar[..i].iter().any(|o| o.name == l.name) {
-                return Err(err(
-                    f("name"),
-                    format!("`{}` is used by two lidars", l.name),
-                ));
+                return Err(err(f("name"), format!("`{}` is used by two lidars", l.name)));
             }
             let p_occ = probability(&f("p_occ"), l.p_occ)?;
             let p_free = probability(&f("p_free"), l.p_free)?;
             if p_occ <= prior {
-                return Err(err(
-                    f("p_occ"),
-                    format!("must be above the prior {prior}, got {p_occ}"),
-                ));
+                return Err(err(f("p_occ"), format!("must be above the prior {prior}, got {p_occ}")));
             }
             if p_free >= prior {
-                return Err(err(
-                    f("p_free"),
-                    format!("must be below the prior {prior}, got {p_free}"),
-                ));
+                return Err(err(f("p_free"), format!("must be below the prior {prior}, got {p_free}")));
             }
             let min_r = finite(&f("min_range"), l.min_range)?;
             let max_r = finite(&f("max_range"), l.max_range)?;
@@ -238,36 +306,41 @@ impl Config {
                 return Err(err(f("min_range"), format!("must be >= 0, got {min_r}")));
             }
             if min_r >= max_r {
-                return Err(err(
-                    f("max_range"),
-                    format!("must be above min_range ({min_r}), got {max_r}"),
-                ));
+                return Err(err(f("max_range"), format!("must be above min_range ({min_r}), got {max_r}")));
             }
             let tilt = finite(&f("max_tilt_deg"), l.max_tilt_deg)?;
             if !(0.0..=90.0).contains(&tilt) {
-                return Err(err(
-                    f("max_tilt_deg"),
-                    format!("must be within [0, 90] degrees, got {tilt}"),
-                ));
+                return Err(err(f("max_tilt_deg"), format!("must be within [0, 90] degrees, got {tilt}")));
             }
-            let mount: PlanarMount = l
-                .mount
-                .to_planar(tilt.to_radians())
-                .map_err(|e| err(f("mount"), e.to_string()))?;
-            let params = LidarParams {
-                p_occ,
-                p_free,
-                min_range: min_r,
-                max_range: max_r,
-                max_range_policy: l.max_range_policy,
-            };
+            let mount: PlanarMount =
+                l.mount.to_planar(tilt.to_radians()).map_err(|e| err(f("mount"), e.to_string()))?;
+            let params =
+                LidarParams { p_occ, p_free, min_range: min_r, max_range: max_r, max_range_policy: l.max_range_policy };
             lidars.push((l.name.clone(), LidarModel::new(params, mount)));
         }
-        Ok(Plan {
-            geometry,
-            occupancy,
-            lidars,
-        })
+        let g = &self.log;
+        finite("log.nearest_tolerance_s", g.nearest_tolerance_s)?;
+        if g.nearest_tolerance_s < 0.0 {
+            return Err(err("log.nearest_tolerance_s", "must be >= 0 (0 = half the scan period)"));
+        }
+        for (name, v) in [
+            ("log.max_pose_gap_s", g.max_pose_gap_s),
+            ("log.extrinsics_tolerance_m", g.extrinsics_tolerance_m),
+            ("log.extrinsics_tolerance_deg", g.extrinsics_tolerance_deg),
+            ("log.far_delay_s", g.far_delay_s),
+        ] {
+            if finite(name, v)? <= 0.0 {
+                return Err(err(name, format!("must be > 0, got {v}")));
+            }
+        }
+        for (name, v) in
+            [("log.scan_topic", &g.scan_topic), ("log.odom_topic", &g.odom_topic), ("log.base_frame", &g.base_frame)]
+        {
+            if v.trim().is_empty() {
+                return Err(err(name, "must not be empty"));
+            }
+        }
+        Ok(Plan { geometry, occupancy, lidars, log: g.clone() })
     }
 }
 
@@ -324,5 +397,17 @@ mod tests {
         let mut c = Config::default();
         c.lidar.push(LidarConfig::default());
         assert_eq!(field_of(c), "lidar[1].name");
+        let mut c = Config::default();
+        c.log.max_pose_gap_s = 0.0;
+        assert_eq!(field_of(c), "log.max_pose_gap_s");
+        let mut c = Config::default();
+        c.log.scan_topic = " ".into();
+        assert_eq!(field_of(c), "log.scan_topic");
+        let mut c = Config::default();
+        c.log.max_pose_gap_s = 0.0;
+        assert_eq!(field_of(c), "log.max_pose_gap_s");
+        let mut c = Config::default();
+        c.log.scan_topic = " ".into();
+        assert_eq!(field_of(c), "log.scan_topic");
     }
 }

@@ -55,11 +55,6 @@ pub struct RangeData {
 impl RangeData {
     /// An empty observation, for reuse as a scratch buffer.
     pub fn empty(sensor: SensorId, evidence: Evidence) -> Self {
-        Self {
-            stamp: Stamp::ZERO,
-            sensor,
-            rays: Vec::new(),
-            evidence,
-        }
+        Self { stamp: Stamp::ZERO, sensor, rays: Vec::new(), evidence }
     }
 }

@@ -49,14 +49,9 @@ pub struct BenchRow {
 /// Runs workload `name` in this process.
 pub fn run_one(name: char) -> Result<BenchRow> {
     let t0 = Instant::now();
-    let Some(w) = workload(name) else {
-        bail!("unknown workload `{name}` (expected a, b or c)")
-    };
+    let Some(w) = workload(name) else { bail!("unknown workload `{name}` (expected a, b or c)") };
     let simulate_s = t0.elapsed().as_secs_f64();
-    let grid = OccupancyGrid::new(
-        GridGeometry::centered(w.resolution)?,
-        OccupancyParams::default(),
-    );
+    let grid = OccupancyGrid::new(GridGeometry::centered(w.resolution)?, OccupancyParams::default());
     let mut engine = Engine::new(grid);
     let laser = engine.add_lidar("laser", LidarModel::new(w.lidar, PlanarMount::default()));
     let t1 = Instant::now();
@@ -104,8 +99,7 @@ pub fn run(which: Option<char>, json: bool) -> Result<()> {
     let rows = match which {
         Some(w) => vec![run_one(w)?],
         None => {
-            let exe = std::env::current_exe()
-                .context("cannot find the fusemap executable to run workloads")?;
+            let exe = std::env::current_exe().context("cannot find the fusemap executable to run workloads")?;
             let mut rows = Vec::new();
             for w in WORKLOADS {
                 let out = std::process::Command::new(&exe)
@@ -113,16 +107,10 @@ pub fn run(which: Option<char>, json: bool) -> Result<()> {
                     .output()
                     .with_context(|| format!("running workload {w}"))?;
                 if !out.status.success() {
-                    bail!(
-                        "workload {w} failed: {}",
-                        String::from_utf8_lossy(&out.stderr).trim()
-                    );
+                    bail!("workload {w} failed: {}", String::from_utf8_lossy(&out.stderr).trim());
                 }
                 let line = String::from_utf8_lossy(&out.stdout);
-                rows.push(
-                    serde_json::from_str(line.trim())
-                        .with_context(|| format!("workload {w} printed `{line}`"))?,
-                );
+                rows.push(serde_json::from_str(line.trim()).with_context(|| format!("workload {w} printed `{line}`"))?);
             }
             rows
         }

@@ -21,9 +21,7 @@ pub enum EngineError {
     #[error("unknown sensor id {0:?}")]
     UnknownSensor(SensorId),
     /// The measurement is older than one already applied.
-    #[error(
-        "measurement at {stamp:?} from sensor {sensor:?} is older than the last applied ({last:?})"
-    )]
+    #[error("measurement at {stamp:?} from sensor {sensor:?} is older than the last applied ({last:?})")]
     OutOfOrder {
         /// The sensor.
         sensor: SensorId,
@@ -73,10 +71,7 @@ pub struct Engine {
 impl Engine {
     /// An engine writing into `grid`.
     pub fn new(grid: OccupancyGrid) -> Self {
-        let evidence = crate::measurement::Evidence {
-            p_hit: 0.5,
-            p_miss: 0.5,
-        };
+        let evidence = crate::measurement::Evidence { p_hit: 0.5, p_miss: 0.5 };
         Self {
             grid,
             lidars: Vec::new(),
@@ -89,13 +84,7 @@ impl Engine {
     /// Registers a lidar and returns its id.
     pub fn add_lidar(&mut self, name: impl Into<String>, model: LidarModel) -> SensorId {
         let id = SensorId(self.lidars.len() as u16);
-        self.lidars.push(LidarSlot {
-            model,
-            stats: SensorStats {
-                name: name.into(),
-                ..Default::default()
-            },
-        });
+        self.lidars.push(LidarSlot { model, stats: SensorStats { name: name.into(), ..Default::default() } });
         id
     }
 
@@ -123,11 +112,7 @@ impl Engine {
         if let Some(last) = self.last {
             if stamp < last {
                 self.stats.out_of_order += 1;
-                return Err(EngineError::OutOfOrder {
-                    sensor,
-                    stamp,
-                    last,
-                });
+                return Err(EngineError::OutOfOrder { sensor, stamp, last });
             }
         }
         self.last = Some(stamp);
@@ -156,13 +141,7 @@ impl Engine {
         }
         self.check_order(sensor, scan.stamp)?;
         let slot = &mut self.lidars[sensor.0 as usize];
-        slot.model.scan_to_range_data_with(
-            sensor,
-            scan,
-            pose_of_beam,
-            &mut self.scratch,
-            &mut slot.stats.returns,
-        );
+        slot.model.scan_to_range_data_with(sensor, scan, pose_of_beam, &mut self.scratch, &mut slot.stats.returns);
         slot.stats.scans += 1;
         let s = self.grid.insert(&self.scratch);
         self.stats.measurements += 1;
@@ -186,13 +165,7 @@ impl Engine {
         self.check_order(sensor, scan.stamp)?;
         let slot = &mut self.lidars[sensor.0 as usize];
         let model = slot.model.limited_to(range_min, range_max);
-        model.scan_to_range_data_with(
-            sensor,
-            scan,
-            pose_of_beam,
-            &mut self.scratch,
-            &mut slot.stats.returns,
-        );
+        model.scan_to_range_data_with(sensor, scan, pose_of_beam, &mut self.scratch, &mut slot.stats.returns);
         slot.stats.scans += 1;
         let s = self.grid.insert(&self.scratch);
         self.stats.measurements += 1;
@@ -223,29 +196,15 @@ mod tests {
     use crate::sensor::LidarParams;
 
     fn engine() -> (Engine, SensorId, SensorId) {
-        let grid = OccupancyGrid::new(
-            GridGeometry::centered(0.1).unwrap(),
-            OccupancyParams::default(),
-        );
+        let grid = OccupancyGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
         let mut e = Engine::new(grid);
-        let a = e.add_lidar(
-            "front",
-            LidarModel::new(LidarParams::default(), PlanarMount::default()),
-        );
-        let b = e.add_lidar(
-            "rear",
-            LidarModel::new(LidarParams::default(), PlanarMount::default()),
-        );
+        let a = e.add_lidar("front", LidarModel::new(LidarParams::default(), PlanarMount::default()));
+        let b = e.add_lidar("rear", LidarModel::new(LidarParams::default(), PlanarMount::default()));
         (e, a, b)
     }
 
     fn scan(t: i64) -> LaserScan {
-        LaserScan {
-            stamp: Stamp(t),
-            angle_min: 0.0,
-            angle_increment: 0.1,
-            ranges: vec![1.0, f32::NAN],
-        }
+        LaserScan { stamp: Stamp(t), angle_min: 0.0, angle_increment: 0.1, ranges: vec![1.0, f32::NAN] }
     }
 
     #[test]
@@ -263,8 +222,6 @@ mod tests {
         assert_eq!(s[0].returns.nan, 2);
         assert_eq!(s[1].scans, 1);
         assert_eq!(s[1].name, "rear");
-        assert!(e
-            .insert_scan(SensorId(9), &scan(5), Pose2::IDENTITY)
-            .is_err());
+        assert!(e.insert_scan(SensorId(9), &scan(5), Pose2::IDENTITY).is_err());
     }
 }

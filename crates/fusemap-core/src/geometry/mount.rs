@@ -57,14 +57,7 @@ impl Mount3 {
     /// or non-finite quaternion gives NaN angles, which [`Mount3::to_planar`] refuses.
     pub fn from_translation_quaternion(t: [f64; 3], q: [f64; 4]) -> Self {
         let (roll, pitch, yaw) = quaternion_to_rpy(q);
-        Self {
-            x: t[0],
-            y: t[1],
-            z: t[2],
-            roll,
-            pitch,
-            yaw,
-        }
+        Self { x: t[0], y: t[1], z: t[2], roll, pitch, yaw }
     }
 
     /// The rotation matrix `R = Rz(yaw)·Ry(pitch)·Rx(roll)`, row-major.
@@ -82,14 +75,9 @@ impl Mount3 {
     /// Reduces the mount to the plane, refusing a scan plane tilted more than
     /// `max_tilt` radians from horizontal (upright or upside down).
     pub fn to_planar(&self, max_tilt: f64) -> Result<PlanarMount, MountError> {
-        for (field, v) in [
-            ("x", self.x),
-            ("y", self.y),
-            ("z", self.z),
-            ("roll", self.roll),
-            ("pitch", self.pitch),
-            ("yaw", self.yaw),
-        ] {
+        for (field, v) in
+            [("x", self.x), ("y", self.y), ("z", self.z), ("roll", self.roll), ("pitch", self.pitch), ("yaw", self.yaw)]
+        {
             if !v.is_finite() {
                 return Err(MountError::NotFinite { field });
             }
@@ -99,18 +87,12 @@ impl Mount3 {
         let z_z = r[2][2];
         let tilt = z_z.abs().clamp(0.0, 1.0).acos();
         if tilt > max_tilt {
-            return Err(MountError::Tilted {
-                tilt_deg: tilt.to_degrees(),
-                limit_deg: max_tilt.to_degrees(),
-            });
+            return Err(MountError::Tilted { tilt_deg: tilt.to_degrees(), limit_deg: max_tilt.to_degrees() });
         }
         // Heading of the sensor's x axis (R's first column) projected on the base plane.
         let yaw = r[1][0].atan2(r[0][0]);
         let handedness = if z_z < 0.0 { -1.0 } else { 1.0 };
-        Ok(PlanarMount {
-            base_from_sensor: Pose2::new(self.x, self.y, normalize_angle(yaw)),
-            handedness,
-        })
+        Ok(PlanarMount { base_from_sensor: Pose2::new(self.x, self.y, normalize_angle(yaw)), handedness })
     }
 }
 
@@ -157,10 +139,7 @@ pub struct PlanarMount {
 
 impl Default for PlanarMount {
     fn default() -> Self {
-        Self {
-            base_from_sensor: Pose2::IDENTITY,
-            handedness: 1.0,
-        }
+        Self { base_from_sensor: Pose2::IDENTITY, handedness: 1.0 }
     }
 }
 
@@ -183,13 +162,7 @@ mod tests {
 
     #[test]
     fn level_mount_keeps_yaw_and_translation() {
-        let m = Mount3 {
-            x: 0.2,
-            y: -0.1,
-            z: 0.3,
-            yaw: 0.5,
-            ..Default::default()
-        };
+        let m = Mount3 { x: 0.2, y: -0.1, z: 0.3, yaw: 0.5, ..Default::default() };
         let p = m.to_planar(0.01).unwrap();
         assert_eq!(p.handedness, 1.0);
         assert!((p.base_from_sensor.theta - 0.5).abs() < 1e-12);
@@ -199,19 +172,13 @@ mod tests {
     #[test]
     fn upside_down_mount_mirrors_beams() {
         // roll = π: the sensor's +y axis points to the base's -y.
-        let m = Mount3 {
-            roll: PI,
-            ..Default::default()
-        };
+        let m = Mount3 { roll: PI, ..Default::default() };
         let p = m.to_planar(0.01).unwrap();
         assert_eq!(p.handedness, -1.0);
         let a = p.beam_angle_in_base(FRAC_PI_2);
         assert!((normalize_angle(a) + FRAC_PI_2).abs() < 1e-12, "{a}");
         // The same holds when flipped by pitch = π instead: forward becomes backward.
-        let m = Mount3 {
-            pitch: PI,
-            ..Default::default()
-        };
+        let m = Mount3 { pitch: PI, ..Default::default() };
         let p = m.to_planar(0.01).unwrap();
         assert_eq!(p.handedness, -1.0);
         assert!((normalize_angle(p.beam_angle_in_base(0.0)).abs() - PI).abs() < 1e-12);
@@ -219,11 +186,7 @@ mod tests {
 
     #[test]
     fn mirrored_beam_direction_matches_the_3d_rotation() {
-        let m = Mount3 {
-            roll: PI,
-            yaw: 0.7,
-            ..Default::default()
-        };
+        let m = Mount3 { roll: PI, yaw: 0.7, ..Default::default() };
         let p = m.to_planar(0.01).unwrap();
         let r = m.rotation();
         for a in [-1.2f64, -0.3, 0.0, 0.4, 1.5] {
@@ -247,17 +210,12 @@ mod tests {
         let m = Mount3::from_translation_quaternion([0.1, 0.0, 0.2], [2.0, 0.0, 0.0, 0.0]);
         assert_eq!(m.to_planar(0.01).unwrap().handedness, -1.0);
         assert!(quaternion_yaw([0.0; 4]).is_nan());
-        assert!(Mount3::from_translation_quaternion([0.0; 3], [0.0; 4])
-            .to_planar(0.1)
-            .is_err());
+        assert!(Mount3::from_translation_quaternion([0.0; 3], [0.0; 4]).to_planar(0.1).is_err());
     }
 
     #[test]
     fn tilted_mount_is_refused() {
-        let m = Mount3 {
-            pitch: 0.2,
-            ..Default::default()
-        };
+        let m = Mount3 { pitch: 0.2, ..Default::default() };
         let e = m.to_planar(0.05).unwrap_err();
         assert!(matches!(e, MountError::Tilted { .. }), "{e}");
         assert!(e.to_string().contains("tilted"));
@@ -265,13 +223,7 @@ mod tests {
 
     #[test]
     fn non_finite_mount_names_the_field() {
-        let m = Mount3 {
-            yaw: f64::NAN,
-            ..Default::default()
-        };
-        assert_eq!(
-            m.to_planar(0.1).unwrap_err(),
-            MountError::NotFinite { field: "yaw" }
-        );
+        let m = Mount3 { yaw: f64::NAN, ..Default::default() };
+        assert_eq!(m.to_planar(0.1).unwrap_err(), MountError::NotFinite { field: "yaw" });
     }
 }

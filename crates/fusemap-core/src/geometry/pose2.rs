@@ -60,11 +60,7 @@ pub struct Pose2 {
 
 impl Pose2 {
     /// The identity transform.
-    pub const IDENTITY: Pose2 = Pose2 {
-        x: 0.0,
-        y: 0.0,
-        theta: 0.0,
-    };
+    pub const IDENTITY: Pose2 = Pose2 { x: 0.0, y: 0.0, theta: 0.0 };
 
     /// A transform from translation and rotation.
     pub const fn new(x: f64, y: f64, theta: f64) -> Self {
@@ -78,10 +74,7 @@ impl Pose2 {
 
     /// The same transform with `theta` wrapped to (-π, π].
     pub fn normalized(self) -> Self {
-        Self {
-            theta: normalize_angle(self.theta),
-            ..self
-        }
+        Self { theta: normalize_angle(self.theta), ..self }
     }
 
     /// True when all three components are finite.
@@ -102,20 +95,13 @@ impl Pose2 {
     /// The inverse transform: `a_from_b.inverse()` is `b_from_a`.
     pub fn inverse(self) -> Pose2 {
         let (s, c) = self.theta.sin_cos();
-        Pose2 {
-            x: -(c * self.x + s * self.y),
-            y: -(-s * self.x + c * self.y),
-            theta: normalize_angle(-self.theta),
-        }
+        Pose2 { x: -(c * self.x + s * self.y), y: -(-s * self.x + c * self.y), theta: normalize_angle(-self.theta) }
     }
 
     /// Maps a point: `a_from_b.transform_point(p_in_b)` is `p_in_a`.
     pub fn transform_point(self, p: Point2) -> Point2 {
         let (s, c) = self.theta.sin_cos();
-        Point2 {
-            x: self.x + c * p.x - s * p.y,
-            y: self.y + s * p.x + c * p.y,
-        }
+        Point2 { x: self.x + c * p.x - s * p.y, y: self.y + s * p.x + c * p.y }
     }
 
     /// Interpolates between two poses: linear in translation, shortest arc in rotation.

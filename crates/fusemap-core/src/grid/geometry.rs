@@ -15,9 +15,7 @@ pub const TILE_CELLS: usize = TILE_SIZE * TILE_SIZE;
 
 /// A cell's integer coordinates. Full 64-bit width: the map can grow anywhere a `f64`
 /// metre coordinate can point without the key truncation that Bonxai and MOLA had to fix.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct CellIndex {
     /// Column (x direction).
     pub x: i64,
@@ -34,10 +32,7 @@ impl CellIndex {
     /// The tile holding this cell (`floor(x / TILE_SIZE)` via an arithmetic shift).
     #[inline]
     pub fn tile(self) -> TileKey {
-        TileKey {
-            x: self.x >> TILE_SHIFT,
-            y: self.y >> TILE_SHIFT,
-        }
+        TileKey { x: self.x >> TILE_SHIFT, y: self.y >> TILE_SHIFT }
     }
 
     /// The cell's offset inside its tile, row-major (`row * TILE_SIZE + column`).
@@ -146,10 +141,7 @@ impl GridGeometry {
 
     /// A geometry whose cell centres lie on multiples of `resolution`.
     pub fn centered(resolution: f64) -> Result<Self, GeometryError> {
-        Self::new(
-            resolution,
-            Point2::new(-resolution / 2.0, -resolution / 2.0),
-        )
+        Self::new(resolution, Point2::new(-resolution / 2.0, -resolution / 2.0))
     }
 
     /// Cell side, metres.
@@ -165,10 +157,7 @@ impl GridGeometry {
     /// A world point in continuous cell units (cell (i, j) spans `[i, i+1) × [j, j+1)`).
     #[inline]
     pub fn to_cell_units(&self, p: Point2) -> (f64, f64) {
-        (
-            (p.x - self.origin.x) / self.resolution,
-            (p.y - self.origin.y) / self.resolution,
-        )
+        ((p.x - self.origin.x) / self.resolution, (p.y - self.origin.y) / self.resolution)
     }
 
     /// The cell holding a world point. Uses `floor`: truncation toward zero (the design
@@ -197,10 +186,7 @@ impl GridGeometry {
 
     /// The world coordinates of a cell's lower-left corner.
     pub fn cell_corner(&self, c: CellIndex) -> Point2 {
-        Point2::new(
-            self.origin.x + c.x as f64 * self.resolution,
-            self.origin.y + c.y as f64 * self.resolution,
-        )
+        Point2::new(self.origin.x + c.x as f64 * self.resolution, self.origin.y + c.y as f64 * self.resolution)
     }
 }
 
@@ -213,33 +199,17 @@ mod tests {
     fn floor_not_truncation_for_negative_coordinates() {
         let g = GridGeometry::new(0.05, Point2::new(0.0, 0.0)).unwrap();
         // The document's int((x - origin) / res) gives 0 for x = -0.01; the right cell is -1.
-        assert_eq!(
-            g.cell_of(Point2::new(-0.01, -0.01)),
-            Some(CellIndex::new(-1, -1))
-        );
-        assert_eq!(
-            (-0.01f64 / 0.05) as i64,
-            0,
-            "what truncation would have done"
-        );
-        assert_eq!(
-            g.cell_of(Point2::new(0.01, -0.06)),
-            Some(CellIndex::new(0, -2))
-        );
-        assert_eq!(
-            g.cell_of(Point2::new(-0.05, 0.0)),
-            Some(CellIndex::new(-1, 0))
-        );
+        assert_eq!(g.cell_of(Point2::new(-0.01, -0.01)), Some(CellIndex::new(-1, -1)));
+        assert_eq!((-0.01f64 / 0.05) as i64, 0, "what truncation would have done");
+        assert_eq!(g.cell_of(Point2::new(0.01, -0.06)), Some(CellIndex::new(0, -2)));
+        assert_eq!(g.cell_of(Point2::new(-0.05, 0.0)), Some(CellIndex::new(-1, 0)));
     }
 
     #[test]
     fn centered_geometry_puts_round_coordinates_mid_cell() {
         let g = GridGeometry::centered(0.05).unwrap();
         assert_eq!(g.cell_of(Point2::new(0.0, 0.0)), Some(CellIndex::new(0, 0)));
-        assert_eq!(
-            g.cell_of(Point2::new(2.0, -2.0)),
-            Some(CellIndex::new(40, -40))
-        );
+        assert_eq!(g.cell_of(Point2::new(2.0, -2.0)), Some(CellIndex::new(40, -40)));
         // A wall point that rounding put 1 ulp either side of y = 2 stays in one row.
         assert_eq!(g.cell_of(Point2::new(1.0, 2.0 - 4e-16)).unwrap().y, 40);
         assert_eq!(g.cell_of(Point2::new(1.0, 2.0 + 4e-16)).unwrap().y, 40);

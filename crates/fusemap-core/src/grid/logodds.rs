@@ -57,13 +57,7 @@ pub struct OccupancyParams {
 
 impl Default for OccupancyParams {
     fn default() -> Self {
-        Self {
-            prior: 0.5,
-            clamp_min: 0.12,
-            clamp_max: 0.97,
-            occupied_threshold: 0.65,
-            free_threshold: 0.25,
-        }
+        Self { prior: 0.5, clamp_min: 0.12, clamp_max: 0.97, occupied_threshold: 0.65, free_threshold: 0.25 }
     }
 }
 
@@ -135,10 +129,7 @@ mod tests {
     #[test]
     fn prior_is_not_injected_twice() {
         // With prior 0.7, a measurement that says exactly "0.7" must leave the cell alone.
-        let t = LogOddsTable::new(&OccupancyParams {
-            prior: 0.7,
-            ..Default::default()
-        });
+        let t = LogOddsTable::new(&OccupancyParams { prior: 0.7, ..Default::default() });
         assert!(t.increment(0.7).abs() < 1e-6);
     }
 

@@ -8,8 +8,7 @@ mod raycast;
 mod tiles;
 
 pub use geometry::{
-    CellBox, CellIndex, GeometryError, GridGeometry, TileKey, TILE_CELLS, TILE_MASK, TILE_SHIFT,
-    TILE_SIZE,
+    CellBox, CellIndex, GeometryError, GridGeometry, TileKey, TILE_CELLS, TILE_MASK, TILE_SHIFT, TILE_SIZE,
 };
 pub use logodds::{LogOddsTable, OccupancyParams, Ternary};
 pub use occupancy::{InsertStats, OccupancyGrid, OccupancyTile, MAX_RAY_CELLS};

@@ -17,8 +17,8 @@
 //! 4-bit counter that made Bonxai drop 7.6 % of its updates (Bonxai PR #61).
 
 use super::{
-    CellBox, CellIndex, CellRay, GridGeometry, LogOddsTable, OccupancyParams, Raster, Ternary,
-    Tile, TileKey, TileMap, TILE_CELLS, TILE_SIZE,
+    CellBox, CellIndex, CellRay, GridGeometry, LogOddsTable, OccupancyParams, Raster, Ternary, Tile, TileKey, TileMap,
+    TILE_CELLS, TILE_SIZE,
 };
 use crate::grid::logodds::probability;
 use crate::measurement::RangeData;
@@ -39,11 +39,7 @@ pub struct OccupancyTile {
 
 impl Tile for OccupancyTile {
     fn empty() -> Self {
-        Self {
-            log_odds: [f32::NAN; TILE_CELLS],
-            observation: 0,
-            updated: [0; TILE_CELLS / 64],
-        }
+        Self { log_odds: [f32::NAN; TILE_CELLS], observation: 0, updated: [0; TILE_CELLS / 64] }
     }
 }
 
@@ -173,8 +169,7 @@ impl OccupancyGrid {
 
     /// The occupancy probability of a cell (the prior if never observed).
     pub fn probability(&self, cell: CellIndex) -> f64 {
-        self.log_odds(cell)
-            .map_or(self.params.prior, |l| probability(l as f64))
+        self.log_odds(cell).map_or(self.params.prior, |l| probability(l as f64))
     }
 
     /// Free / occupied / unknown by the thresholds; never-observed cells are unknown.
@@ -258,10 +253,7 @@ impl OccupancyGrid {
             let first = key.first_cell();
             let tile_box = CellBox {
                 min: first,
-                max: CellIndex::new(
-                    first.x + TILE_SIZE as i64 - 1,
-                    first.y + TILE_SIZE as i64 - 1,
-                ),
+                max: CellIndex::new(first.x + TILE_SIZE as i64 - 1, first.y + TILE_SIZE as i64 - 1),
             };
             let Some(ov) = intersect(area, tile_box) else {
                 continue;
@@ -333,30 +325,15 @@ mod tests {
     use crate::time::Stamp;
 
     fn grid() -> OccupancyGrid {
-        OccupancyGrid::new(
-            GridGeometry::centered(1.0).unwrap(),
-            OccupancyParams::default(),
-        )
+        OccupancyGrid::new(GridGeometry::centered(1.0).unwrap(), OccupancyParams::default())
     }
 
     fn data(rays: Vec<Ray>) -> RangeData {
-        RangeData {
-            stamp: Stamp::ZERO,
-            sensor: SensorId(0),
-            rays,
-            evidence: Evidence {
-                p_hit: 0.9,
-                p_miss: 0.4,
-            },
-        }
+        RangeData { stamp: Stamp::ZERO, sensor: SensorId(0), rays, evidence: Evidence { p_hit: 0.9, p_miss: 0.4 } }
     }
 
     fn hit(ox: f64, oy: f64, ex: f64, ey: f64) -> Ray {
-        Ray {
-            origin: Point2::new(ox, oy),
-            end: Point2::new(ex, ey),
-            hit: true,
-        }
+        Ray { origin: Point2::new(ox, oy), end: Point2::new(ex, ey), hit: true }
     }
 
     #[test]
@@ -410,11 +387,7 @@ mod tests {
     #[test]
     fn cleared_miss_rays_have_no_hit() {
         let mut g = grid();
-        let s = g.insert(&data(vec![Ray {
-            origin: Point2::new(0.0, 0.0),
-            end: Point2::new(0.0, -4.0),
-            hit: false,
-        }]));
+        let s = g.insert(&data(vec![Ray { origin: Point2::new(0.0, 0.0), end: Point2::new(0.0, -4.0), hit: false }]));
         assert_eq!(s.hit_updates, 0);
         assert_eq!(s.miss_updates, 5);
         assert_eq!(g.ternary(CellIndex::new(0, -4)), g.table().classify(0.4));
@@ -453,11 +426,7 @@ mod tests {
     #[test]
     fn grows_in_every_direction() {
         let mut g = grid();
-        g.insert(&data(vec![
-            hit(0.0, 0.0, -300.0, 0.0),
-            hit(0.0, 0.0, 0.0, 250.0),
-            hit(0.0, 0.0, 120.0, -90.0),
-        ]));
+        g.insert(&data(vec![hit(0.0, 0.0, -300.0, 0.0), hit(0.0, 0.0, 0.0, 250.0), hit(0.0, 0.0, 120.0, -90.0)]));
         let b = g.known_box().unwrap();
         assert_eq!(b.min, CellIndex::new(-300, -90));
         assert_eq!(b.max, CellIndex::new(120, 250));

@@ -28,10 +28,7 @@ pub struct Raster {
 impl Raster {
     /// Occupancy probabilities as `f32`, `1 - 1/(1 + e^l)` (the prior where unknown).
     pub fn occupancy(&self) -> Vec<f32> {
-        self.log_odds
-            .iter()
-            .map(|&l| probability(l as f64) as f32)
-            .collect()
+        self.log_odds.iter().map(|&l| probability(l as f64) as f32).collect()
     }
 
     /// Free / occupied / unknown per cell; unobserved cells are unknown whatever the prior.
@@ -40,13 +37,7 @@ impl Raster {
         self.log_odds
             .iter()
             .zip(&self.known)
-            .map(|(&l, &k)| {
-                if k {
-                    table.classify(probability(l as f64))
-                } else {
-                    Ternary::Unknown
-                }
-            })
+            .map(|(&l, &k)| if k { table.classify(probability(l as f64)) } else { Ternary::Unknown })
             .collect()
     }
 

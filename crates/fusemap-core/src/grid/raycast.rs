@@ -181,22 +181,10 @@ mod tests {
 
     #[test]
     fn axis_aligned_both_ways() {
-        assert_eq!(
-            walk((0.5, 0.5), (3.5, 0.5)),
-            vec![(0, 0), (1, 0), (2, 0), (3, 0)]
-        );
-        assert_eq!(
-            walk((3.5, 0.5), (0.5, 0.5)),
-            vec![(3, 0), (2, 0), (1, 0), (0, 0)]
-        );
-        assert_eq!(
-            walk((0.5, 0.5), (0.5, 3.5)),
-            vec![(0, 0), (0, 1), (0, 2), (0, 3)]
-        );
-        assert_eq!(
-            walk((0.5, 3.5), (0.5, 0.5)),
-            vec![(0, 3), (0, 2), (0, 1), (0, 0)]
-        );
+        assert_eq!(walk((0.5, 0.5), (3.5, 0.5)), vec![(0, 0), (1, 0), (2, 0), (3, 0)]);
+        assert_eq!(walk((3.5, 0.5), (0.5, 0.5)), vec![(3, 0), (2, 0), (1, 0), (0, 0)]);
+        assert_eq!(walk((0.5, 0.5), (0.5, 3.5)), vec![(0, 0), (0, 1), (0, 2), (0, 3)]);
+        assert_eq!(walk((0.5, 3.5), (0.5, 0.5)), vec![(0, 3), (0, 2), (0, 1), (0, 0)]);
     }
 
     #[test]
@@ -257,10 +245,7 @@ mod tests {
             let a = (0.37 * s, 0.21 * s);
             let b = (4.91 * s, -2.63 * s);
             let w = walk(a, b);
-            assert_eq!(
-                w.last().copied(),
-                Some((b.0.floor() as i64, b.1.floor() as i64))
-            );
+            assert_eq!(w.last().copied(), Some((b.0.floor() as i64, b.1.floor() as i64)));
             assert_connected(&w);
             assert_no_repeats(&w);
             assert_eq!(w, reference_walk_cells(a, b, &w));
@@ -313,14 +298,8 @@ mod tests {
     /// Brute force: every cell whose interior the segment crosses (shrunk cells, so grazing
     /// a corner or running along a border does not count), plus the start and end cells.
     fn must_visit(a: (f64, f64), b: (f64, f64)) -> HashSet<(i64, i64)> {
-        let (xmin, xmax) = (
-            a.0.min(b.0).floor() as i64 - 1,
-            a.0.max(b.0).floor() as i64 + 1,
-        );
-        let (ymin, ymax) = (
-            a.1.min(b.1).floor() as i64 - 1,
-            a.1.max(b.1).floor() as i64 + 1,
-        );
+        let (xmin, xmax) = (a.0.min(b.0).floor() as i64 - 1, a.0.max(b.0).floor() as i64 + 1);
+        let (ymin, ymax) = (a.1.min(b.1).floor() as i64 - 1, a.1.max(b.1).floor() as i64 + 1);
         let mut s = HashSet::new();
         for i in xmin..=xmax {
             for j in ymin..=ymax {
@@ -343,28 +322,21 @@ mod tests {
     fn reference_walk_cells(a: (f64, f64), b: (f64, f64), w: &[(i64, i64)]) -> Vec<(i64, i64)> {
         let mut last_lo = -1.0;
         for &(i, j) in w {
-            let (lo, _) = clip(a, b, i, j, 1e-9)
-                .unwrap_or_else(|| panic!("cell {:?} not on segment {a:?}->{b:?}", (i, j)));
+            let (lo, _) =
+                clip(a, b, i, j, 1e-9).unwrap_or_else(|| panic!("cell {:?} not on segment {a:?}->{b:?}", (i, j)));
             assert!(lo >= last_lo - 1e-9, "walk goes backwards at {:?}", (i, j));
             last_lo = lo;
         }
         let set: HashSet<_> = w.iter().copied().collect();
         for c in must_visit(a, b) {
-            assert!(
-                set.contains(&c),
-                "walk {a:?}->{b:?} misses crossed cell {c:?}"
-            );
+            assert!(set.contains(&c), "walk {a:?}->{b:?} misses crossed cell {c:?}");
         }
         w.to_vec()
     }
 
     fn coord() -> impl Strategy<Value = f64> {
         // Mix free floats with coordinates snapped to borders and half cells.
-        prop_oneof![
-            -20.0..20.0f64,
-            (-40i32..40).prop_map(|k| k as f64 * 0.5),
-            (-20i32..20).prop_map(|k| k as f64),
-        ]
+        prop_oneof![-20.0..20.0f64, (-40i32..40).prop_map(|k| k as f64 * 0.5), (-20i32..20).prop_map(|k| k as f64),]
     }
 
     proptest! {

@@ -56,11 +56,7 @@ pub struct TileMap<T> {
 
 impl<T: Tile> Default for TileMap<T> {
     fn default() -> Self {
-        Self {
-            index: HashMap::default(),
-            keys: Vec::new(),
-            tiles: Vec::new(),
-        }
+        Self { index: HashMap::default(), keys: Vec::new(), tiles: Vec::new() }
     }
 }
 
@@ -109,10 +105,7 @@ impl<T: Tile> TileMap<T> {
 
     /// All tiles with their keys, in allocation order.
     pub fn iter(&self) -> impl Iterator<Item = (TileKey, &T)> {
-        self.keys
-            .iter()
-            .copied()
-            .zip(self.tiles.iter().map(|b| &**b))
+        self.keys.iter().copied().zip(self.tiles.iter().map(|b| &**b))
     }
 
     /// Bytes held by tiles (not counting the index).
@@ -136,21 +129,13 @@ mod tests {
     fn tiles_are_allocated_on_demand_with_wide_keys() {
         let mut m: TileMap<Counter> = TileMap::new();
         assert!(m.is_empty());
-        let far = TileKey {
-            x: i64::MAX >> 7,
-            y: i64::MIN >> 7,
-        };
+        let far = TileKey { x: i64::MAX >> 7, y: i64::MIN >> 7 };
         m.get_or_insert(far).0[0] = 7;
         m.get_or_insert(TileKey { x: -1, y: 0 }).0[1] = 3;
         assert_eq!(m.len(), 2);
         assert_eq!(m.get(far).unwrap().0[0], 7);
         // A key that differs only in the high bits is a different tile.
-        assert!(m
-            .get(TileKey {
-                x: (i64::MAX >> 7) ^ (1 << 40),
-                y: i64::MIN >> 7
-            })
-            .is_none());
+        assert!(m.get(TileKey { x: (i64::MAX >> 7) ^ (1 << 40), y: i64::MIN >> 7 }).is_none());
         m.get_or_insert(far).0[0] += 1;
         assert_eq!(m.len(), 2);
         assert_eq!(m.get(far).unwrap().0[0], 8);

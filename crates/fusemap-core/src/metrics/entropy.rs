@@ -32,19 +32,11 @@ pub struct EntropyReport {
 pub fn map_entropy(raster: &Raster) -> EntropyReport {
     let cells = raster.log_odds.len() as u64;
     let known_cells = raster.known_count() as u64;
-    let sum: f64 = raster
-        .log_odds
-        .iter()
-        .map(|&l| binary_entropy(probability(l as f64)))
-        .sum();
+    let sum: f64 = raster.log_odds.iter().map(|&l| binary_entropy(probability(l as f64))).sum();
     EntropyReport {
         cells,
         known_cells,
-        known_share: if cells > 0 {
-            known_cells as f64 / cells as f64
-        } else {
-            0.0
-        },
+        known_share: if cells > 0 { known_cells as f64 / cells as f64 } else { 0.0 },
         mean_entropy_nats: if cells > 0 { sum / cells as f64 } else { 0.0 },
     }
 }
@@ -79,9 +71,6 @@ mod tests {
         assert_eq!(e.cells, 2);
         assert_eq!(e.known_cells, 1);
         assert!((e.known_share - 0.5).abs() < 1e-12);
-        assert!(
-            (e.mean_entropy_nats - (std::f64::consts::LN_2 + binary_entropy(1.0)) / 2.0).abs()
-                < 1e-9
-        );
+        assert!((e.mean_entropy_nats - (std::f64::consts::LN_2 + binary_entropy(1.0)) / 2.0).abs() < 1e-9);
     }
 }

@@ -67,22 +67,8 @@ mod tests {
 
     #[test]
     fn scores() {
-        let c = Confusion::from_pairs([
-            (true, true),
-            (true, false),
-            (false, true),
-            (false, false),
-            (true, true),
-        ]);
-        assert_eq!(
-            c,
-            Confusion {
-                true_positive: 2,
-                false_positive: 1,
-                false_negative: 1,
-                true_negative: 1
-            }
-        );
+        let c = Confusion::from_pairs([(true, true), (true, false), (false, true), (false, false), (true, true)]);
+        assert_eq!(c, Confusion { true_positive: 2, false_positive: 1, false_negative: 1, true_negative: 1 });
         assert!((c.precision() - 2.0 / 3.0).abs() < 1e-12);
         assert!((c.recall() - 2.0 / 3.0).abs() < 1e-12);
         assert!((c.f1() - 2.0 / 3.0).abs() < 1e-12);

@@ -46,13 +46,7 @@ pub struct LidarParams {
 
 impl Default for LidarParams {
     fn default() -> Self {
-        Self {
-            p_occ: 0.9,
-            p_free: 0.4,
-            min_range: 0.1,
-            max_range: 10.0,
-            max_range_policy: MaxRangePolicy::Skip,
-        }
+        Self { p_occ: 0.9, p_free: 0.4, min_range: 0.1, max_range: 10.0, max_range_policy: MaxRangePolicy::Skip }
     }
 }
 
@@ -73,17 +67,8 @@ impl LaserScan {
     /// A scan of `n` evenly spaced beams from `angle_min` to `angle_max` inclusive.
     pub fn evenly_spaced(stamp: Stamp, angle_min: f64, angle_max: f64, ranges: Vec<f32>) -> Self {
         let n = ranges.len();
-        let inc = if n > 1 {
-            (angle_max - angle_min) / (n - 1) as f64
-        } else {
-            0.0
-        };
-        Self {
-            stamp,
-            angle_min,
-            angle_increment: inc,
-            ranges,
-        }
+        let inc = if n > 1 { (angle_max - angle_min) / (n - 1) as f64 } else { 0.0 };
+        Self { stamp, angle_min, angle_increment: inc, ranges }
     }
 }
 
@@ -182,18 +167,12 @@ impl LidarModel {
             // A message claiming an empty interval: nothing it reports is valid.
             p.min_range = p.max_range;
         }
-        LidarModel {
-            params: p,
-            mount: self.mount,
-        }
+        LidarModel { params: p, mount: self.mount }
     }
 
     /// The evidence probabilities of this model.
     pub fn evidence(&self) -> Evidence {
-        Evidence {
-            p_hit: self.params.p_occ,
-            p_miss: self.params.p_free,
-        }
+        Evidence { p_hit: self.params.p_occ, p_miss: self.params.p_free }
     }
 
     #[inline]
@@ -281,17 +260,11 @@ impl LidarModel {
                 }
             };
             let world_from_base = pose_of_beam(i);
-            let angle = world_from_base.theta
-                + self
-                    .mount
-                    .beam_angle_in_base(scan.angle_min + i as f64 * scan.angle_increment);
+            let angle =
+                world_from_base.theta + self.mount.beam_angle_in_base(scan.angle_min + i as f64 * scan.angle_increment);
             let origin = world_from_base * origin_in_base;
             let (s, c) = angle.sin_cos();
-            out.rays.push(Ray {
-                origin,
-                end: Point2::new(origin.x + range * c, origin.y + range * s),
-                hit,
-            });
+            out.rays.push(Ray { origin, end: Point2::new(origin.x + range * c, origin.y + range * s), hit });
         }
     }
 }
@@ -303,13 +276,8 @@ mod tests {
     use std::f64::consts::FRAC_PI_2;
 
     fn run(policy: MaxRangePolicy, ranges: Vec<f32>) -> (RangeData, ReturnCounts) {
-        let model = LidarModel::new(
-            LidarParams {
-                max_range_policy: policy,
-                ..Default::default()
-            },
-            PlanarMount::default(),
-        );
+        let model =
+            LidarModel::new(LidarParams { max_range_policy: policy, ..Default::default() }, PlanarMount::default());
         let scan = LaserScan::evenly_spaced(Stamp(7), -FRAC_PI_2, FRAC_PI_2, ranges);
         let mut out = RangeData::empty(SensorId(0), model.evidence());
         let mut counts = ReturnCounts::default();
@@ -319,33 +287,12 @@ mod tests {
 
     #[test]
     fn invalid_returns_are_counted_never_used() {
-        let corpus = vec![
-            f32::NAN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            0.0,
-            -1.0,
-            1e-9,
-            10.0,
-            25.0,
-            3.0,
-        ];
+        let corpus = vec![f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -1.0, 1e-9, 10.0, 25.0, 3.0];
         let (rd, c) = run(MaxRangePolicy::Skip, corpus.clone());
         assert_eq!(rd.rays.len(), 1);
         assert_eq!(rd.stamp, Stamp(7));
         assert_eq!(rd.sensor, SensorId(3));
-        assert_eq!(
-            c,
-            ReturnCounts {
-                valid: 1,
-                no_return: 2,
-                nan: 1,
-                infinite: 2,
-                zero: 1,
-                negative: 1,
-                below_min: 1
-            }
-        );
+        assert_eq!(c, ReturnCounts { valid: 1, no_return: 2, nan: 1, infinite: 2, zero: 1, negative: 1, below_min: 1 });
         assert_eq!(c.total(), corpus.len() as u64);
         // Under `clear` the two no-returns clear to max_range without a hit.
         let (rd, c) = run(MaxRangePolicy::Clear, corpus);
@@ -360,13 +307,7 @@ mod tests {
 
     #[test]
     fn message_limits_narrow_the_model() {
-        let m = LidarModel::new(
-            LidarParams {
-                max_range: 40.0,
-                ..Default::default()
-            },
-            PlanarMount::default(),
-        );
+        let m = LidarModel::new(LidarParams { max_range: 40.0, ..Default::default() }, PlanarMount::default());
         let l = m.limited_to(0.2, 30.0);
         assert_eq!(l.params().min_range, 0.2f32 as f64);
         assert_eq!(l.params().max_range, 30.0);
@@ -382,30 +323,13 @@ mod tests {
 
     #[test]
     fn beams_follow_pose_and_mount() {
-        let mount = Mount3 {
-            x: 0.5,
-            yaw: FRAC_PI_2,
-            ..Default::default()
-        }
-        .to_planar(0.01)
-        .unwrap();
+        let mount = Mount3 { x: 0.5, yaw: FRAC_PI_2, ..Default::default() }.to_planar(0.01).unwrap();
         let model = LidarModel::new(LidarParams::default(), mount);
-        let scan = LaserScan {
-            stamp: Stamp(0),
-            angle_min: 0.0,
-            angle_increment: 0.0,
-            ranges: vec![2.0],
-        };
+        let scan = LaserScan { stamp: Stamp(0), angle_min: 0.0, angle_increment: 0.0, ranges: vec![2.0] };
         let mut out = RangeData::empty(SensorId(0), model.evidence());
         let mut counts = ReturnCounts::default();
         // Robot at (1, 1) facing +x; lidar 0.5 m ahead looking left: hit at (1.5, 3).
-        model.scan_to_range_data(
-            SensorId(0),
-            &scan,
-            Pose2::new(1.0, 1.0, 0.0),
-            &mut out,
-            &mut counts,
-        );
+        model.scan_to_range_data(SensorId(0), &scan, Pose2::new(1.0, 1.0, 0.0), &mut out, &mut counts);
         let r = out.rays[0];
         assert!(r.origin.distance(Point2::new(1.5, 1.0)) < 1e-12);
         assert!(r.end.distance(Point2::new(1.5, 3.0)) < 1e-6, "{:?}", r.end);

@@ -32,13 +32,7 @@ impl ScannerSpec {
     /// The document's scanner: 181 beams over [-π/2, π/2], 10 m, 10 Hz.
     pub fn document() -> Self {
         use std::f64::consts::FRAC_PI_2;
-        Self {
-            beams: 181,
-            angle_min: -FRAC_PI_2,
-            angle_max: FRAC_PI_2,
-            range_max: 10.0,
-            rate_hz: 10.0,
-        }
+        Self { beams: 181, angle_min: -FRAC_PI_2, angle_max: FRAC_PI_2, range_max: 10.0, rate_hz: 10.0 }
     }
 
     /// Angle between beams.
@@ -64,20 +58,14 @@ pub fn simulate_scan(
     let origin = world_from_base * mount.origin_in_base();
     let ranges = (0..spec.beams)
         .map(|i| {
-            let a =
-                world_from_base.theta + mount.beam_angle_in_base(spec.angle_min + i as f64 * inc);
+            let a = world_from_base.theta + mount.beam_angle_in_base(spec.angle_min + i as f64 * inc);
             match world.cast(origin, a) {
                 Some(d) if d < spec.range_max => d as f32,
                 _ => spec.range_max as f32,
             }
         })
         .collect();
-    LaserScan {
-        stamp,
-        angle_min: spec.angle_min,
-        angle_increment: inc,
-        ranges,
-    }
+    LaserScan { stamp, angle_min: spec.angle_min, angle_increment: inc, ranges }
 }
 
 /// A whole simulated run: a trajectory of base poses, one scan at each.
@@ -105,15 +93,8 @@ impl SimulatedRun {
 
     /// The document's corridor run: poses (0.1·i, 0, 0), i = 0..40.
     pub fn document_corridor() -> Self {
-        let poses = (0..40)
-            .map(|i| Pose2::new(0.1 * i as f64, 0.0, 0.0))
-            .collect();
-        Self::new(
-            &super::corridor(),
-            &ScannerSpec::document(),
-            &PlanarMount::default(),
-            poses,
-        )
+        let poses = (0..40).map(|i| Pose2::new(0.1 * i as f64, 0.0, 0.0)).collect();
+        Self::new(&super::corridor(), &ScannerSpec::document(), &PlanarMount::default(), poses)
     }
 }
 

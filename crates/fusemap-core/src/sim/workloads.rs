@@ -30,11 +30,7 @@ pub const WORKLOADS: [char; 3] = ['a', 'b', 'c'];
 
 /// Builds workload `name` (`'a'`, `'b'`, `'c'`); `None` for another name.
 pub fn workload(name: char) -> Option<Workload> {
-    let corridor_poses = |n: usize| {
-        (0..n)
-            .map(|i| Pose2::new(0.1 * (i % 40) as f64, 0.0, 0.0))
-            .collect()
-    };
+    let corridor_poses = |n: usize| (0..n).map(|i| Pose2::new(0.1 * (i % 40) as f64, 0.0, 0.0)).collect();
     let mount = PlanarMount::default();
     match name {
         'a' | 'b' => {
@@ -48,12 +44,7 @@ pub fn workload(name: char) -> Option<Workload> {
                 },
                 resolution: 0.05,
                 lidar: LidarParams::default(),
-                run: SimulatedRun::new(
-                    &corridor(),
-                    &ScannerSpec::document(),
-                    &mount,
-                    corridor_poses(n),
-                ),
+                run: SimulatedRun::new(&corridor(), &ScannerSpec::document(), &mount, corridor_poses(n)),
             })
         }
         'c' => {
@@ -68,21 +59,13 @@ pub fn workload(name: char) -> Option<Workload> {
                 }
             }
             let half_fov = 135f64.to_radians();
-            let spec = ScannerSpec {
-                beams: 1081,
-                angle_min: -half_fov,
-                angle_max: half_fov,
-                range_max: 30.0,
-                rate_hz: 40.0,
-            };
+            let spec =
+                ScannerSpec { beams: 1081, angle_min: -half_fov, angle_max: half_fov, range_max: 30.0, rate_hz: 40.0 };
             Some(Workload {
                 name,
                 description: "39 m box, 5,000 scans x 1,081 beams over 270 deg, 0.02 m, 30 m range",
                 resolution: 0.02,
-                lidar: LidarParams {
-                    max_range: 30.0,
-                    ..LidarParams::default()
-                },
+                lidar: LidarParams { max_range: 30.0, ..LidarParams::default() },
                 run: SimulatedRun::new(&b.world, &spec, &mount, poses),
             })
         }

@@ -16,10 +16,7 @@ pub struct Segment {
 impl Segment {
     /// A segment between two points.
     pub fn new(ax: f64, ay: f64, bx: f64, by: f64) -> Self {
-        Self {
-            a: Point2::new(ax, ay),
-            b: Point2::new(bx, by),
-        }
+        Self { a: Point2::new(ax, ay), b: Point2::new(bx, by) }
     }
 
     /// Distance along the ray `origin + t·(cos θ, sin θ)` to this segment, `None` when it
@@ -50,10 +47,7 @@ impl World {
     /// Distance to the nearest wall along the ray, `None` when no wall is hit.
     pub fn cast(&self, origin: Point2, angle: f64) -> Option<f64> {
         let (s, c) = angle.sin_cos();
-        self.segments
-            .iter()
-            .filter_map(|seg| seg.intersect(origin, (c, s)))
-            .min_by(f64::total_cmp)
+        self.segments.iter().filter_map(|seg| seg.intersect(origin, (c, s))).min_by(f64::total_cmp)
     }
 }
 
@@ -87,12 +81,10 @@ impl BoxWorld {
     pub fn is_free(&self, p: Point2, margin: f64) -> bool {
         let inside = p.x.abs() < self.half - margin && p.y.abs() < self.half - margin;
         inside
-            && !self.rects.iter().any(|r| {
-                p.x > r[0] - margin
-                    && p.x < r[2] + margin
-                    && p.y > r[1] - margin
-                    && p.y < r[3] + margin
-            })
+            && !self
+                .rects
+                .iter()
+                .any(|r| p.x > r[0] - margin && p.x < r[2] + margin && p.y > r[1] - margin && p.y < r[3] + margin)
     }
 }
 
@@ -105,14 +97,9 @@ pub fn box_world(half: f64, n_rects: usize, seed: u64) -> BoxWorld {
     while rects.len() < n_rects && attempts < 10_000 {
         attempts += 1;
         let (w, h) = (rng.uniform(1.0, 6.0), rng.uniform(1.0, 6.0));
-        let (cx, cy) = (
-            rng.uniform(-half + 3.0, half - 3.0),
-            rng.uniform(-half + 3.0, half - 3.0),
-        );
+        let (cx, cy) = (rng.uniform(-half + 3.0, half - 3.0), rng.uniform(-half + 3.0, half - 3.0));
         let r = [cx - w / 2.0, cy - h / 2.0, cx + w / 2.0, cy + h / 2.0];
-        let apart = |q: &[f64; 4]| {
-            r[2] + 1.0 < q[0] || q[2] + 1.0 < r[0] || r[3] + 1.0 < q[1] || q[3] + 1.0 < r[1]
-        };
+        let apart = |q: &[f64; 4]| r[2] + 1.0 < q[0] || q[2] + 1.0 < r[0] || r[3] + 1.0 < q[1] || q[3] + 1.0 < r[1];
         if rects.iter().all(apart) {
             rects.push(r);
         }
@@ -130,11 +117,7 @@ pub fn box_world(half: f64, n_rects: usize, seed: u64) -> BoxWorld {
         segments.push(Segment::new(r[2], r[3], r[0], r[3]));
         segments.push(Segment::new(r[0], r[3], r[0], r[1]));
     }
-    BoxWorld {
-        world: World { segments },
-        half,
-        rects,
-    }
+    BoxWorld { world: World { segments }, half, rects }
 }
 
 #[cfg(test)]
@@ -163,10 +146,7 @@ mod tests {
         for _ in 0..200 {
             let p = Point2::new(rng.uniform(-19.0, 19.0), rng.uniform(-19.0, 19.0));
             if b.is_free(p, 0.1) {
-                let d = b
-                    .world
-                    .cast(p, rng.uniform(-3.2, 3.2))
-                    .expect("closed room");
+                let d = b.world.cast(p, rng.uniform(-3.2, 3.2)).expect("closed room");
                 assert!(d > 0.0 && d < 56.0);
             }
         }

@@ -80,16 +80,8 @@ pub struct PoseBuffer {
 impl PoseBuffer {
     /// An empty buffer refusing to interpolate across gaps longer than `max_gap_s`.
     pub fn new(max_gap_s: f64) -> Self {
-        let max_gap_ns = if max_gap_s.is_finite() {
-            (max_gap_s * 1e9).max(0.0) as i64
-        } else {
-            i64::MAX
-        };
-        Self {
-            stamps: Vec::new(),
-            poses: Vec::new(),
-            max_gap_ns,
-        }
+        let max_gap_ns = if max_gap_s.is_finite() { (max_gap_s * 1e9).max(0.0) as i64 } else { i64::MAX };
+        Self { stamps: Vec::new(), poses: Vec::new(), max_gap_ns }
     }
 
     /// Samples held.
@@ -156,10 +148,7 @@ impl PoseBuffer {
         let (t0, t1) = (self.stamps[i - 1], self.stamps[i]);
         let gap = t1.0 - t0.0;
         if gap > self.max_gap_ns {
-            return Err(NoPose::Gap {
-                gap_s: gap as f64 * 1e-9,
-                limit_s: self.max_gap_ns as f64 * 1e-9,
-            });
+            return Err(NoPose::Gap { gap_s: gap as f64 * 1e-9, limit_s: self.max_gap_ns as f64 * 1e-9 });
         }
         let f = (t.0 - t0.0) as f64 / gap as f64;
         Ok(self.poses[i - 1].interpolate(self.poses[i], f))
@@ -185,10 +174,7 @@ impl PoseBuffer {
         if distance_s <= tolerance_s {
             Ok(self.poses[j])
         } else {
-            Err(NoPose::TooFar {
-                distance_s,
-                tolerance_s,
-            })
+            Err(NoPose::TooFar { distance_s, tolerance_s })
         }
     }
 }
@@ -216,10 +202,7 @@ mod tests {
         let p = b.interpolate(s(0.15)).unwrap();
         assert!((p.x - 1.5).abs() < 1e-9);
         assert_eq!(b.interpolate(s(0.1)).unwrap().x, 1.0);
-        assert!(matches!(
-            b.interpolate(s(-0.01)),
-            Err(NoPose::BeforeStart(_))
-        ));
+        assert!(matches!(b.interpolate(s(-0.01)), Err(NoPose::BeforeStart(_))));
         assert!(matches!(b.interpolate(s(1.01)), Err(NoPose::AfterEnd(_))));
         // 0.2 → 1.0 is a 0.8 s gap: no pose inside it.
         assert!(matches!(b.interpolate(s(0.5)), Err(NoPose::Gap { .. })));
@@ -232,10 +215,7 @@ mod tests {
         let b = buffer();
         assert_eq!(b.nearest(s(0.13), 0.05).unwrap().x, 1.0);
         assert_eq!(b.nearest(s(0.17), 0.05).unwrap().x, 2.0);
-        assert!(matches!(
-            b.nearest(s(0.5), 0.05),
-            Err(NoPose::TooFar { .. })
-        ));
+        assert!(matches!(b.nearest(s(0.5), 0.05), Err(NoPose::TooFar { .. })));
         assert_eq!(b.nearest(s(1.04), 0.05).unwrap().x, 3.0);
     }
 
@@ -244,10 +224,7 @@ mod tests {
         let mut b = buffer();
         assert_eq!(b.push(s(1.0), Pose2::default()), PushOutcome::Duplicate);
         assert_eq!(b.push(s(0.5), Pose2::default()), PushOutcome::OutOfOrder);
-        assert_eq!(
-            b.push(s(2.0), Pose2::new(f64::NAN, 0.0, 0.0)),
-            PushOutcome::NotFinite
-        );
+        assert_eq!(b.push(s(2.0), Pose2::new(f64::NAN, 0.0, 0.0)), PushOutcome::NotFinite);
         assert_eq!(b.len(), 4);
     }
 

@@ -5,9 +5,7 @@ use serde::{Deserialize, Serialize};
 /// A time stamp in integer nanoseconds since an arbitrary epoch (Unix time for ROS logs,
 /// log start for relative CARMEN logs). Integer so that equal stamps compare equal and
 /// ordering is exact; `i64` nanoseconds span ±292 years.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct Stamp(pub i64);
 
 impl Stamp {
@@ -48,10 +46,7 @@ impl Stamp {
 
     /// From ROS `sec` + `nanosec` fields.
     pub fn from_sec_nsec(sec: i64, nsec: u32) -> Stamp {
-        Stamp(
-            sec.saturating_mul(1_000_000_000)
-                .saturating_add(nsec as i64),
-        )
+        Stamp(sec.saturating_mul(1_000_000_000).saturating_add(nsec as i64))
     }
 
     /// Seconds as `f64`.
@@ -76,17 +71,11 @@ mod tests {
         assert_eq!(Stamp::from_sec_nsec(2, 5), Stamp(2_000_000_005));
         assert!((Stamp(2_500_000_000).secs_since(Stamp(1_000_000_000)) - 1.5).abs() < 1e-12);
         // Unix stamps of the SLAM-benchmark logs keep their microseconds exactly.
-        assert_eq!(
-            Stamp::parse_decimal("1134864629.895182"),
-            Some(Stamp(1_134_864_629_895_182_000))
-        );
+        assert_eq!(Stamp::parse_decimal("1134864629.895182"), Some(Stamp(1_134_864_629_895_182_000)));
         assert_eq!(Stamp::parse_decimal("-0.042"), Some(Stamp(-42_000_000)));
         assert_eq!(Stamp::parse_decimal("12"), Some(Stamp(12_000_000_000)));
         assert_eq!(Stamp::parse_decimal(".5"), Some(Stamp(500_000_000)));
-        assert_eq!(
-            Stamp::parse_decimal("0.1234567891"),
-            Some(Stamp(123_456_789))
-        );
+        assert_eq!(Stamp::parse_decimal("0.1234567891"), Some(Stamp(123_456_789)));
         for bad in ["", "-", ".", "1e5", "nan", "1.2.3", "0x10", " 1"] {
             assert_eq!(Stamp::parse_decimal(bad), None, "{bad}");
         }

@@ -16,10 +16,7 @@ pub struct TimingLimits {
 
 impl Default for TimingLimits {
     fn default() -> Self {
-        Self {
-            gap_s: 0.5,
-            far_delay_s: 1.0,
-        }
+        Self { gap_s: 0.5, far_delay_s: 1.0 }
     }
 }
 
@@ -99,36 +96,24 @@ impl StreamTiming {
             (0.0, 0.0)
         } else {
             let mean = periods.iter().sum::<f64>() / periods.len() as f64;
-            let var =
-                periods.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / periods.len() as f64;
+            let var = periods.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / periods.len() as f64;
             periods.sort_by(f64::total_cmp);
             (periods[periods.len() / 2], var.sqrt())
         };
-        let delays: Vec<f64> = header
-            .iter()
-            .zip(receive)
-            .filter_map(|(h, r)| r.map(|r| r.secs_since(*h)))
-            .collect();
+        let delays: Vec<f64> = header.iter().zip(receive).filter_map(|(h, r)| r.map(|r| r.secs_since(*h))).collect();
         let delay = (!delays.is_empty()).then(|| DelayStats {
             count: delays.len() as u64,
             mean_s: delays.iter().sum::<f64>() / delays.len() as f64,
             min_s: delays.iter().copied().fold(f64::INFINITY, f64::min),
             max_s: delays.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            far: delays
-                .iter()
-                .filter(|d| d.abs() > limits.far_delay_s)
-                .count() as u64,
+            far: delays.iter().filter(|d| d.abs() > limits.far_delay_s).count() as u64,
         });
         Self {
             count,
             first_s: first.map(Stamp::as_secs_f64),
             last_s: last.map(Stamp::as_secs_f64),
             span_s,
-            rate_hz: if span_s > 0.0 {
-                (count - 1) as f64 / span_s
-            } else {
-                0.0
-            },
+            rate_hz: if span_s > 0.0 { (count - 1) as f64 / span_s } else { 0.0 },
             median_period_s,
             jitter_s,
             regressions,
@@ -145,18 +130,13 @@ mod tests {
     use super::*;
 
     fn st(v: &[f64]) -> Vec<Stamp> {
-        v.iter()
-            .map(|&s| Stamp::from_secs_f64(s).unwrap())
-            .collect()
+        v.iter().map(|&s| Stamp::from_secs_f64(s).unwrap()).collect()
     }
 
     #[test]
     fn faults_are_counted() {
         let h = st(&[0.0, 0.1, 0.2, 0.2, 0.15, 0.3, 1.3, 1.4]);
-        let r: Vec<_> = st(&[0.01, 0.11, 0.21, 0.21, 0.16, 2.0, 1.31, 1.41])
-            .into_iter()
-            .map(Some)
-            .collect();
+        let r: Vec<_> = st(&[0.01, 0.11, 0.21, 0.21, 0.16, 2.0, 1.31, 1.41]).into_iter().map(Some).collect();
         let t = StreamTiming::analyze(&h, &r, TimingLimits::default());
         assert_eq!(t.count, 8);
         assert_eq!(t.regressions, 1);
@@ -179,9 +159,6 @@ mod tests {
         assert!(t.jitter_s < 1e-9);
         assert_eq!(t.delay, None);
         assert_eq!(t.regressions + t.duplicates + t.gaps, 0);
-        assert_eq!(
-            StreamTiming::analyze(&[], &[], TimingLimits::default()).count,
-            0
-        );
+        assert_eq!(StreamTiming::analyze(&[], &[], TimingLimits::default()).count, 0);
     }
 }
