@@ -7,6 +7,8 @@
 
 mod mount;
 mod pose2;
+mod pose3;
 
 pub use mount::{quaternion_to_rpy, quaternion_yaw, Mount3, MountError, PlanarMount};
 pub use pose2::{normalize_angle, Point2, Pose2};
+pub use pose3::Pose3;
