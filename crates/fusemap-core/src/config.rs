@@ -231,6 +231,19 @@ fn probability(field: &str, v: f64) -> Result<f64, ConfigError> {
     }
 }
 
+/// One validated lidar.
+#[derive(Clone, Debug)]
+pub struct PlannedLidar {
+    /// Name (frame id).
+    pub name: String,
+    /// The inverse model with the planar mount.
+    pub model: LidarModel,
+    /// The mount as configured (3D).
+    pub mount: Mount3,
+    /// Largest accepted scan-plane tilt, radians.
+    pub max_tilt: f64,
+}
+
 /// A validated configuration, ready to build a map and sensor models.
 #[derive(Clone, Debug)]
 pub struct Plan {
@@ -238,8 +251,8 @@ pub struct Plan {
     pub geometry: GridGeometry,
     /// The grid's probabilities.
     pub occupancy: OccupancyParams,
-    /// Each lidar's name and model.
-    pub lidars: Vec<(String, LidarModel)>,
+    /// Each lidar: name, model and the 3D mount it was reduced from.
+    pub lidars: Vec<PlannedLidar>,
     /// How logs are read.
     pub log: LogConfig,
 }
@@ -316,7 +329,12 @@ impl Config {
                 l.mount.to_planar(tilt.to_radians()).map_err(|e| err(f("mount"), e.to_string()))?;
             let params =
                 LidarParams { p_occ, p_free, min_range: min_r, max_range: max_r, max_range_policy: l.max_range_policy };
-            lidars.push((l.name.clone(), LidarModel::new(params, mount)));
+            lidars.push(PlannedLidar {
+                name: l.name.clone(),
+                model: LidarModel::new(params, mount),
+                mount: l.mount,
+                max_tilt: tilt.to_radians(),
+            });
         }
         let g = &self.log;
         finite("log.nearest_tolerance_s", g.nearest_tolerance_s)?;
@@ -353,7 +371,7 @@ mod tests {
         let p = Config::default().validate().unwrap();
         assert_eq!(p.geometry.resolution(), 0.05);
         assert_eq!(p.occupancy.prior, 0.5);
-        let (name, m) = &p.lidars[0];
+        let (name, m) = (&p.lidars[0].name, &p.lidars[0].model);
         assert_eq!(name, "laser");
         assert_eq!(m.params().p_occ, 0.9);
         assert_eq!(m.params().p_free, 0.4);

@@ -19,8 +19,8 @@
 //! use fusemap_core::{config::Config, fusion::Engine, grid::OccupancyGrid, sim::SimulatedRun};
 //! let plan = Config::default().validate().unwrap();
 //! let mut engine = Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy));
-//! let (name, model) = plan.lidars[0].clone();
-//! let laser = engine.add_lidar(name, model);
+//! let lidar = plan.lidars[0].clone();
+//! let laser = engine.add_lidar(lidar.name, lidar.model);
 //! let run = SimulatedRun::document_corridor();
 //! for (scan, pose) in run.scans.iter().zip(&run.poses) {
 //!     engine.insert_scan(laser, scan, *pose).unwrap();
