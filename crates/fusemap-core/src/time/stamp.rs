@@ -15,7 +15,7 @@ impl Stamp {
     /// From seconds (rounded to the nearest nanosecond). `None` when not finite or out of range.
     pub fn from_secs_f64(s: f64) -> Option<Stamp> {
         let ns = (s * 1e9).round();
-        (ns.is_finite() && ns.abs() < 9.2e18).then(|| Stamp(ns as i64))
+        (ns.is_finite() && ns.abs() < 9.2e18).then_some(Stamp(ns as i64))
     }
 
     /// Parses a decimal number of seconds (`"1134864629.895182"`, `"-0.042"`, `"12"`)

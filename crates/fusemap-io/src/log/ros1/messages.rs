@@ -1,0 +1,167 @@
+//! ROS 1 message payloads fusemap uses, decoded straight into its own types.
+//!
+//! ROS 1 serialisation is the fields in order, little-endian, with no padding; strings
+//! and variable-length arrays start with a `u32` length; `time` is `u32` seconds and
+//! `u32` nanoseconds; `std_msgs/Header` is `u32 seq`, `time stamp`, `string frame_id`.
+//! A layout is only valid for the definition it was written with, so each type carries
+//! the MD5 sum ROS computes from its standard definition and connections whose sum
+//! differs are refused.
+
+use super::cursor::{Cursor, Malformed};
+use crate::log::{ImuMessage, LogMessage, OdomMessage, ScanMessage, TfMessage, Transform};
+use fusemap_core::geometry::{quaternion_yaw, Pose2};
+use fusemap_core::sensor::LaserScan;
+use fusemap_core::time::Stamp;
+
+/// A message type this reader decodes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Kind {
+    /// `sensor_msgs/LaserScan`.
+    LaserScan,
+    /// `nav_msgs/Odometry`.
+    Odometry,
+    /// `tf2_msgs/TFMessage` or `tf/tfMessage` (the same definition).
+    Tf,
+    /// `sensor_msgs/Imu`.
+    Imu,
+}
+
+impl Kind {
+    /// The kind for a connection's `type`, with the MD5 sum of the standard definition
+    /// (ROS's sum over the definition text with nested types replaced by their sums;
+    /// the values `rosmsg md5` prints).
+    pub(super) fn from_type(ty: &[u8]) -> Option<(Kind, &'static str)> {
+        Some(match ty {
+            b"sensor_msgs/LaserScan" => (Kind::LaserScan, "90c7ef2dc6895d81024acba2ac42f369"),
+            b"nav_msgs/Odometry" => (Kind::Odometry, "cd5e73d190d741a2f92e81eda573aca7"),
+            b"tf2_msgs/TFMessage" | b"tf/tfMessage" => (Kind::Tf, "94810edda583a504dfda3829e70d7eec"),
+            b"sensor_msgs/Imu" => (Kind::Imu, "6a62c6daae103f4ff57a132d6f95cec2"),
+            _ => return None,
+        })
+    }
+
+    /// Short name for error messages.
+    fn name(self) -> &'static str {
+        match self {
+            Kind::LaserScan => "LaserScan",
+            Kind::Odometry => "Odometry",
+            Kind::Tf => "TFMessage",
+            Kind::Imu => "Imu",
+        }
+    }
+}
+
+/// Bytes of one `geometry_msgs/TransformStamped` with empty frame names: the least an
+/// element of a TF array can take.
+const MIN_TRANSFORM_SIZE: usize = 4 + 8 + 4 + 4 + 7 * 8;
+
+/// Decodes one message payload of `kind` published on `topic` and logged at `receive`.
+pub(super) fn decode(kind: Kind, topic: &str, receive: Stamp, payload: &[u8]) -> Result<LogMessage, Malformed> {
+    let mut c = Cursor::new(payload);
+    let receive_stamp = Some(receive);
+    let message = match kind {
+        Kind::LaserScan => scan(&mut c, topic, receive_stamp).map(LogMessage::Scan),
+        Kind::Odometry => odometry(&mut c, topic, receive_stamp).map(LogMessage::Odometry),
+        Kind::Tf => tf(&mut c, topic, receive_stamp).map(LogMessage::Tf),
+        Kind::Imu => imu(&mut c, topic, receive_stamp).map(LogMessage::Imu),
+    }
+    .map_err(|e| e.context(kind.name()))?;
+    if !c.is_empty() {
+        return Err(Malformed(format!(
+            "{}: {} bytes left over after the message's last field (the layout differs \
+             from the standard definition)",
+            kind.name(),
+            c.remaining()
+        )));
+    }
+    Ok(message)
+}
+
+/// `std_msgs/Header`: the stamp and frame; `seq` is skipped.
+fn header(c: &mut Cursor<'_>) -> Result<(Stamp, String), Malformed> {
+    c.u32("header.seq")?;
+    let stamp = c.time("header.stamp")?;
+    let frame = c.string("header.frame_id")?;
+    Ok((stamp, frame))
+}
+
+fn scan(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<ScanMessage, Malformed> {
+    let (stamp, frame_id) = header(c)?;
+    let angle_min = c.f32("angle_min")?;
+    let _angle_max = c.f32("angle_max")?;
+    let angle_increment = c.f32("angle_increment")?;
+    let time_increment = c.f32("time_increment")?;
+    let scan_time = c.f32("scan_time")?;
+    let range_min = c.f32("range_min")?;
+    let range_max = c.f32("range_max")?;
+    let ranges = c.f32_vec("ranges")?;
+    c.skip_f32_array("intensities")?;
+    Ok(ScanMessage {
+        topic: topic.to_string(),
+        frame_id,
+        receive_stamp,
+        scan: LaserScan { stamp, angle_min: f64::from(angle_min), angle_increment: f64::from(angle_increment), ranges },
+        time_increment,
+        scan_time,
+        range_min,
+        range_max,
+        pose: None,
+        odom_pose: None,
+        laser_pose: None,
+    })
+}
+
+fn odometry(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<OdomMessage, Malformed> {
+    let (stamp, frame_id) = header(c)?;
+    let child_frame_id = c.string("child_frame_id")?;
+    let [x, y, _z] = c.f64s::<3>("pose.pose.position")?;
+    let q = c.f64s::<4>("pose.pose.orientation")?;
+    // pose.covariance (36), twist.twist (6), twist.covariance (36).
+    c.take((36 + 6 + 36) * 8, "pose.covariance and twist")?;
+    Ok(OdomMessage {
+        topic: topic.to_string(),
+        stamp,
+        receive_stamp,
+        frame_id,
+        child_frame_id,
+        pose: Pose2::new(x, y, quaternion_yaw(q)),
+    })
+}
+
+fn tf(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<TfMessage, Malformed> {
+    let n = c.array_len(MIN_TRANSFORM_SIZE, "transforms")?;
+    let mut transforms = Vec::with_capacity(n);
+    for i in 0..n {
+        let t = transform(c).map_err(|e| e.context(format_args!("transforms[{i}]")))?;
+        transforms.push(t);
+    }
+    Ok(TfMessage { topic: topic.to_string(), is_static: topic == "/tf_static", receive_stamp, transforms })
+}
+
+/// `geometry_msgs/TransformStamped`.
+fn transform(c: &mut Cursor<'_>) -> Result<Transform, Malformed> {
+    let (stamp, parent) = header(c)?;
+    let child = c.string("child_frame_id")?;
+    let translation = c.f64s::<3>("transform.translation")?;
+    let rotation = c.f64s::<4>("transform.rotation")?;
+    Ok(Transform { stamp, parent, child, translation, rotation })
+}
+
+fn imu(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<ImuMessage, Malformed> {
+    let (stamp, frame_id) = header(c)?;
+    let orientation = c.f64s::<4>("orientation")?;
+    c.take(9 * 8, "orientation_covariance")?;
+    let angular_velocity = c.f64s::<3>("angular_velocity")?;
+    c.take(9 * 8, "angular_velocity_covariance")?;
+    let linear_acceleration = c.f64s::<3>("linear_acceleration")?;
+    c.take(9 * 8, "linear_acceleration_covariance")?;
+    Ok(ImuMessage {
+        topic: topic.to_string(),
+        stamp,
+        receive_stamp,
+        frame_id,
+        orientation,
+        angular_velocity,
+        linear_acceleration,
+    })
+}

@@ -1,0 +1,944 @@
+//! Tests of the ROS 1 bag reader: synthetic bags written byte by byte here, damaged in
+//! every way the reader must survive, and the shared SLAM-benchmark bags.
+
+use super::*;
+use crate::log::{ImuMessage, OdomMessage, ScanMessage, TfMessage, Transform};
+use crate::testdata;
+use fusemap_core::geometry::Pose2;
+use fusemap_core::sensor::LaserScan;
+use fusemap_core::time::Stamp;
+use std::collections::BTreeMap;
+use std::io::Write;
+
+// ---------------------------------------------------------------------------------------
+// A tiny bag writer.
+
+const SCAN_MD5: &str = "90c7ef2dc6895d81024acba2ac42f369";
+const ODOM_MD5: &str = "cd5e73d190d741a2f92e81eda573aca7";
+const TF_MD5: &str = "94810edda583a504dfda3829e70d7eec";
+const IMU_MD5: &str = "6a62c6daae103f4ff57a132d6f95cec2";
+
+/// A connection as a test declares it.
+#[derive(Clone, Copy)]
+struct Conn {
+    id: u32,
+    topic: &'static str,
+    ty: &'static str,
+    md5: &'static str,
+}
+
+const SCAN: Conn = Conn { id: 0, topic: "/scan", ty: "sensor_msgs/LaserScan", md5: SCAN_MD5 };
+const ODOM: Conn = Conn { id: 1, topic: "/odom", ty: "nav_msgs/Odometry", md5: ODOM_MD5 };
+const TF: Conn = Conn { id: 2, topic: "/tf", ty: "tf2_msgs/TFMessage", md5: TF_MD5 };
+const TF_STATIC: Conn = Conn { id: 3, topic: "/tf_static", ty: "tf/tfMessage", md5: TF_MD5 };
+const IMU: Conn = Conn { id: 4, topic: "/imu", ty: "sensor_msgs/Imu", md5: IMU_MD5 };
+const CHATTER: Conn = Conn { id: 5, topic: "/chatter", ty: "std_msgs/String", md5: "992ce8a1687cec8c8bd883ec73ca41d1" };
+
+/// A record inside a chunk.
+enum Inner {
+    Conn(Conn),
+    Msg { conn: u32, time: (u32, u32), payload: Vec<u8> },
+}
+
+fn msg(conn: Conn, time: (u32, u32), payload: Vec<u8>) -> Inner {
+    Inner::Msg { conn: conn.id, time, payload }
+}
+
+fn field(out: &mut Vec<u8>, name: &str, value: &[u8]) {
+    out.extend(((name.len() + 1 + value.len()) as u32).to_le_bytes());
+    out.extend(name.as_bytes());
+    out.push(b'=');
+    out.extend(value);
+}
+
+fn record(out: &mut Vec<u8>, fields: &[(&str, &[u8])], data: &[u8]) {
+    let mut header = Vec::new();
+    for (name, value) in fields {
+        field(&mut header, name, value);
+    }
+    out.extend((header.len() as u32).to_le_bytes());
+    out.extend(header);
+    out.extend((data.len() as u32).to_le_bytes());
+    out.extend(data);
+}
+
+fn connection_record(out: &mut Vec<u8>, c: Conn) {
+    let mut data = Vec::new();
+    field(&mut data, "topic", c.topic.as_bytes());
+    field(&mut data, "type", c.ty.as_bytes());
+    field(&mut data, "md5sum", c.md5.as_bytes());
+    field(&mut data, "message_definition", b"(not needed to read)\n");
+    record(
+        out,
+        &[("op", &[record::OP_CONNECTION]), ("conn", &c.id.to_le_bytes()), ("topic", c.topic.as_bytes())],
+        &data,
+    );
+}
+
+fn time_bytes((sec, nsec): (u32, u32)) -> Vec<u8> {
+    let mut t = sec.to_le_bytes().to_vec();
+    t.extend(nsec.to_le_bytes());
+    t
+}
+
+/// How a test chunk is stored.
+#[derive(Clone, Copy, Debug)]
+enum Compression {
+    None,
+    Bz2,
+    Lz4,
+    /// Written as the given name with uncompressed data.
+    Named(&'static str),
+}
+
+fn compress(c: Compression, data: &[u8]) -> (&'static str, Vec<u8>) {
+    match c {
+        Compression::None => ("none", data.to_vec()),
+        Compression::Bz2 => {
+            let mut e = bzip2::write::BzEncoder::new(Vec::new(), bzip2::Compression::best());
+            e.write_all(data).unwrap();
+            ("bz2", e.finish().unwrap())
+        }
+        Compression::Lz4 => {
+            // As roslz4 writes it: independent blocks, a content checksum, no block
+            // checksums, no content size.
+            let info = lz4_flex::frame::FrameInfo::new()
+                .block_size(lz4_flex::frame::BlockSize::Max64KB)
+                .block_mode(lz4_flex::frame::BlockMode::Independent)
+                .content_checksum(true);
+            let mut e = lz4_flex::frame::FrameEncoder::with_frame_info(info, Vec::new());
+            e.write_all(data).unwrap();
+            ("lz4", e.finish().unwrap())
+        }
+        Compression::Named(name) => (name, data.to_vec()),
+    }
+}
+
+/// A complete indexed bag: magic, bag header, the chunks (each followed by index data
+/// records), then the index section (connections and chunk infos), like `rosbag record`
+/// writes it.
+fn bag(chunks: Vec<(Compression, Vec<Inner>)>) -> Vec<u8> {
+    let mut out = record::MAGIC.to_vec();
+    let header_at = out.len();
+    let chunk_count = chunks.len() as u32;
+    let mut conns = Vec::new();
+    bag_header(&mut out, 0, 0, chunk_count);
+    let mut chunk_infos = Vec::new();
+    for (compression, records) in chunks {
+        let mut data = Vec::new();
+        let mut per_conn: BTreeMap<u32, Vec<u8>> = BTreeMap::new();
+        for r in records {
+            let offset = data.len() as u32;
+            match r {
+                Inner::Conn(c) => {
+                    connection_record(&mut data, c);
+                    conns.push(c);
+                }
+                Inner::Msg { conn, time, payload } => {
+                    let t = time_bytes(time);
+                    record(
+                        &mut data,
+                        &[("op", &[record::OP_MESSAGE_DATA]), ("conn", &conn.to_le_bytes()), ("time", &t)],
+                        &payload,
+                    );
+                    let entry = per_conn.entry(conn).or_default();
+                    entry.extend(&t);
+                    entry.extend(offset.to_le_bytes());
+                }
+            }
+        }
+        let (name, stored) = compress(compression, &data);
+        let chunk_pos = out.len() as u64;
+        record(
+            &mut out,
+            &[
+                ("op", &[record::OP_CHUNK]),
+                ("compression", name.as_bytes()),
+                ("size", &(data.len() as u32).to_le_bytes()),
+            ],
+            &stored,
+        );
+        for (conn, entries) in &per_conn {
+            record(
+                &mut out,
+                &[
+                    ("op", &[record::OP_INDEX_DATA]),
+                    ("ver", &1u32.to_le_bytes()),
+                    ("conn", &conn.to_le_bytes()),
+                    ("count", &((entries.len() / 12) as u32).to_le_bytes()),
+                ],
+                entries,
+            );
+        }
+        chunk_infos.push((chunk_pos, per_conn));
+    }
+    let index_pos = out.len() as u64;
+    conns.sort_by_key(|c| c.id);
+    conns.dedup_by_key(|c| c.id);
+    for c in &conns {
+        connection_record(&mut out, *c);
+    }
+    for (chunk_pos, per_conn) in chunk_infos {
+        let mut data = Vec::new();
+        for (conn, entries) in &per_conn {
+            data.extend(conn.to_le_bytes());
+            data.extend(((entries.len() / 12) as u32).to_le_bytes());
+        }
+        record(
+            &mut out,
+            &[
+                ("op", &[record::OP_CHUNK_INFO]),
+                ("ver", &1u32.to_le_bytes()),
+                ("chunk_pos", &chunk_pos.to_le_bytes()),
+                ("start_time", &[0; 8]),
+                ("end_time", &[0; 8]),
+                ("count", &(per_conn.len() as u32).to_le_bytes()),
+            ],
+            &data,
+        );
+    }
+    // Rewrite the bag header now that the index position is known (same size).
+    let mut header = Vec::new();
+    bag_header(&mut header, index_pos, conns.len() as u32, chunk_count);
+    out.splice(header_at..header_at + header.len(), header);
+    out
+}
+
+fn bag_header(out: &mut Vec<u8>, index_pos: u64, conn_count: u32, chunk_count: u32) {
+    record(
+        out,
+        &[
+            ("op", &[record::OP_BAG_HEADER]),
+            ("index_pos", &index_pos.to_le_bytes()),
+            ("conn_count", &conn_count.to_le_bytes()),
+            ("chunk_count", &chunk_count.to_le_bytes()),
+        ],
+        &[b' '; 32],
+    );
+}
+
+fn ros_header(out: &mut Vec<u8>, seq: u32, stamp: (u32, u32), frame: &str) {
+    out.extend(seq.to_le_bytes());
+    out.extend(time_bytes(stamp));
+    ros_string(out, frame);
+}
+
+fn ros_string(out: &mut Vec<u8>, s: &str) {
+    out.extend((s.len() as u32).to_le_bytes());
+    out.extend(s.as_bytes());
+}
+
+fn f32s(out: &mut Vec<u8>, values: &[f32]) {
+    for v in values {
+        out.extend(v.to_le_bytes());
+    }
+}
+
+fn f64s(out: &mut Vec<u8>, values: &[f64]) {
+    for v in values {
+        out.extend(v.to_le_bytes());
+    }
+}
+
+/// `sensor_msgs/LaserScan` with angle_min -1, angle_max 1, increment 0.5, time
+/// increment 0.001, scan time 0.1, range 0.1..30.
+fn scan_payload(stamp: (u32, u32), ranges: &[f32], intensities: &[f32]) -> Vec<u8> {
+    let mut p = Vec::new();
+    ros_header(&mut p, 7, stamp, "laser");
+    f32s(&mut p, &[-1.0, 1.0, 0.5, 0.001, 0.1, 0.1, 30.0]);
+    p.extend((ranges.len() as u32).to_le_bytes());
+    f32s(&mut p, ranges);
+    p.extend((intensities.len() as u32).to_le_bytes());
+    f32s(&mut p, intensities);
+    p
+}
+
+/// `nav_msgs/Odometry` at (x, y) with yaw 90°, covariances and twist filled with junk.
+fn odom_payload(stamp: (u32, u32), x: f64, y: f64) -> Vec<u8> {
+    let mut p = Vec::new();
+    ros_header(&mut p, 1, stamp, "odom");
+    ros_string(&mut p, "base_link");
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    f64s(&mut p, &[x, y, 0.5, 0.0, 0.0, h, h]);
+    f64s(&mut p, &[9.0; 36 + 6 + 36]);
+    p
+}
+
+/// One transform of a test TF message: stamp, parent, child, translation, rotation.
+type TestTransform<'a> = ((u32, u32), &'a str, &'a str, [f64; 3], [f64; 4]);
+
+fn tf_payload(transforms: &[TestTransform<'_>]) -> Vec<u8> {
+    let mut p = (transforms.len() as u32).to_le_bytes().to_vec();
+    for (i, (stamp, parent, child, t, q)) in transforms.iter().enumerate() {
+        ros_header(&mut p, i as u32, *stamp, parent);
+        ros_string(&mut p, child);
+        f64s(&mut p, t);
+        f64s(&mut p, q);
+    }
+    p
+}
+
+fn imu_payload(stamp: (u32, u32)) -> Vec<u8> {
+    let mut p = Vec::new();
+    ros_header(&mut p, 3, stamp, "imu_link");
+    f64s(&mut p, &[0.0, 0.0, 0.0, 1.0]);
+    f64s(&mut p, &[-1.0; 9]);
+    f64s(&mut p, &[0.1, 0.2, 0.3]);
+    f64s(&mut p, &[-1.0; 9]);
+    f64s(&mut p, &[1.0, 2.0, 9.81]);
+    f64s(&mut p, &[-1.0; 9]);
+    p
+}
+
+fn string_payload(s: &str) -> Vec<u8> {
+    let mut p = Vec::new();
+    ros_string(&mut p, s);
+    p
+}
+
+/// The records of the standard test chunk: every decoded type plus one skipped type.
+fn standard_records() -> Vec<Inner> {
+    vec![
+        Inner::Conn(TF_STATIC),
+        msg(
+            TF_STATIC,
+            (100, 0),
+            tf_payload(&[((100, 0), "base_link", "laser", [0.2, 0.0, 0.3], [0.0, 0.0, 0.0, 1.0])]),
+        ),
+        Inner::Conn(SCAN),
+        Inner::Conn(ODOM),
+        Inner::Conn(TF),
+        Inner::Conn(IMU),
+        Inner::Conn(CHATTER),
+        msg(ODOM, (100, 5), odom_payload((100, 1), 1.5, -2.5)),
+        msg(
+            TF,
+            (100, 6),
+            tf_payload(&[
+                ((100, 1), "odom", "base_link", [1.5, -2.5, 0.0], [0.0, 0.0, 0.5, 0.5]),
+                ((100, 2), "map", "odom", [0.0; 3], [0.0, 0.0, 0.0, 1.0]),
+            ]),
+        ),
+        msg(CHATTER, (100, 7), string_payload("hello")),
+        msg(
+            SCAN,
+            (101, 999_999_999),
+            scan_payload((101, 500_000_000), &[1.0, f32::INFINITY, 2.5, 0.0, 81.91], &[7.0; 5]),
+        ),
+        msg(IMU, (102, 0), imu_payload((101, 900_000_000))),
+        msg(SCAN, (103, 0), scan_payload((102, 0), &[], &[])),
+    ]
+}
+
+/// What [`standard_records`] must decode to.
+fn standard_messages() -> Vec<LogMessage> {
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let scan = |stamp, receive, ranges: Vec<f32>| {
+        LogMessage::Scan(ScanMessage {
+            topic: "/scan".into(),
+            frame_id: "laser".into(),
+            receive_stamp: Some(receive),
+            scan: LaserScan { stamp, angle_min: -1.0, angle_increment: 0.5, ranges },
+            time_increment: 0.001,
+            scan_time: 0.1,
+            range_min: 0.1,
+            range_max: 30.0,
+            pose: None,
+            odom_pose: None,
+            laser_pose: None,
+        })
+    };
+    let yaw = fusemap_core::geometry::quaternion_yaw([0.0, 0.0, h, h]);
+    assert!((yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    vec![
+        LogMessage::Tf(TfMessage {
+            topic: "/tf_static".into(),
+            is_static: true,
+            receive_stamp: Some(Stamp(100_000_000_000)),
+            transforms: vec![Transform {
+                stamp: Stamp(100_000_000_000),
+                parent: "base_link".into(),
+                child: "laser".into(),
+                translation: [0.2, 0.0, 0.3],
+                rotation: [0.0, 0.0, 0.0, 1.0],
+            }],
+        }),
+        LogMessage::Odometry(OdomMessage {
+            topic: "/odom".into(),
+            stamp: Stamp(100_000_000_001),
+            receive_stamp: Some(Stamp(100_000_000_005)),
+            frame_id: "odom".into(),
+            child_frame_id: "base_link".into(),
+            pose: Pose2::new(1.5, -2.5, yaw),
+        }),
+        LogMessage::Tf(TfMessage {
+            topic: "/tf".into(),
+            is_static: false,
+            receive_stamp: Some(Stamp(100_000_000_006)),
+            transforms: vec![
+                Transform {
+                    stamp: Stamp(100_000_000_001),
+                    parent: "odom".into(),
+                    child: "base_link".into(),
+                    translation: [1.5, -2.5, 0.0],
+                    rotation: [0.0, 0.0, 0.5, 0.5],
+                },
+                Transform {
+                    stamp: Stamp(100_000_000_002),
+                    parent: "map".into(),
+                    child: "odom".into(),
+                    translation: [0.0; 3],
+                    rotation: [0.0, 0.0, 0.0, 1.0],
+                },
+            ],
+        }),
+        scan(Stamp(101_500_000_000), Stamp(101_999_999_999), vec![1.0, f32::INFINITY, 2.5, 0.0, 81.91]),
+        LogMessage::Imu(ImuMessage {
+            topic: "/imu".into(),
+            stamp: Stamp(101_900_000_000),
+            receive_stamp: Some(Stamp(102_000_000_000)),
+            frame_id: "imu_link".into(),
+            orientation: [0.0, 0.0, 0.0, 1.0],
+            angular_velocity: [0.1, 0.2, 0.3],
+            linear_acceleration: [1.0, 2.0, 9.81],
+        }),
+        scan(Stamp(102_000_000_000), Stamp(103_000_000_000), vec![]),
+    ]
+}
+
+/// Everything a bag yields: the messages before the first error, the error, and stats.
+fn read_bytes(bytes: &[u8]) -> (Vec<LogMessage>, Option<Error>, ReadStats) {
+    let mut reader = match BagReader::from_reader(bytes, "test.bag") {
+        Ok(r) => r,
+        Err(e) => return (Vec::new(), Some(e), ReadStats::default()),
+    };
+    let mut messages = Vec::new();
+    let mut error = None;
+    while let Some(m) = reader.next_message() {
+        match m {
+            Ok(m) => messages.push(m),
+            Err(e) => {
+                error = Some(e);
+                // The reader stops after an error.
+                assert!(reader.next_message().is_none());
+                break;
+            }
+        }
+    }
+    (messages, error, reader.stats().clone())
+}
+
+/// The location and message of a format error.
+fn format_error(e: Option<Error>) -> (Location, String) {
+    match e {
+        Some(Error::Format { path, location, message }) => {
+            assert_eq!(path, Path::new("test.bag"));
+            (location, message)
+        }
+        other => panic!("expected a format error, got {other:?}"),
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Decoding.
+
+#[test]
+fn sniff_recognises_the_version_line() {
+    assert!(sniff(b"#ROSBAG V2.0\n\x04\x00\x00\x00"));
+    assert!(sniff(record::MAGIC));
+    assert!(!sniff(b"#ROSBAG V1.2\n"));
+    assert!(!sniff(b"#ROSBAG V2.0"));
+    assert!(!sniff(b""));
+    assert!(!sniff(b"\x89PNG\r\n\x1a\n"));
+}
+
+#[test]
+fn decodes_every_field_of_an_uncompressed_chunk() {
+    let bytes = bag(vec![(Compression::None, standard_records())]);
+    let (messages, error, stats) = read_bytes(&bytes);
+    assert!(error.is_none(), "{error:?}");
+    assert_eq!(messages, standard_messages());
+    assert_eq!(stats.skipped_by_type, BTreeMap::from([("std_msgs/String".to_string(), 1)]));
+    assert_eq!(stats.malformed, 0);
+}
+
+#[test]
+fn bz2_and_lz4_chunks_decode_like_uncompressed_ones() {
+    for compression in [Compression::Bz2, Compression::Lz4] {
+        let bytes = bag(vec![(compression, standard_records())]);
+        let (messages, error, _) = read_bytes(&bytes);
+        assert!(error.is_none(), "{compression:?}: {error:?}");
+        assert_eq!(messages, standard_messages(), "{compression:?}");
+    }
+}
+
+#[test]
+fn messages_come_in_file_order_across_chunks_of_mixed_compression() {
+    // Connections declared in one chunk serve the next ones; stamps go backwards on
+    // purpose: the reader keeps file order.
+    let odom = |i: u32| msg(ODOM, (50 - i, 0), odom_payload((50 - i, 0), f64::from(i), 0.0));
+    let bytes = bag(vec![
+        (Compression::Lz4, vec![Inner::Conn(ODOM), odom(0), odom(1)]),
+        (Compression::None, vec![odom(2)]),
+        (Compression::Bz2, vec![odom(3), Inner::Conn(ODOM), odom(4)]),
+    ]);
+    let (messages, error, _) = read_bytes(&bytes);
+    assert!(error.is_none(), "{error:?}");
+    let xs: Vec<f64> = messages
+        .iter()
+        .map(|m| match m {
+            LogMessage::Odometry(o) => o.pose.x,
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(xs, [0.0, 1.0, 2.0, 3.0, 4.0]);
+}
+
+#[test]
+fn a_large_scan_decodes_exactly() {
+    let ranges: Vec<f32> = (0..100_000).map(|i| i as f32 * 0.25).collect();
+    let bytes =
+        bag(vec![(Compression::Lz4, vec![Inner::Conn(SCAN), msg(SCAN, (1, 0), scan_payload((1, 0), &ranges, &[]))])]);
+    let (messages, error, _) = read_bytes(&bytes);
+    assert!(error.is_none(), "{error:?}");
+    match messages.as_slice() {
+        [LogMessage::Scan(s)] => assert_eq!(s.scan.ranges, ranges),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn open_reads_a_file_and_names_it() {
+    let dir = std::env::temp_dir().join(format!("fusemap-ros1-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("standard.bag");
+    std::fs::write(&path, bag(vec![(Compression::Bz2, standard_records())])).unwrap();
+    let mut reader = BagReader::open(&path).unwrap();
+    assert_eq!(reader.path(), path);
+    let mut messages = Vec::new();
+    while let Some(m) = reader.next_message() {
+        messages.push(m.unwrap());
+    }
+    assert_eq!(messages, standard_messages());
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    match BagReader::open(dir.join("missing.bag")) {
+        Err(Error::Io { path, .. }) => assert_eq!(path, dir.join("missing.bag")),
+        other => panic!("{:?}", other.err()),
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Bad input.
+
+#[test]
+fn not_a_bag_is_refused_at_byte_zero() {
+    for (bytes, expected) in [
+        (&b""[..], "not a ROS 1 bag (v2.0) file"),
+        (b"hello world, this is text", "not a ROS 1 bag (v2.0) file"),
+        (
+            b"#ROSBAG V1.2\n\0\0\0\0",
+            "not a ROS 1 bag (v2.0) file: it is a version 1.2 bag, which fusemap does not read",
+        ),
+    ] {
+        let (location, message) = format_error(BagReader::from_reader(bytes, "test.bag").err());
+        assert_eq!(location, Location::Offset(0));
+        assert_eq!(message, expected);
+    }
+    let (location, message) = format_error(BagReader::from_reader(record::MAGIC, "test.bag").err());
+    assert_eq!(location, Location::Offset(13));
+    assert_eq!(message, "the file ends after its first line");
+}
+
+#[test]
+fn every_truncation_is_an_error_and_keeps_a_correct_prefix() {
+    for compression in [Compression::None, Compression::Bz2, Compression::Lz4] {
+        let bytes = bag(vec![
+            (compression, standard_records()),
+            (compression, vec![msg(SCAN, (200, 0), scan_payload((200, 0), &[4.0], &[]))]),
+        ]);
+        let (all, error, _) = read_bytes(&bytes);
+        assert!(error.is_none());
+        for cut in 0..bytes.len() {
+            let (messages, error, _) = read_bytes(&bytes[..cut]);
+            assert!(error.is_some(), "{compression:?}: cut at {cut} of {} ended cleanly", bytes.len());
+            assert!(all.starts_with(&messages), "{compression:?}: cut at {cut} changed the messages before it");
+            let (location, _) = format_error(error);
+            assert!(matches!(location, Location::Offset(o) if o <= cut as u64));
+        }
+    }
+}
+
+#[test]
+fn truncated_record_error_names_the_record() {
+    let bytes = bag(vec![(Compression::None, standard_records())]);
+    let cut = bytes.len() - 3;
+    let (_, error, _) = read_bytes(&bytes[..cut]);
+    let (_, message) = format_error(error);
+    assert!(message.starts_with("truncated record: its data claims"), "{message}");
+}
+
+/// A small deterministic generator (xorshift) for the corruption tests.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+}
+
+#[test]
+fn corrupted_bytes_never_panic() {
+    for compression in [Compression::None, Compression::Bz2, Compression::Lz4] {
+        let bytes = bag(vec![(compression, standard_records())]);
+        for i in 0..bytes.len() {
+            for flip in [0xff, 0x01, 0x80] {
+                let mut bad = bytes.clone();
+                bad[i] ^= flip;
+                let _ = read_bytes(&bad);
+            }
+        }
+    }
+    // Garbage after a valid start, and garbage lengths.
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let start = bag(vec![(Compression::None, standard_records())]);
+    for _ in 0..300 {
+        let keep = 13 + rng.next() as usize % (start.len() - 13);
+        let mut bad = start[..keep].to_vec();
+        let extra = rng.next() as usize % 300;
+        bad.extend((0..extra).map(|_| rng.next() as u8));
+        let _ = read_bytes(&bad);
+        let mut garbage = record::MAGIC.to_vec();
+        garbage.extend((0..extra).map(|_| rng.next() as u8));
+        let (_, error, _) = read_bytes(&garbage);
+        assert!(error.is_some());
+    }
+}
+
+#[test]
+fn unknown_compression_is_refused_at_the_chunk() {
+    let bytes = bag(vec![(Compression::Named("zstd"), standard_records())]);
+    let chunk_offset = 13 + record_len(&bytes, 13);
+    let (messages, error, _) = read_bytes(&bytes);
+    assert!(messages.is_empty());
+    let (location, message) = format_error(error);
+    assert_eq!(location, Location::Offset(chunk_offset as u64));
+    assert!(message.starts_with("chunk compression `zstd` is not supported"), "{message}");
+}
+
+/// The total length of the top-level record at `at`.
+fn record_len(bytes: &[u8], at: usize) -> usize {
+    let u32_at = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap()) as usize;
+    let header = u32_at(at);
+    4 + header + 4 + u32_at(at + 4 + header)
+}
+
+#[test]
+fn unknown_types_are_counted_and_still_numbered() {
+    let bytes = bag(vec![(
+        Compression::None,
+        vec![
+            Inner::Conn(CHATTER),
+            msg(CHATTER, (1, 0), string_payload("a")),
+            msg(CHATTER, (2, 0), string_payload("b")),
+            Inner::Conn(SCAN),
+            msg(SCAN, (3, 0), vec![1, 2, 3]),
+        ],
+    )]);
+    let (messages, error, stats) = read_bytes(&bytes);
+    assert!(messages.is_empty());
+    assert_eq!(stats.skipped_by_type["std_msgs/String"], 2);
+    let (location, message) = format_error(error);
+    assert_eq!(location, Location::Message { index: 3, topic: "/scan".into() });
+    assert_eq!(message, "LaserScan: header.seq: needs 4 bytes but 3 remain");
+}
+
+#[test]
+fn a_scan_whose_ranges_overflow_the_payload_is_a_message_error() {
+    let mut payload = scan_payload((1, 0), &[], &[]);
+    // Replace the two empty arrays by a ranges count of 1e9 followed by 12 bytes.
+    payload.truncate(payload.len() - 8);
+    payload.extend(1_000_000_000u32.to_le_bytes());
+    payload.extend([0u8; 12]);
+    let bytes = bag(vec![(
+        Compression::Bz2,
+        vec![Inner::Conn(SCAN), msg(SCAN, (1, 0), scan_payload((1, 0), &[1.0], &[])), msg(SCAN, (2, 0), payload)],
+    )]);
+    let (messages, error, _) = read_bytes(&bytes);
+    assert_eq!(messages.len(), 1);
+    let (location, message) = format_error(error);
+    assert_eq!(location, Location::Message { index: 2, topic: "/scan".into() });
+    assert_eq!(message, "LaserScan: ranges array claims 1000000000 elements but 12 bytes remain");
+}
+
+#[test]
+fn malformed_payloads_name_the_field() {
+    let mut short_intensities = scan_payload((1, 0), &[1.0], &[]);
+    short_intensities.truncate(short_intensities.len() - 4);
+    short_intensities.extend(2u32.to_le_bytes());
+    short_intensities.extend([0; 4]);
+    let mut trailing = scan_payload((1, 0), &[1.0], &[]);
+    trailing.push(0);
+    let mut short_odom = odom_payload((1, 0), 0.0, 0.0);
+    short_odom.truncate(short_odom.len() - 8);
+    let mut huge_tf = tf_payload(&[]);
+    huge_tf[..4].copy_from_slice(&u32::MAX.to_le_bytes());
+    let mut short_imu = imu_payload((1, 0));
+    short_imu.pop();
+    let mut long_frame = Vec::new();
+    ros_header(&mut long_frame, 0, (1, 0), "x");
+    long_frame[12..16].copy_from_slice(&1000u32.to_le_bytes());
+    let cases = [
+        (SCAN, short_intensities, "LaserScan: intensities array claims 2 elements but 4 bytes remain"),
+        (
+            SCAN,
+            trailing,
+            "LaserScan: 1 bytes left over after the message's last field (the layout \
+             differs from the standard definition)",
+        ),
+        (ODOM, short_odom, "Odometry: pose.covariance and twist: needs 624 bytes but 616 remain"),
+        (TF, huge_tf, "TFMessage: transforms array claims 4294967295 elements but 0 bytes remain"),
+        (IMU, short_imu, "Imu: linear_acceleration_covariance: needs 72 bytes but 71 remain"),
+        (SCAN, long_frame, "LaserScan: header.frame_id: claims 1000 bytes but 1 remain"),
+    ];
+    for (conn, payload, expected) in cases {
+        let bytes = bag(vec![(Compression::None, vec![Inner::Conn(conn), msg(conn, (1, 0), payload)])]);
+        let (_, error, _) = read_bytes(&bytes);
+        let (location, message) = format_error(error);
+        assert_eq!(location, Location::Message { index: 1, topic: conn.topic.into() });
+        assert_eq!(message, expected);
+    }
+}
+
+#[test]
+fn a_known_type_with_another_md5sum_is_refused() {
+    let odd = Conn { md5: "0123456789abcdef0123456789abcdef", ..SCAN };
+    let bytes = bag(vec![(Compression::None, vec![Inner::Conn(odd)])]);
+    let (_, error, _) = read_bytes(&bytes);
+    let (location, message) = format_error(error);
+    assert!(matches!(location, Location::Offset(_)));
+    assert!(message.contains("`/scan`"), "{message}");
+    assert!(message.contains("0123456789abcdef0123456789abcdef"), "{message}");
+    assert!(message.contains(SCAN_MD5), "{message}");
+}
+
+#[test]
+fn a_chunk_of_the_wrong_size_is_an_error() {
+    for compression in [Compression::None, Compression::Bz2, Compression::Lz4] {
+        let mut bytes = bag(vec![(compression, standard_records())]);
+        // The chunk's `size` field is the last 4 bytes of its header.
+        let chunk = 13 + record_len(&bytes, 13);
+        let header_len = u32::from_le_bytes(bytes[chunk..chunk + 4].try_into().unwrap());
+        let size_at = chunk + 4 + header_len as usize - 4;
+        let size = u32::from_le_bytes(bytes[size_at..size_at + 4].try_into().unwrap());
+        for wrong in [size - 1, size + 1] {
+            bytes[size_at..size_at + 4].copy_from_slice(&wrong.to_le_bytes());
+            let (messages, error, _) = read_bytes(&bytes);
+            assert!(messages.is_empty());
+            let (location, message) = format_error(error);
+            assert_eq!(location, Location::Offset(chunk as u64));
+            assert!(
+                message.starts_with(&format!("chunk header says {wrong} uncompressed bytes")),
+                "{compression:?}: {message}"
+            );
+        }
+    }
+}
+
+#[test]
+fn corrupt_compressed_data_is_a_decompression_error() {
+    for (compression, name) in [(Compression::Bz2, "bz2"), (Compression::Lz4, "lz4")] {
+        let mut bytes = bag(vec![(compression, standard_records())]);
+        let chunk = 13 + record_len(&bytes, 13);
+        let header_len = u32::from_le_bytes(bytes[chunk..chunk + 4].try_into().unwrap());
+        let data = chunk + 4 + header_len as usize + 4;
+        // Past the stream's own header: damage the compressed blocks.
+        for b in &mut bytes[data + 12..data + 40] {
+            *b = 0x55;
+        }
+        let (_, error, _) = read_bytes(&bytes);
+        let (location, message) = format_error(error);
+        assert_eq!(location, Location::Offset(chunk as u64));
+        assert!(
+            message.starts_with(&format!("{name} decompression of the chunk failed"))
+                || message.starts_with("chunk header says"),
+            "{message}"
+        );
+    }
+}
+
+#[test]
+fn a_message_before_its_connection_is_an_error() {
+    let bytes = bag(vec![(Compression::None, vec![msg(ODOM, (1, 0), odom_payload((1, 0), 0.0, 0.0))])]);
+    let (_, error, _) = read_bytes(&bytes);
+    let (location, message) = format_error(error);
+    // Uncompressed chunk: the exact byte of the record.
+    let chunk = 13 + record_len(&bytes, 13);
+    let header_len = u32::from_le_bytes(bytes[chunk..chunk + 4].try_into().unwrap());
+    let data = chunk + 4 + header_len as usize + 4;
+    assert_eq!(location, Location::Offset(data as u64));
+    assert_eq!(
+        message,
+        "message data record refers to connection 1, which no connection record before it \
+         defines"
+    );
+}
+
+#[test]
+fn errors_in_compressed_chunks_give_the_chunk_and_the_offset_inside() {
+    let bytes = bag(vec![(
+        Compression::Lz4,
+        vec![Inner::Conn(ODOM), msg(ODOM, (1, 0), odom_payload((1, 0), 0.0, 0.0)), msg(SCAN, (1, 0), vec![])],
+    )]);
+    let (messages, error, _) = read_bytes(&bytes);
+    assert_eq!(messages.len(), 1);
+    let (location, message) = format_error(error);
+    assert_eq!(location, Location::Offset(13 + record_len(&bytes, 13) as u64));
+    assert!(message.starts_with("in the chunk's uncompressed data at offset "), "{message}");
+}
+
+#[test]
+fn an_unindexed_bag_reads_to_its_end() {
+    // A bag whose recording stopped before the index was written: index_pos 0.
+    let full = bag(vec![(Compression::None, standard_records())]);
+    let header_len = 13 + record_len(&full, 13);
+    let chunk_len = record_len(&full, header_len);
+    let mut bytes = record::MAGIC.to_vec();
+    bag_header(&mut bytes, 0, 0, 0);
+    bytes.extend(&full[header_len..header_len + chunk_len]);
+    let (messages, error, _) = read_bytes(&bytes);
+    assert!(error.is_none(), "{error:?}");
+    assert_eq!(messages, standard_messages());
+}
+
+// ---------------------------------------------------------------------------------------
+// The shared SLAM-benchmark bags (PROVENANCE.md §4).
+
+/// Per-topic message counts, the scans' beam counts, and the messages themselves.
+struct BagSummary {
+    counts: BTreeMap<String, usize>,
+    beams: BTreeMap<usize, usize>,
+    messages: Vec<LogMessage>,
+    stats: ReadStats,
+}
+
+fn summarize(path: &Path) -> BagSummary {
+    let mut reader = BagReader::open(path).unwrap();
+    let mut s = BagSummary {
+        counts: BTreeMap::new(),
+        beams: BTreeMap::new(),
+        messages: Vec::new(),
+        stats: ReadStats::default(),
+    };
+    while let Some(m) = reader.next_message() {
+        let m = m.unwrap();
+        let topic = match &m {
+            LogMessage::Scan(x) => {
+                *s.beams.entry(x.scan.ranges.len()).or_default() += 1;
+                &x.topic
+            }
+            LogMessage::Odometry(x) => &x.topic,
+            LogMessage::Tf(x) => &x.topic,
+            LogMessage::Imu(x) => &x.topic,
+        };
+        *s.counts.entry(topic.clone()).or_default() += 1;
+        s.messages.push(m);
+    }
+    s.stats = reader.stats().clone();
+    s
+}
+
+fn counts(scan: usize, odom: usize) -> BTreeMap<String, usize> {
+    BTreeMap::from([
+        ("/scan".to_string(), scan),
+        ("/odom".to_string(), odom),
+        ("/tf".to_string(), odom),
+        ("/tf_static".to_string(), 1),
+    ])
+}
+
+fn scans(s: &BagSummary) -> impl Iterator<Item = &ScanMessage> {
+    s.messages.iter().filter_map(|m| match m {
+        LogMessage::Scan(x) => Some(x),
+        _ => None,
+    })
+}
+
+#[test]
+fn intel_bag_matches_its_provenance() {
+    let Some(path) = testdata::dataset("rosbag1-slam-benchmark/intel.orig.bag") else {
+        return;
+    };
+    let s = summarize(&path);
+    assert_eq!(s.counts, counts(13_631, 26_915));
+    assert_eq!(s.beams, BTreeMap::from([(180, 13_631)]));
+    assert_eq!(s.stats, ReadStats::default());
+
+    let statics: Vec<&TfMessage> = s
+        .messages
+        .iter()
+        .filter_map(|m| match m {
+            LogMessage::Tf(t) if t.is_static => Some(t),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(statics.len(), 1);
+    assert_eq!(statics[0].topic, "/tf_static");
+    let [t] = statics[0].transforms.as_slice() else {
+        panic!("{:?}", statics[0]);
+    };
+    assert_eq!((t.parent.as_str(), t.child.as_str()), ("base_link", "laser"));
+
+    let first = scans(&s).next().unwrap();
+    // 976052857.34 in PROVENANCE.md; exact as stored.
+    assert_eq!(first.scan.stamp, Stamp(976_052_857_337_530_017));
+    assert_eq!(first.receive_stamp, Some(first.scan.stamp));
+    assert_eq!(first.frame_id, "laser");
+    assert_eq!(first.scan.angle_min, f64::from(-std::f32::consts::FRAC_PI_2));
+    assert!((first.scan.angle_increment - 0.017551).abs() < 1e-6);
+    assert_eq!((first.range_min, first.range_max), (0.1, 80.0));
+    assert_eq!(&first.scan.ranges[..3], &[1.07, 1.07, 1.08]);
+    let last = scans(&s).last().unwrap();
+    assert!((last.scan.stamp.as_secs_f64() - 976_055_548.63).abs() < 0.006);
+    let above_max: usize = scans(&s).map(|x| x.scan.ranges.iter().filter(|&&r| r > 80.0).count()).sum();
+    assert_eq!(above_max, 68_313);
+
+    for m in &s.messages {
+        if let LogMessage::Odometry(o) = m {
+            assert_eq!((o.frame_id.as_str(), o.child_frame_id.as_str()), ("odom", "base_link"));
+            assert!(o.pose.theta.is_finite());
+        }
+    }
+}
+
+#[test]
+fn mit_csail_bag_matches_its_provenance() {
+    let Some(path) = testdata::dataset("rosbag1-slam-benchmark/mit-csail.orig.bag") else {
+        return;
+    };
+    let s = summarize(&path);
+    assert_eq!(s.counts, counts(1988, 1988));
+    assert_eq!(s.beams, BTreeMap::from([(361, 1988)]));
+    let first = scans(&s).next().unwrap();
+    assert_eq!(first.scan.stamp, Stamp(1_134_864_629_895_181_894));
+    assert!((first.scan.angle_increment - 0.008727).abs() < 1e-6);
+}
+
+#[test]
+fn other_benchmark_bags_match_their_provenance() {
+    for (file, scan_count, odom_count, beams) in [
+        ("aces.orig.bag", 7374, 7375, 180),
+        ("fr079.orig.bag", 4934, 8951, 360),
+        ("mit-killian.clf2bag.bag", 17_480, 17_480, 180),
+    ] {
+        let Some(path) = testdata::dataset(&format!("rosbag1-slam-benchmark/{file}")) else {
+            return;
+        };
+        let s = summarize(&path);
+        assert_eq!(s.counts, counts(scan_count, odom_count), "{file}");
+        assert_eq!(s.beams, BTreeMap::from([(beams, scan_count)]), "{file}");
+    }
+}
