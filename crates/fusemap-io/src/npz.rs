@@ -1,0 +1,615 @@
+//! NumPy `.npz` output: the design document's hand-over format (§3.3 saves `occupancy`
+//! and `log_odds` to `map_result.npz`; §4.4 adds `resolution` and `origin` so tools such as
+//! slam_toolbox and cartographer_ros can pick the map up).
+//!
+//! An `.npz` is a zip archive of `.npy` files, one per array, named `<array>.npy`
+//! (`numpy.savez`). The `.npy` format is NumPy's own, specified in
+//! `numpy/lib/format.py` (NEP 1, "A Simple File Format for NumPy Arrays"):
+//!
+//! * the magic string `\x93NUMPY`, then the format version as two bytes (1, 0);
+//! * a little-endian `u16` header length (version 2.0: `u32`, needed only past 64 KiB);
+//! * an ASCII header that is the `repr` of a Python dict with the keys `descr` (the dtype,
+//!   e.g. `'<f4'`), `fortran_order` and `shape` (a tuple), padded with spaces and ended by
+//!   `\n` so that magic + version + length + header is a multiple of 64 bytes, which keeps
+//!   the data aligned for memory mapping;
+//! * the raw data, C (row-major) order.
+//!
+//! `numpy.savez` stores its members uncompressed (`ZIP_STORED`); this writer does the
+//! same, so the files are the ones NumPy itself would make and `np.load(..., mmap_mode=)`
+//! style readers that expect stored members work. Member timestamps are fixed at the zip
+//! epoch (1980-01-01) so the same map gives byte-identical files.
+
+use crate::atomic::{check_raster, write_atomic};
+use crate::{Error, Location, Result};
+use fusemap_core::grid::Raster;
+use std::collections::HashSet;
+use std::fs::File;
+use std::io::{self, BufReader, Read, Seek, Write};
+use std::path::Path;
+use zip::write::SimpleFileOptions;
+use zip::{CompressionMethod, DateTime, ZipArchive, ZipWriter};
+
+/// The `.npy` magic string (format.py `MAGIC_PREFIX`).
+pub const NPY_MAGIC: &[u8; 6] = b"\x93NUMPY";
+
+/// Alignment of the data after the header (format.py `ARRAY_ALIGN`).
+const ARRAY_ALIGN: usize = 64;
+
+/// The element data of an array to write, borrowed from the caller.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NpyData<'a> {
+    /// `float32`, written as `'<f4'`.
+    F32(&'a [f32]),
+    /// `float64`, written as `'<f8'`.
+    F64(&'a [f64]),
+    /// `bool`, written as `'|b1'` (one byte, 0 or 1).
+    Bool(&'a [bool]),
+    /// `uint8`, written as `'|u1'`.
+    U8(&'a [u8]),
+    /// `int32`, written as `'<i4'`.
+    I32(&'a [i32]),
+}
+
+impl NpyData<'_> {
+    /// NumPy's dtype string (`descr`): explicit little-endian (`<`) for multi-byte types,
+    /// `|` (not applicable) for single bytes, as `numpy.dtype.str` spells them.
+    pub fn descr(&self) -> &'static str {
+        match self {
+            NpyData::F32(_) => "<f4",
+            NpyData::F64(_) => "<f8",
+            NpyData::Bool(_) => "|b1",
+            NpyData::U8(_) => "|u1",
+            NpyData::I32(_) => "<i4",
+        }
+    }
+
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        match self {
+            NpyData::F32(d) => d.len(),
+            NpyData::F64(d) => d.len(),
+            NpyData::Bool(d) => d.len(),
+            NpyData::U8(d) => d.len(),
+            NpyData::I32(d) => d.len(),
+        }
+    }
+
+    /// True when there are no elements.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn item_size(&self) -> usize {
+        match self {
+            NpyData::F32(_) | NpyData::I32(_) => 4,
+            NpyData::F64(_) => 8,
+            NpyData::Bool(_) | NpyData::U8(_) => 1,
+        }
+    }
+}
+
+/// One C-order array ready to be written as a `.npy` file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NpyArray<'a> {
+    shape: Vec<usize>,
+    data: NpyData<'a>,
+}
+
+impl<'a> NpyArray<'a> {
+    /// An array of `shape` (empty for a 0-d scalar) holding `data` in C (row-major)
+    /// order. `None` when the shape's product is not `data.len()`: a wrong shape would
+    /// otherwise produce a file NumPy refuses or, worse, reads with the wrong layout.
+    pub fn new(shape: &[usize], data: NpyData<'a>) -> Option<Self> {
+        let count = shape.iter().try_fold(1usize, |acc, &d| acc.checked_mul(d))?;
+        (count == data.len()).then(|| Self { shape: shape.to_vec(), data })
+    }
+
+    /// The shape.
+    pub fn shape(&self) -> &[usize] {
+        &self.shape
+    }
+
+    /// The data.
+    pub fn data(&self) -> NpyData<'a> {
+        self.data
+    }
+
+    /// The complete header: magic, version, length and the padded dict. Version 1.0
+    /// unless the dict needs more than 65535 bytes (only absurdly many dimensions), then
+    /// 2.0 as format.py does.
+    pub fn header(&self) -> Vec<u8> {
+        let shape = match self.shape.as_slice() {
+            [] => "()".to_string(),
+            [n] => format!("({n},)"),
+            dims => format!("({})", dims.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")),
+        };
+        let dict = format!("{{'descr': '{}', 'fortran_order': False, 'shape': {shape}, }}", self.data.descr());
+        // magic (6) + version (2) + length (2 for v1, 4 for v2) + dict + padding + '\n';
+        // the padded header (dict + padding + '\n') is at most dict + ARRAY_ALIGN bytes.
+        let (version, len_size) = if dict.len() + ARRAY_ALIGN <= u16::MAX as usize { (1u8, 2) } else { (2u8, 4) };
+        let unpadded = 6 + 2 + len_size + dict.len() + 1;
+        let padding = (ARRAY_ALIGN - unpadded % ARRAY_ALIGN) % ARRAY_ALIGN;
+        let header_len = dict.len() + padding + 1;
+        let mut out = Vec::with_capacity(unpadded + padding);
+        out.extend_from_slice(NPY_MAGIC);
+        out.extend_from_slice(&[version, 0]);
+        match u16::try_from(header_len) {
+            Ok(len) if version == 1 => out.extend_from_slice(&len.to_le_bytes()),
+            _ => out.extend_from_slice(&u32::try_from(header_len).unwrap_or(u32::MAX).to_le_bytes()),
+        }
+        out.extend_from_slice(dict.as_bytes());
+        out.resize(out.len() + padding, b' ');
+        out.push(b'\n');
+        out
+    }
+
+    /// Size in bytes of the whole `.npy` file.
+    pub fn file_size(&self) -> u64 {
+        self.header().len() as u64 + (self.data.len() as u64) * self.data.item_size() as u64
+    }
+
+    /// Writes the `.npy` file: header, then the data in little-endian byte order
+    /// whatever the host's, in chunks so memory stays small.
+    pub fn write_to(&self, w: &mut dyn Write) -> io::Result<()> {
+        w.write_all(&self.header())?;
+        const CHUNK: usize = 8192;
+        let mut buf = Vec::with_capacity(CHUNK * 8);
+        macro_rules! chunks {
+            ($d:expr, $conv:expr) => {
+                for part in $d.chunks(CHUNK) {
+                    buf.clear();
+                    for &v in part {
+                        buf.extend_from_slice(&$conv(v));
+                    }
+                    w.write_all(&buf)?;
+                }
+            };
+        }
+        match self.data {
+            NpyData::F32(d) => chunks!(d, f32::to_le_bytes),
+            NpyData::F64(d) => chunks!(d, f64::to_le_bytes),
+            NpyData::I32(d) => chunks!(d, i32::to_le_bytes),
+            NpyData::Bool(d) => chunks!(d, |b: bool| [u8::from(b)]),
+            NpyData::U8(d) => w.write_all(d)?,
+        }
+        Ok(())
+    }
+}
+
+/// Writes `.npz` archives the way `numpy.savez` does: each array is a stored (not
+/// compressed) member `<name>.npy`.
+pub struct NpzWriter<W: Write + Seek> {
+    zip: ZipWriter<W>,
+    names: HashSet<String>,
+}
+
+impl<W: Write + Seek> NpzWriter<W> {
+    /// An archive written to `inner`.
+    pub fn new(inner: W) -> Self {
+        Self { zip: ZipWriter::new(inner), names: HashSet::new() }
+    }
+
+    /// Adds `array` as `<name>.npy`. Names must be unique, non-empty and without `/`
+    /// (NumPy turns member names into the keys of the loaded dict; a `/` would make a
+    /// directory in the archive).
+    pub fn add(&mut self, name: &str, array: &NpyArray<'_>) -> io::Result<()> {
+        if name.is_empty() || name.contains(['/', '\\']) {
+            return Err(io::Error::new(io::ErrorKind::InvalidInput, format!("`{name}` is not a valid npz array name")));
+        }
+        if !self.names.insert(name.to_string()) {
+            return Err(io::Error::new(io::ErrorKind::InvalidInput, format!("array `{name}` added twice")));
+        }
+        let options = SimpleFileOptions::default()
+            .compression_method(CompressionMethod::Stored)
+            .last_modified_time(DateTime::default())
+            .unix_permissions(0o644)
+            .large_file(array.file_size() >= u32::MAX as u64);
+        self.zip.start_file(format!("{name}.npy"), options)?;
+        array.write_to(&mut self.zip)
+    }
+
+    /// Writes the central directory and returns the inner writer.
+    pub fn finish(self) -> io::Result<W> {
+        Ok(self.zip.finish()?)
+    }
+}
+
+/// Writes a map as `.npz`, atomically, with exactly these arrays:
+///
+/// | name | dtype | shape | meaning |
+/// |---|---|---|---|
+/// | `occupancy` | float32 | (height, width) | `1 - 1/(1 + e^l)`; the prior where unknown |
+/// | `log_odds` | float32 | (height, width) | `l`; the prior's log-odds where unknown |
+/// | `known` | bool | (height, width) | whether the cell was ever observed |
+/// | `resolution` | float64 | () | cell side, metres |
+/// | `origin` | float64 | (2,) | world x, y of the lower-left corner of cell `[0, 0]` |
+///
+/// Arrays are indexed `[iy, ix]` with row 0 the lowest y, the design document's
+/// `log_odds[iy, ix]` (§3.3): cell `[iy, ix]` covers
+/// `origin + (ix, iy) · resolution` to `origin + (ix + 1, iy + 1) · resolution`. To show
+/// it the right way up, use `imshow(occupancy, origin='lower')`.
+pub fn write_map_npz(path: &Path, raster: &Raster) -> Result<()> {
+    check_raster(path, raster, false)?;
+    let shape = [raster.height, raster.width];
+    let occupancy = raster.occupancy();
+    let arrays = [
+        ("occupancy", NpyArray::new(&shape, NpyData::F32(&occupancy))),
+        ("log_odds", NpyArray::new(&shape, NpyData::F32(&raster.log_odds))),
+        ("known", NpyArray::new(&shape, NpyData::Bool(&raster.known))),
+    ];
+    let resolution = [raster.resolution];
+    let origin = [raster.origin.x, raster.origin.y];
+    let scalars = [
+        ("resolution", NpyArray::new(&[], NpyData::F64(&resolution))),
+        ("origin", NpyArray::new(&[2], NpyData::F64(&origin))),
+    ];
+    let mut all = Vec::new();
+    for (name, array) in arrays.into_iter().chain(scalars) {
+        // check_raster guarantees the sizes; this keeps the writer panic-free regardless.
+        let array = array.ok_or_else(|| {
+            Error::format(path, Location::Field(name.into()), "array size does not match the map's shape")
+        })?;
+        all.push((name, array));
+    }
+    write_atomic(path, |w| {
+        let mut npz = NpzWriter::new(w);
+        for (name, array) in &all {
+            npz.add(name, array)?;
+        }
+        npz.finish()?;
+        Ok(())
+    })
+}
+
+/// The element values of an array read back from a `.npy` member.
+#[derive(Clone, Debug, PartialEq)]
+pub enum NpyValues {
+    /// `<f4`.
+    F32(Vec<f32>),
+    /// `<f8`.
+    F64(Vec<f64>),
+    /// `|b1`.
+    Bool(Vec<bool>),
+    /// `|u1`.
+    U8(Vec<u8>),
+    /// `<i4`.
+    I32(Vec<i32>),
+}
+
+/// An array read from an `.npz`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NpyOwned {
+    /// The shape (empty for a 0-d array).
+    pub shape: Vec<usize>,
+    /// The values, C order.
+    pub values: NpyValues,
+}
+
+/// Reads the array `name` (with or without `.npy`) of an `.npz` file.
+///
+/// Supports what [`NpyArray`] writes: little-endian `f4`, `f8`, `i4`, and `b1`, `u1`, C
+/// order, `.npy` versions 1.0 to 3.0, stored or deflated members (`np.savez` and
+/// `np.savez_compressed`). Anything else is an [`Error::Format`] naming the array.
+pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut zip = ZipArchive::new(BufReader::new(file)).map_err(|e| zip_error(path, e))?;
+    let member = if name.ends_with(".npy") { name.to_string() } else { format!("{name}.npy") };
+    let field = Location::Field(name.trim_end_matches(".npy").to_string());
+    let mut entry = match zip.by_name(&member) {
+        Ok(e) => e,
+        Err(zip::result::ZipError::FileNotFound) => {
+            return Err(Error::format(path, field, "no such array in the archive"))
+        }
+        Err(e) => return Err(zip_error(path, e)),
+    };
+    let bad = |msg: String| Error::format(path, field.clone(), msg);
+
+    let mut pre = [0u8; 8];
+    entry.read_exact(&mut pre).map_err(|e| bad(format!("truncated .npy header: {e}")))?;
+    if &pre[..6] != NPY_MAGIC {
+        return Err(bad("not a .npy file (bad magic)".into()));
+    }
+    let header_len = match pre[6] {
+        1 => {
+            let mut l = [0u8; 2];
+            entry.read_exact(&mut l).map_err(|e| bad(format!("truncated .npy header: {e}")))?;
+            u16::from_le_bytes(l) as usize
+        }
+        2 | 3 => {
+            let mut l = [0u8; 4];
+            entry.read_exact(&mut l).map_err(|e| bad(format!("truncated .npy header: {e}")))?;
+            u32::from_le_bytes(l) as usize
+        }
+        v => return Err(bad(format!("unsupported .npy version {v}.{}", pre[7]))),
+    };
+    if header_len > 1 << 20 {
+        return Err(bad(format!("implausible .npy header length {header_len}")));
+    }
+    let mut header = vec![0u8; header_len];
+    entry.read_exact(&mut header).map_err(|e| bad(format!("truncated .npy header: {e}")))?;
+    let header = String::from_utf8(header).map_err(|_| bad("header is not text".into()))?;
+    let (descr, fortran, shape) = parse_header(&header).map_err(bad)?;
+    if fortran {
+        return Err(bad("Fortran-order arrays are not supported".into()));
+    }
+    let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).ok_or_else(|| bad("shape overflows".into()))?;
+    let item = match descr.as_str() {
+        "<f4" | "<i4" => 4,
+        "<f8" => 8,
+        "|b1" | "|u1" => 1,
+        d => return Err(bad(format!("unsupported dtype `{d}`"))),
+    };
+    let bytes = count.checked_mul(item).ok_or_else(|| bad("shape overflows".into()))?;
+    if bytes as u64 > entry.size() {
+        return Err(bad(format!("shape {shape:?} needs {bytes} bytes but the member holds {}", entry.size())));
+    }
+    let mut raw = vec![0u8; bytes];
+    entry.read_exact(&mut raw).map_err(|e| bad(format!("truncated data: {e}")))?;
+    let values = match descr.as_str() {
+        "<f4" => NpyValues::F32(raw.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),
+        "<i4" => NpyValues::I32(raw.chunks_exact(4).map(|c| i32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),
+        "<f8" => NpyValues::F64(
+            raw.chunks_exact(8).map(|c| f64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])).collect(),
+        ),
+        "|b1" => NpyValues::Bool(raw.iter().map(|&b| b != 0).collect()),
+        _ => NpyValues::U8(raw),
+    };
+    Ok(NpyOwned { shape, values })
+}
+
+/// Reads a `float32` array of an `.npz`: its shape and values (see [`read_npz`]).
+pub fn read_npz_f32(path: &Path, name: &str) -> Result<(Vec<usize>, Vec<f32>)> {
+    let a = read_npz(path, name)?;
+    match a.values {
+        NpyValues::F32(v) => Ok((a.shape, v)),
+        _ => Err(Error::format(
+            path,
+            Location::Field(name.trim_end_matches(".npy").to_string()),
+            "the array is not float32 ('<f4')",
+        )),
+    }
+}
+
+fn zip_error(path: &Path, e: zip::result::ZipError) -> Error {
+    match e {
+        zip::result::ZipError::Io(io) => Error::io(path, io),
+        other => Error::format(path, Location::File, format!("not a valid npz: {other}")),
+    }
+}
+
+/// Parses the header dict: `descr`, `fortran_order`, `shape`. Only the literal forms
+/// NumPy writes are accepted (a Python dict of a string, a bool and a tuple of ints).
+fn parse_header(h: &str) -> std::result::Result<(String, bool, Vec<usize>), String> {
+    let body = h
+        .trim()
+        .strip_prefix('{')
+        .and_then(|s| s.strip_suffix('}'))
+        .ok_or_else(|| format!("header is not a dict: {h:?}"))?;
+    let value_after = |key: &str| -> std::result::Result<&str, String> {
+        let at = body.find(&format!("'{key}'")).ok_or_else(|| format!("header lacks `{key}`"))?;
+        let rest = &body[at + key.len() + 2..];
+        rest.trim_start().strip_prefix(':').map(str::trim_start).ok_or_else(|| format!("header: `{key}` has no value"))
+    };
+    let d = value_after("descr")?;
+    let quote = d.chars().next().filter(|c| *c == '\'' || *c == '"');
+    let descr = quote
+        .and_then(|q| d[1..].split(q).next())
+        .ok_or_else(|| "header: `descr` is not a string".to_string())?
+        .to_string();
+    let f = value_after("fortran_order")?;
+    let fortran = if f.starts_with("True") {
+        true
+    } else if f.starts_with("False") {
+        false
+    } else {
+        return Err("header: `fortran_order` is not True or False".into());
+    };
+    let s = value_after("shape")?;
+    let inner = s
+        .strip_prefix('(')
+        .and_then(|s| s.split(')').next())
+        .ok_or_else(|| "header: `shape` is not a tuple".to_string())?;
+    let shape = inner
+        .split(',')
+        .map(str::trim)
+        .filter(|t| !t.is_empty())
+        .map(|t| {
+            t.trim_end_matches('L').parse::<usize>().map_err(|_| format!("header: bad dimension `{t}` in `shape`"))
+        })
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    Ok((descr, fortran, shape))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fusemap_core::geometry::Point2;
+    use fusemap_core::grid::{CellIndex, OccupancyParams};
+    use std::path::PathBuf;
+
+    fn temp_dir(tag: &str) -> PathBuf {
+        static N: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let d = std::env::temp_dir().join(format!(
+            "fusemap-npz-{tag}-{}-{}",
+            std::process::id(),
+            N.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+        ));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// A 3-row, 4-column raster whose log-odds encode their position, `(row * 10 + col) / 8
+    /// - 1`, unknown on the diagonal.
+    fn raster() -> Raster {
+        let (width, height) = (4, 3);
+        let mut log_odds = Vec::new();
+        let mut known = Vec::new();
+        for row in 0..height {
+            for col in 0..width {
+                // Multiples of 1/8: exact in float32 and float64 alike.
+                log_odds.push((row * 10 + col) as f32 / 8.0 - 1.0);
+                known.push(row != col);
+            }
+        }
+        Raster {
+            width,
+            height,
+            resolution: 0.05,
+            origin: Point2::new(-5.0, -2.5),
+            first_cell: CellIndex { x: -100, y: -50 },
+            log_odds,
+            known,
+            params: OccupancyParams::default(),
+        }
+    }
+
+    #[test]
+    fn header_is_aligned_and_exact() {
+        let data = [0f32; 6];
+        let a = NpyArray::new(&[2, 3], NpyData::F32(&data)).unwrap();
+        let h = a.header();
+        assert_eq!(h.len() % 64, 0);
+        assert_eq!(&h[..8], b"\x93NUMPY\x01\x00");
+        assert_eq!(u16::from_le_bytes([h[8], h[9]]) as usize, h.len() - 10);
+        let text = std::str::from_utf8(&h[10..]).unwrap();
+        assert!(text.starts_with("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }"));
+        assert!(text.ends_with(" \n"));
+        let s = [1.0f64];
+        let h0 = NpyArray::new(&[], NpyData::F64(&s)).unwrap().header();
+        assert!(std::str::from_utf8(&h0[10..]).unwrap().contains("'shape': (), }"));
+        let h1 = NpyArray::new(&[1], NpyData::F64(&s)).unwrap().header();
+        assert!(std::str::from_utf8(&h1[10..]).unwrap().contains("'shape': (1,), }"));
+        assert!(NpyArray::new(&[2, 2], NpyData::F32(&data)).is_none());
+        assert!(NpyArray::new(&[usize::MAX, 2], NpyData::F32(&data)).is_none());
+    }
+
+    #[test]
+    fn map_round_trips() {
+        let d = temp_dir("rt");
+        let p = d.join("map.npz");
+        let r = raster();
+        write_map_npz(&p, &r).unwrap();
+        let (shape, lo) = read_npz_f32(&p, "log_odds").unwrap();
+        assert_eq!(shape, [3, 4]);
+        assert_eq!(lo, r.log_odds);
+        // Row-major, row = y index: element [2, 1] is row 2, column 1.
+        assert_eq!(lo[2 * 4 + 1], 21.0 / 8.0 - 1.0);
+        let (shape, occ) = read_npz_f32(&p, "occupancy.npy").unwrap();
+        assert_eq!(shape, [3, 4]);
+        assert_eq!(occ, r.occupancy());
+        let known = read_npz(&p, "known").unwrap();
+        assert_eq!(known.shape, [3, 4]);
+        assert_eq!(known.values, NpyValues::Bool(r.known.clone()));
+        let res = read_npz(&p, "resolution").unwrap();
+        assert_eq!(res.shape, Vec::<usize>::new());
+        assert_eq!(res.values, NpyValues::F64(vec![0.05]));
+        let origin = read_npz(&p, "origin").unwrap();
+        assert_eq!(origin.shape, [2]);
+        assert_eq!(origin.values, NpyValues::F64(vec![-5.0, -2.5]));
+        // Wrong type and missing arrays are errors naming the array.
+        let e = read_npz_f32(&p, "known").unwrap_err();
+        assert!(e.to_string().contains("`known`"), "{e}");
+        let e = read_npz_f32(&p, "nope").unwrap_err();
+        assert!(e.to_string().contains("`nope`"), "{e}");
+        // Same map, same bytes.
+        let p2 = d.join("again.npz");
+        write_map_npz(&p2, &r).unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), std::fs::read(&p2).unwrap());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn members_are_stored_like_np_savez() {
+        let d = temp_dir("stored");
+        let p = d.join("map.npz");
+        write_map_npz(&p, &raster()).unwrap();
+        let mut z = ZipArchive::new(File::open(&p).unwrap()).unwrap();
+        let mut names = Vec::new();
+        for i in 0..z.len() {
+            let f = z.by_index(i).unwrap();
+            assert_eq!(f.compression(), CompressionMethod::Stored);
+            names.push(f.name().unwrap().to_string());
+        }
+        assert_eq!(names, ["occupancy.npy", "log_odds.npy", "known.npy", "resolution.npy", "origin.npy"]);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let d = temp_dir("bad");
+        let p = d.join("not.npz");
+        std::fs::write(&p, b"hello").unwrap();
+        assert!(matches!(read_npz(&p, "x"), Err(Error::Format { location: Location::File, .. })));
+        assert!(matches!(read_npz(&d.join("missing.npz"), "x"), Err(Error::Io { .. })));
+        let mut r = raster();
+        r.known.pop();
+        let e = write_map_npz(&d.join("m.npz"), &r).unwrap_err();
+        assert!(e.to_string().contains("known flags"), "{e}");
+        assert!(!d.join("m.npz").exists());
+        let mut w = NpzWriter::new(io::Cursor::new(Vec::new()));
+        let one = [1u8];
+        let a = NpyArray::new(&[1], NpyData::U8(&one)).unwrap();
+        w.add("a", &a).unwrap();
+        assert!(w.add("a", &a).is_err());
+        assert!(w.add("x/y", &a).is_err());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn header_parser_accepts_numpys_spellings() {
+        let (d, f, s) = parse_header("{'descr': '<f8', 'fortran_order': False, 'shape': (3, 4), }   \n").unwrap();
+        assert_eq!((d.as_str(), f, s), ("<f8", false, vec![3, 4]));
+        let (_, _, s) = parse_header("{'descr': '|b1', 'fortran_order': True, 'shape': (7,), }").unwrap();
+        assert_eq!(s, [7]);
+        let (_, _, s) = parse_header("{'descr': '<f4', 'fortran_order': False, 'shape': (), }").unwrap();
+        assert!(s.is_empty());
+        assert!(parse_header("{'descr': '<f4'}").is_err());
+        assert!(parse_header("nonsense").is_err());
+        assert!(parse_header("{'descr': '<f4', 'fortran_order': 0, 'shape': ()}").is_err());
+        assert!(parse_header("{'descr': '<f4', 'fortran_order': False, 'shape': (x,)}").is_err());
+    }
+
+    /// NumPy itself loads the file with the documented names, shapes, dtypes and values.
+    #[test]
+    fn numpy_loads_the_map() {
+        let d = temp_dir("numpy");
+        let p = d.join("map.npz");
+        let r = raster();
+        write_map_npz(&p, &r).unwrap();
+        let script = r#"
+import sys
+import numpy as np
+m = np.load(sys.argv[1])
+assert sorted(m.files) == ['known', 'log_odds', 'occupancy', 'origin', 'resolution'], m.files
+for k in ('occupancy', 'log_odds'):
+    assert m[k].dtype == np.float32 and m[k].shape == (3, 4), (k, m[k].dtype, m[k].shape)
+assert m['known'].dtype == np.bool_ and m['known'].shape == (3, 4)
+assert m['resolution'].dtype == np.float64 and m['resolution'].shape == ()
+assert float(m['resolution']) == 0.05
+assert m['origin'].dtype == np.float64 and m['origin'].tolist() == [-5.0, -2.5]
+lo = m['log_odds']
+for iy in range(3):
+    for ix in range(4):
+        assert lo[iy, ix] == np.float32((iy * 10 + ix) / 8.0 - 1.0), (iy, ix, lo[iy, ix])
+        assert m['known'][iy, ix] == (iy != ix)
+occ = 1.0 - 1.0 / (1.0 + np.exp(lo.astype(np.float64)))
+assert np.allclose(m['occupancy'], occ, atol=1e-6)
+print('ok')
+"#;
+        let out = match std::process::Command::new("python3").arg("-c").arg(script).arg(&p).output() {
+            Ok(o) => o,
+            Err(e) => {
+                crate::testdata::skip(&format!("python3 is not available ({e})"));
+                return;
+            }
+        };
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        if !out.status.success() && stderr.contains("No module named 'numpy'") {
+            crate::testdata::skip("numpy is not installed for python3");
+            return;
+        }
+        assert!(out.status.success(), "numpy could not read the file:\n{stderr}");
+        assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "ok");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}
