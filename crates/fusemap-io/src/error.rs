@@ -72,19 +72,12 @@ pub enum Error {
 impl Error {
     /// An OS error on `path`.
     pub fn io(path: &Path, source: std::io::Error) -> Self {
-        Error::Io {
-            path: path.to_path_buf(),
-            source,
-        }
+        Error::Io { path: path.to_path_buf(), source }
     }
 
     /// A format error at `location` in `path`.
     pub fn format(path: &Path, location: Location, message: impl Into<String>) -> Self {
-        Error::Format {
-            path: path.to_path_buf(),
-            location,
-            message: message.into(),
-        }
+        Error::Format { path: path.to_path_buf(), location, message: message.into() }
     }
 }
 

@@ -5,8 +5,14 @@
 
 #![warn(missing_docs)]
 
+pub mod atomic;
+pub mod config_file;
 pub mod error;
 pub mod log;
+pub mod map_server;
+pub mod npz;
+pub mod picture;
+pub mod world_file;
 
 pub use error::{Error, Location, Result};
 #[doc(hidden)]

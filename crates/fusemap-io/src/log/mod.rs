@@ -7,6 +7,13 @@
 //! and record; a record of a type fusemap does not use is counted in
 //! [`ReadStats::skipped_by_type`] and skipped.
 
+pub mod carmen;
+mod open;
+pub mod ros1;
+pub mod ros2;
+
+pub use open::{detect, open_log, LogFormat, OpenedLog};
+
 use fusemap_core::geometry::Pose2;
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::Stamp;

@@ -1,0 +1,1217 @@
+//! CARMEN text logs (`.log`, `.clf`, plain or gzipped), read line by line as
+//! [`LogMessage`]s.
+//!
+//! # What is read
+//!
+//! | line | becomes |
+//! |---|---|
+//! | `FLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_ts host logger_ts` | [`LogMessage::Scan`] |
+//! | `RLASER …` (the rear laser, same layout as `FLASER`) | [`LogMessage::Scan`] |
+//! | `ROBOTLASER1 type start_angle fov res max_range accuracy remission_mode n r1..rn m rem1..remm laser_x laser_y laser_theta robot_x robot_y robot_theta tv rv forward_safety side_safety turn_axis ipc_ts host logger_ts` | [`LogMessage::Scan`] |
+//! | `RAWLASER1`…`RAWLASER4 type start_angle fov res max_range accuracy remission_mode n r1..rn m rem1..remm ipc_ts host logger_ts` | [`LogMessage::Scan`] |
+//! | `ODOM x y theta tv rv accel ipc_ts host logger_ts` | [`LogMessage::Odometry`] |
+//! | `PARAM name value …` | kept in [`CarmenReader::params`] |
+//! | `#…` comments and blank lines | ignored |
+//! | any other message type (`NEFF`, `TRUEPOS`, `SYNC`, …) | counted in [`ReadStats::skipped_by_type`] |
+//!
+//! Every scan has `topic` = the message type, `frame_id` = `""`, `scan.stamp` = the IPC
+//! time stamp, `receive_stamp` = the logger time stamp, `time_increment` = `scan_time` =
+//! 0 (CARMEN does not say) and `range_min` = 0. `FLASER`/`RLASER` carry `pose` (x y theta,
+//! the corrected pose in corrected logs) and `odom_pose`; `ROBOTLASER1` carries `pose`
+//! (the robot pose) and `laser_pose`; `RAWLASERn` carries no pose.
+//!
+//! Time stamps are decimal seconds and are parsed exactly, digit by digit
+//! ([`Stamp::parse_decimal`]), never through `f64`. Some logs print them with `%g`
+//! (`1.13486e+09`): such a number is converted by moving its decimal point, which is
+//! exact too, and passed on as written (coarse as it is) for the log doctor to judge.
+//!
+//! # Beam angles
+//!
+//! `FLASER`/`RLASER` lines carry no angles; they follow from the number of readings `n`
+//! (see [`flaser_angles`]). `ROBOTLASER1` and `RAWLASERn` give `start_angle` and the
+//! angular resolution, which are used as written.
+//!
+//! # No-returns
+//!
+//! CARMEN writes "no return" as the sensor's maximum value, never as inf: 81.91 or 81.83
+//! for a SICK LMS in its 80 m mode, 50.0 to about 51.25 in the 50 m-mode logs. The range
+//! values are left as written; the reader states the limit in `range_max`, so that the
+//! lidar model (which treats `r >= min(its max_range, range_max)` as a no-return) never
+//! takes a sentinel for a hit:
+//!
+//! * `FLASER`/`RLASER`: per line, `range_max = 81.0` when any finite value on the line is
+//!   above 51.5, else `50.0`. 50 m-mode logs never go above ≈51.25, and the 80 m-mode
+//!   sentinels are ≥ 81.8, so a line whose values all stay below 51.5 either comes from a
+//!   50 m-mode sensor (its sentinels ≥ 50 are then no-returns) or from an 80 m-mode
+//!   sensor that saw nothing far on that line. The cost of the rule is that a real return
+//!   between 50 and 51.5 m in an 80 m-mode log, on a line with no farther value, is
+//!   treated as a no-return: rare and negligible. A line whose largest value lies in
+//!   [32.7, 32.77] m is a sensor counting millimetres in 16 bits (the Örebro log writes
+//!   32.759–32.767 for no-return): `range_max = 32.7` there; a real 32.7 m return on a
+//!   line with nothing farther is lost, again negligible. [`CarmenOptions::flaser_range_max`]
+//!   replaces the rule for logs it does not fit.
+//! * `ROBOTLASER1`/`RAWLASERn`: the line's `maximum_range` when it is finite and > 0
+//!   (values at or beyond it are then no-returns by themselves), else the `FLASER` rule.
+//!
+//! # Errors
+//!
+//! A malformed line (too few or too many fields for its counts, a number that does not
+//! parse, a count that does not fit the line, a non-finite pose, bytes that are not
+//! UTF-8, a line that does not start with a message type) is skipped and counted in
+//! [`ReadStats::malformed`] with a description naming file, line and what was wrong; with
+//! [`CarmenOptions::strict`] it is returned as [`Error::Format`] at
+//! [`Location::Line`] instead, and reading can go on with the next line. A NaN or
+//! infinite *range* is not malformed: it is kept, for the lidar model to count as
+//! invalid. A gzip stream that ends early or is corrupt is an [`Error::Format`] for the
+//! whole file, after which the reader returns `None`.
+
+use super::{LogMessage, LogReader, OdomMessage, ReadStats, ScanMessage};
+use crate::{Error, Location, Result};
+use flate2::bufread::MultiGzDecoder;
+use fusemap_core::geometry::Pose2;
+use fusemap_core::sensor::LaserScan;
+use fusemap_core::time::Stamp;
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+use std::fs::File;
+use std::io::{BufRead, BufReader, ErrorKind, Read};
+use std::path::{Path, PathBuf};
+use std::str::SplitAsciiWhitespace;
+
+/// The first two bytes of every gzip stream.
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
+/// Buffer size for the file and for decompressed text.
+const BUFFER: usize = 64 * 1024;
+
+/// `range_max` of a `FLASER`/`RLASER` line whose values reach beyond [`MODE_50M_LIMIT`].
+const RANGE_MAX_80M_MODE: f32 = 81.0;
+/// `range_max` of any other `FLASER`/`RLASER` line.
+const RANGE_MAX_50M_MODE: f32 = 50.0;
+/// No 50 m-mode log goes beyond ≈51.25 m; 80 m-mode sentinels are ≥ 81.8 m.
+const MODE_50M_LIMIT: f32 = 51.5;
+/// `range_max` of a line whose largest value is a 16-bit millimetre overflow (32.7–32.768 m,
+/// the Örebro log's no-return).
+const RANGE_MAX_32M_MODE: f32 = 32.7;
+/// The largest value a 16-bit millimetre counter writes, 32.767 m, with rounding room.
+const MODE_32M_LIMIT: f32 = 32.77;
+
+/// Message types [`sniff`] recognises as CARMEN (read or skipped by the reader).
+const KNOWN_TYPES: &[&str] = &[
+    "FLASER",
+    "RLASER",
+    "LASER1",
+    "LASER2",
+    "LASER3",
+    "LASER4",
+    "ROBOTLASER0",
+    "ROBOTLASER1",
+    "ROBOTLASER2",
+    "RAWLASER1",
+    "RAWLASER2",
+    "RAWLASER3",
+    "RAWLASER4",
+    "ODOM",
+    "TRUEPOS",
+    "PARAM",
+    "SYNC",
+    "NEFF",
+    "SONAR",
+    "BUMPER",
+    "SCANMARK",
+    "POSITIONLASER",
+    "IMU",
+    "GPSNMEAGGA",
+    "GPSNMEARMC",
+];
+
+/// How [`CarmenReader`] treats what it cannot use.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CarmenOptions {
+    /// Return a malformed line as [`Error::Format`] instead of skipping and counting it.
+    pub strict: bool,
+    /// `range_max` for every `FLASER`/`RLASER` line, replacing the per-line rule of the
+    /// module documentation (for a log whose sensor has another maximum).
+    pub flaser_range_max: Option<f32>,
+}
+
+/// The beam angles of a `FLASER`/`RLASER` line with `n` readings, as
+/// `(angle_min, angle_increment)` in radians.
+///
+/// * n = 180: 1° steps from −90° (the last beam is +89°);
+/// * n = 181: 1° steps over [−90°, +90°];
+/// * n = 360: 0.5° steps from −90° (the last beam is +89.5°);
+/// * n = 361: 0.5° steps over [−90°, +90°];
+/// * any other n ≥ 2: spread evenly over [−90°, +90°], first and last beam included
+///   (CARMEN has no convention for them; a 180° field of view is the usual one);
+/// * n ≤ 1: a single beam straight ahead (0, 0).
+pub fn flaser_angles(n: usize) -> (f64, f64) {
+    match n {
+        180 | 181 => (-PI / 2.0, PI / 180.0),
+        360 | 361 => (-PI / 2.0, PI / 360.0),
+        0 | 1 => (0.0, 0.0),
+        _ => (-PI / 2.0, PI / (n - 1) as f64),
+    }
+}
+
+/// True when `first_bytes` (the start of a file, any length; a few KiB is plenty) look
+/// like a CARMEN log.
+///
+/// Gzipped content is recognised by its magic bytes and decompressed here (as far as
+/// the given bytes go), so the caller passes the file's first bytes as they are. The
+/// test: skipping blank lines and `#`/`##` comments, the first line starts with a known
+/// CARMEN message type (`FLASER`, `ODOM`, `PARAM`, `ROBOTLASER1`, `NEFF`, …). When the
+/// bytes hold only comments, they must include CARMEN's header comment
+/// (`# message formats defined: …`). A ROS bag (`#ROSBAG`) is never CARMEN.
+pub fn sniff(first_bytes: &[u8]) -> bool {
+    if first_bytes.starts_with(&GZIP_MAGIC) {
+        let mut text = Vec::new();
+        let mut decoder = flate2::read::MultiGzDecoder::new(first_bytes);
+        let mut chunk = [0u8; 4096];
+        while text.len() < BUFFER {
+            match decoder.read(&mut chunk) {
+                Ok(0) | Err(_) => break,
+                Ok(k) => text.extend_from_slice(&chunk[..k]),
+            }
+        }
+        sniff_text(&text)
+    } else {
+        sniff_text(first_bytes)
+    }
+}
+
+fn sniff_text(bytes: &[u8]) -> bool {
+    let mut saw_header = false;
+    let mut lines = bytes.split(|&b| b == b'\n').peekable();
+    while let Some(line) = lines.next() {
+        let complete = lines.peek().is_some();
+        let line = line.trim_ascii_start();
+        if line.is_empty() {
+            continue;
+        }
+        if line.starts_with(b"#") {
+            if line.starts_with(b"#ROSBAG") {
+                return false;
+            }
+            if line.windows(b"message formats defined".len()).any(|w| w == b"message formats defined") {
+                saw_header = true;
+            }
+            continue;
+        }
+        let token = match line.iter().position(|b| b.is_ascii_whitespace()) {
+            Some(end) => &line[..end],
+            None if complete => line,
+            // The first token is cut off by the end of the bytes: undecided.
+            None => return saw_header,
+        };
+        return KNOWN_TYPES.iter().any(|t| t.as_bytes() == token);
+    }
+    saw_header
+}
+
+/// The byte source: as given, or gunzipped.
+enum Input<R> {
+    Plain(R),
+    Gzip(BufReader<MultiGzDecoder<R>>),
+}
+
+/// A CARMEN log opened for reading: messages in file order, streamed line by line.
+///
+/// Also an [`Iterator`] over the same items as [`LogReader::next_message`].
+pub struct CarmenReader<R> {
+    input: Input<R>,
+    path: PathBuf,
+    options: CarmenOptions,
+    line: Vec<u8>,
+    line_number: u64,
+    done: bool,
+    stats: ReadStats,
+    params: BTreeMap<String, String>,
+}
+
+impl CarmenReader<BufReader<File>> {
+    /// Opens the log at `path`, plain text or gzip (recognised by its magic bytes, not
+    /// by the file name).
+    pub fn open(path: impl AsRef<Path>, options: CarmenOptions) -> Result<Self> {
+        let path = path.as_ref();
+        let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        Self::from_reader(path, BufReader::with_capacity(BUFFER, file), options)
+    }
+}
+
+impl<R: BufRead> CarmenReader<R> {
+    /// Reads a log from `reader`, plain text or gzip (recognised by the magic bytes the
+    /// first `fill_buf` shows, which for files and byte slices is the start of the data).
+    /// `name` names the log in errors and descriptions.
+    pub fn from_reader(name: impl AsRef<Path>, mut reader: R, options: CarmenOptions) -> Result<Self> {
+        let path = name.as_ref().to_path_buf();
+        let gzip = reader.fill_buf().map_err(|e| Error::io(&path, e))?.starts_with(&GZIP_MAGIC);
+        let input = if gzip {
+            Input::Gzip(BufReader::with_capacity(BUFFER, MultiGzDecoder::new(reader)))
+        } else {
+            Input::Plain(reader)
+        };
+        Ok(Self {
+            input,
+            path,
+            options,
+            line: Vec::with_capacity(8 * 1024),
+            line_number: 0,
+            done: false,
+            stats: ReadStats::default(),
+            params: BTreeMap::new(),
+        })
+    }
+
+    /// The `PARAM` lines read so far, name → value (the last one wins; a value is the
+    /// first word after the name).
+    pub fn params(&self) -> &BTreeMap<String, String> {
+        &self.params
+    }
+
+    /// The value of `PARAM name`, if read so far.
+    pub fn param(&self, name: &str) -> Option<&str> {
+        self.params.get(name).map(String::as_str)
+    }
+
+    /// The number of lines read so far.
+    pub fn line_number(&self) -> u64 {
+        self.line_number
+    }
+
+    /// The name given to the log (its path for [`CarmenReader::open`]).
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    fn read_line(&mut self) -> std::io::Result<usize> {
+        self.line.clear();
+        match &mut self.input {
+            Input::Plain(r) => r.read_until(b'\n', &mut self.line),
+            Input::Gzip(r) => r.read_until(b'\n', &mut self.line),
+        }
+    }
+
+    fn read_error(&self, e: std::io::Error) -> Error {
+        if !matches!(self.input, Input::Gzip(_)) {
+            return Error::io(&self.path, e);
+        }
+        let after = self.line_number;
+        match e.kind() {
+            ErrorKind::UnexpectedEof => {
+                Error::format(&self.path, Location::File, format!("gzip stream ends early after line {after}"))
+            }
+            ErrorKind::InvalidInput | ErrorKind::InvalidData => {
+                Error::format(&self.path, Location::File, format!("gzip stream is corrupt after line {after}: {e}"))
+            }
+            _ => Error::io(&self.path, e),
+        }
+    }
+}
+
+impl<R: BufRead> LogReader for CarmenReader<R> {
+    fn next_message(&mut self) -> Option<Result<LogMessage>> {
+        while !self.done {
+            match self.read_line() {
+                Ok(0) => self.done = true,
+                Ok(_) => {
+                    self.line_number += 1;
+                    match parse_line(&self.line, &self.options, &mut self.params) {
+                        Parsed::Ignored => {}
+                        Parsed::Message(m) => return Some(Ok(m)),
+                        Parsed::Skipped(kind) => self.stats.skip_type(kind),
+                        Parsed::Malformed(message) => {
+                            let err = Error::format(&self.path, Location::Line(self.line_number), message);
+                            if self.options.strict {
+                                return Some(Err(err));
+                            }
+                            self.stats.malformed(err.to_string());
+                        }
+                    }
+                }
+                Err(e) => {
+                    self.done = true;
+                    return Some(Err(self.read_error(e)));
+                }
+            }
+        }
+        None
+    }
+
+    fn stats(&self) -> &ReadStats {
+        &self.stats
+    }
+}
+
+impl<R: BufRead> Iterator for CarmenReader<R> {
+    type Item = Result<LogMessage>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        self.next_message()
+    }
+}
+
+/// What one line is.
+enum Parsed<'a> {
+    /// Blank, comment or `PARAM`.
+    Ignored,
+    Message(LogMessage),
+    /// A message type the reader does not use.
+    Skipped(&'a str),
+    /// What is wrong with it.
+    Malformed(String),
+}
+
+fn parse_line<'a>(bytes: &'a [u8], options: &CarmenOptions, params: &mut BTreeMap<String, String>) -> Parsed<'a> {
+    let Ok(text) = std::str::from_utf8(bytes) else {
+        return Parsed::Malformed("the line is not UTF-8 text".into());
+    };
+    let Some(kind) = text.split_ascii_whitespace().next() else {
+        return Parsed::Ignored;
+    };
+    if kind.starts_with('#') {
+        return Parsed::Ignored;
+    }
+    let result = match kind {
+        "FLASER" | "RLASER" => parse_flaser(kind, text, options),
+        "ROBOTLASER1" => parse_laser_with_params(kind, text, true),
+        "RAWLASER1" | "RAWLASER2" | "RAWLASER3" | "RAWLASER4" => parse_laser_with_params(kind, text, false),
+        "ODOM" => parse_odom(text),
+        "PARAM" => parse_param(text, params).map(|()| None),
+        _ if is_type_name(kind) => return Parsed::Skipped(kind),
+        _ => return Parsed::Malformed(format!("not a CARMEN message: the line starts with `{}`", shorten(kind))),
+    };
+    match result {
+        Ok(Some(message)) => Parsed::Message(message),
+        Ok(None) => Parsed::Ignored,
+        Err(why) => Parsed::Malformed(format!("{kind}: {why}")),
+    }
+}
+
+/// CARMEN message types are upper-case words: `FLASER`, `ROBOTLASER1`, `GPSNMEAGGA`.
+fn is_type_name(s: &str) -> bool {
+    s.len() <= 32
+        && s.as_bytes()[0].is_ascii_uppercase()
+        && s.bytes().all(|b| b.is_ascii_uppercase() || b.is_ascii_digit() || b == b'_')
+}
+
+/// `s`, cut to at most 24 characters for a message.
+fn shorten(s: &str) -> String {
+    match s.char_indices().nth(24) {
+        Some((i, _)) => format!("{}…", &s[..i]),
+        None => s.to_string(),
+    }
+}
+
+/// The fields of one line, read in order; errors name the 1-based field (the message
+/// type is field 1, as in awk).
+struct Fields<'a> {
+    tokens: SplitAsciiWhitespace<'a>,
+    /// 1-based number of the field `next` returns.
+    number: usize,
+    /// How many fields the line has.
+    total: usize,
+}
+
+impl<'a> Fields<'a> {
+    /// The fields of `text` after the message type.
+    fn new(text: &'a str) -> Self {
+        let mut tokens = text.split_ascii_whitespace();
+        tokens.next();
+        Self { tokens, number: 2, total: text.split_ascii_whitespace().count() }
+    }
+
+    fn next(&mut self, what: &str) -> Result<&'a str, String> {
+        let token = self
+            .tokens
+            .next()
+            .ok_or_else(|| format!("the line ends at field {} before {what}", self.number.saturating_sub(1)))?;
+        self.number += 1;
+        Ok(token)
+    }
+
+    fn bad(&self, what: &str, token: &str, is_not: &str) -> String {
+        format!("field {} ({what}): `{}` is not {is_not}", self.number - 1, shorten(token))
+    }
+
+    fn f64(&mut self, what: &str) -> Result<f64, String> {
+        let token = self.next(what)?;
+        token.parse().map_err(|_| self.bad(what, token, "a number"))
+    }
+
+    fn finite(&mut self, what: &str) -> Result<f64, String> {
+        let token = self.next(what)?;
+        match token.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err(self.bad(what, token, "a finite number")),
+            Err(_) => Err(self.bad(what, token, "a number")),
+        }
+    }
+
+    fn count(&mut self, what: &str) -> Result<usize, String> {
+        let token = self.next(what)?;
+        token.parse().map_err(|_| self.bad(what, token, "a count"))
+    }
+
+    fn stamp(&mut self, what: &str) -> Result<Stamp, String> {
+        let token = self.next(what)?;
+        parse_stamp(token).ok_or_else(|| self.bad(what, token, "a time stamp in seconds"))
+    }
+
+    fn pose(&mut self, what: [&str; 3]) -> Result<Pose2, String> {
+        Ok(Pose2::new(self.finite(what[0])?, self.finite(what[1])?, self.finite(what[2])?))
+    }
+
+    /// `n` range readings as f32 (NaN and inf kept), with the largest finite one.
+    fn ranges(&mut self, n: usize) -> Result<(Vec<f32>, f32), String> {
+        let mut ranges = Vec::with_capacity(n);
+        let mut largest = f32::NEG_INFINITY;
+        for _ in 0..n {
+            let token = self.next("a range reading")?;
+            let r: f32 = token.parse().map_err(|_| self.bad("range reading", token, "a number"))?;
+            if r.is_finite() && r > largest {
+                largest = r;
+            }
+            ranges.push(r);
+        }
+        Ok((ranges, largest))
+    }
+
+    /// Checks that the line has exactly `fixed + counts` fields.
+    fn expect_total(&self, fixed: usize, counts: &[usize], what: &str) -> Result<(), String> {
+        let expected = counts.iter().try_fold(fixed, |acc, &c| acc.checked_add(c)).unwrap_or(usize::MAX);
+        if expected == self.total {
+            Ok(())
+        } else {
+            Err(format!("expected {expected} fields for {what}, found {}", self.total))
+        }
+    }
+
+    /// Checks that the line has at least `fixed + n` fields.
+    fn expect_at_least(&self, fixed: usize, n: usize, what: &str) -> Result<(), String> {
+        let expected = fixed.saturating_add(n);
+        if self.total >= expected {
+            Ok(())
+        } else {
+            Err(format!("expected at least {expected} fields for {what}, found {}", self.total))
+        }
+    }
+}
+
+/// Parses a time stamp in decimal seconds exactly: `123.456789`, `-0.042`, and the
+/// `%g` form `1.13486e+09`, whose decimal point is moved digit by digit. A value below
+/// one nanosecond (`6.53023e-43`, which some corrected logs hold) is truncated to 0,
+/// as [`Stamp::parse_decimal`] truncates digits beyond nanoseconds.
+fn parse_stamp(s: &str) -> Option<Stamp> {
+    let Some(e) = s.find(['e', 'E']) else {
+        return Stamp::parse_decimal(s);
+    };
+    let (mantissa, exponent) = (&s[..e], &s[e + 1..]);
+    let exponent: i64 = exponent.parse().ok()?;
+    let (sign, body) = match mantissa.as_bytes().first()? {
+        b'-' => ("-", &mantissa[1..]),
+        b'+' => ("", &mantissa[1..]),
+        _ => ("", mantissa),
+    };
+    let (int, frac) = body.split_once('.').unwrap_or((body, ""));
+    if (int.is_empty() && frac.is_empty())
+        || !int.bytes().chain(frac.bytes()).all(|b| b.is_ascii_digit())
+        || body.len() > 64
+    {
+        return None;
+    }
+    // The digits, with the decimal point after `point` of them.
+    let point = (int.len() as i64).checked_add(exponent)?;
+    if point < -9 {
+        return Some(Stamp::ZERO);
+    }
+    if point > 20 {
+        return None; // beyond ±292 years in nanoseconds
+    }
+    let digits = || int.bytes().chain(frac.bytes()).map(char::from);
+    let n = (int.len() + frac.len()) as i64;
+    let mut out = String::with_capacity(96);
+    out.push_str(sign);
+    if point <= 0 {
+        out.push_str("0.");
+        out.extend(std::iter::repeat_n('0', (-point) as usize));
+        out.extend(digits());
+    } else if point >= n {
+        out.extend(digits());
+        out.extend(std::iter::repeat_n('0', (point - n) as usize));
+    } else {
+        out.extend(digits().take(point as usize));
+        out.push('.');
+        out.extend(digits().skip(point as usize));
+    }
+    Stamp::parse_decimal(&out)
+}
+
+/// `FLASER`/`RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_ts host logger_ts`.
+fn parse_flaser(kind: &str, text: &str, options: &CarmenOptions) -> Result<Option<LogMessage>, String> {
+    let mut f = Fields::new(text);
+    let n = f.count("the number of readings")?;
+    f.expect_total(11, &[n], &format!("{n} readings"))?;
+    let (ranges, largest) = f.ranges(n)?;
+    let pose = f.pose(["x", "y", "theta"])?;
+    let odom = f.pose(["odom_x", "odom_y", "odom_theta"])?;
+    let stamp = f.stamp("ipc_timestamp")?;
+    f.next("ipc_hostname")?;
+    let receive = f.stamp("logger_timestamp")?;
+    let range_max = options.flaser_range_max.unwrap_or_else(|| flaser_range_max(largest));
+    let (angle_min, angle_increment) = flaser_angles(n);
+    Ok(Some(LogMessage::Scan(ScanMessage {
+        topic: kind.to_string(),
+        frame_id: String::new(),
+        receive_stamp: Some(receive),
+        scan: LaserScan { stamp, angle_min, angle_increment, ranges },
+        time_increment: 0.0,
+        scan_time: 0.0,
+        range_min: 0.0,
+        range_max,
+        pose: Some(pose),
+        odom_pose: Some(odom),
+        laser_pose: None,
+    })))
+}
+
+/// The `FLASER` no-return rule, from the largest finite value on the line.
+fn flaser_range_max(largest: f32) -> f32 {
+    if largest > MODE_50M_LIMIT {
+        RANGE_MAX_80M_MODE
+    } else if largest > MODE_32M_LIMIT {
+        RANGE_MAX_50M_MODE
+    } else if largest >= RANGE_MAX_32M_MODE {
+        RANGE_MAX_32M_MODE
+    } else {
+        RANGE_MAX_50M_MODE
+    }
+}
+
+/// `ROBOTLASER1` (`with_poses`) and `RAWLASERn`: the laser's parameters, ranges and
+/// remissions, then for `ROBOTLASER1` the laser and robot poses and the velocities.
+fn parse_laser_with_params(kind: &str, text: &str, with_poses: bool) -> Result<Option<LogMessage>, String> {
+    // Fields besides the readings: type, 7 parameters, 2 counts, 3 stamp fields, and
+    // for ROBOTLASER1 two poses and 5 velocities/safety values.
+    let fixed = if with_poses { 24 } else { 13 };
+    let mut f = Fields::new(text);
+    f.f64("laser_type")?;
+    let start_angle = f.finite("start_angle")?;
+    f.f64("field_of_view")?;
+    let resolution = f.finite("angular_resolution")?;
+    let maximum_range = f.f64("maximum_range")?;
+    f.f64("accuracy")?;
+    f.f64("remission_mode")?;
+    let n = f.count("the number of readings")?;
+    f.expect_at_least(fixed, n, &format!("{n} readings"))?;
+    let (ranges, largest) = f.ranges(n)?;
+    let m = f.count("the number of remissions")?;
+    f.expect_total(fixed, &[n, m], &format!("{n} readings and {m} remissions"))?;
+    for _ in 0..m {
+        let token = f.next("a remission")?;
+        token.parse::<f32>().map_err(|_| f.bad("remission", token, "a number"))?;
+    }
+    let (laser_pose, pose) = if with_poses {
+        let laser = f.pose(["laser_x", "laser_y", "laser_theta"])?;
+        let robot = f.pose(["robot_x", "robot_y", "robot_theta"])?;
+        for what in ["tv", "rv", "forward_safety_dist", "side_safety_dist", "turn_axis"] {
+            f.f64(what)?;
+        }
+        (Some(laser), Some(robot))
+    } else {
+        (None, None)
+    };
+    let stamp = f.stamp("ipc_timestamp")?;
+    f.next("ipc_hostname")?;
+    let receive = f.stamp("logger_timestamp")?;
+    let range_max =
+        if maximum_range.is_finite() && maximum_range > 0.0 { maximum_range as f32 } else { flaser_range_max(largest) };
+    Ok(Some(LogMessage::Scan(ScanMessage {
+        topic: kind.to_string(),
+        frame_id: String::new(),
+        receive_stamp: Some(receive),
+        scan: LaserScan { stamp, angle_min: start_angle, angle_increment: resolution, ranges },
+        time_increment: 0.0,
+        scan_time: 0.0,
+        range_min: 0.0,
+        range_max,
+        pose,
+        odom_pose: None,
+        laser_pose,
+    })))
+}
+
+/// `ODOM x y theta tv rv accel ipc_ts host logger_ts`.
+fn parse_odom(text: &str) -> Result<Option<LogMessage>, String> {
+    let mut f = Fields::new(text);
+    f.expect_total(10, &[], "ODOM")?;
+    let pose = f.pose(["x", "y", "theta"])?;
+    for what in ["tv", "rv", "accel"] {
+        f.f64(what)?;
+    }
+    let stamp = f.stamp("ipc_timestamp")?;
+    f.next("ipc_hostname")?;
+    let receive = f.stamp("logger_timestamp")?;
+    Ok(Some(LogMessage::Odometry(OdomMessage {
+        topic: "ODOM".to_string(),
+        stamp,
+        receive_stamp: Some(receive),
+        frame_id: "odom".to_string(),
+        child_frame_id: "base_link".to_string(),
+        pose,
+    })))
+}
+
+/// `PARAM name value …`: what follows the value (stamps, host) varies between logs.
+fn parse_param(text: &str, params: &mut BTreeMap<String, String>) -> Result<(), String> {
+    let mut f = Fields::new(text);
+    let name = f.next("the parameter name")?;
+    let value = f.next("the parameter value")?;
+    params.insert(name.to_string(), value.to_string());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    fn reader(text: &str, options: CarmenOptions) -> CarmenReader<&[u8]> {
+        CarmenReader::from_reader("test.log", text.as_bytes(), options).unwrap()
+    }
+
+    /// All messages of a log read leniently, with the stats.
+    fn read_all(text: &str) -> (Vec<LogMessage>, ReadStats) {
+        let mut r = reader(text, CarmenOptions::default());
+        let messages = r.by_ref().map(|m| m.unwrap()).collect();
+        (messages, r.stats().clone())
+    }
+
+    fn scan(m: &LogMessage) -> &ScanMessage {
+        match m {
+            LogMessage::Scan(s) => s,
+            other => panic!("not a scan: {other:?}"),
+        }
+    }
+
+    /// A FLASER line with the given ranges.
+    fn flaser_line(ranges: &[&str]) -> String {
+        format!(
+            "FLASER {} {} 1.5 -2.25 0.5 1.0 -2.0 0.25 1134864629.895182 b21 0.086295\n",
+            ranges.len(),
+            ranges.join(" ")
+        )
+    }
+
+    fn flaser_n(n: usize) -> String {
+        flaser_line(&vec!["1.0"; n])
+    }
+
+    fn last_angle(s: &ScanMessage) -> f64 {
+        s.scan.angle_min + s.scan.angle_increment * (s.scan.ranges.len() - 1) as f64
+    }
+
+    #[test]
+    fn flaser_fields() {
+        let (m, stats) = read_all(&flaser_line(&["1.25", "2.5", "81.83"]));
+        assert_eq!(m.len(), 1);
+        let s = scan(&m[0]);
+        assert_eq!(s.topic, "FLASER");
+        assert_eq!(s.frame_id, "");
+        assert_eq!(s.scan.stamp, Stamp(1_134_864_629_895_182_000));
+        assert_eq!(s.receive_stamp, Some(Stamp(86_295_000)));
+        assert_eq!(s.scan.ranges, vec![1.25, 2.5, 81.83]);
+        assert_eq!(s.pose, Some(Pose2::new(1.5, -2.25, 0.5)));
+        assert_eq!(s.odom_pose, Some(Pose2::new(1.0, -2.0, 0.25)));
+        assert_eq!(s.laser_pose, None);
+        assert_eq!((s.time_increment, s.scan_time, s.range_min), (0.0, 0.0, 0.0));
+        assert_eq!(s.range_max, 81.0);
+        assert_eq!(stats, ReadStats::default());
+    }
+
+    #[test]
+    fn rlaser_reads_like_flaser() {
+        let (m, _) = read_all(&flaser_n(180).replacen("FLASER", "RLASER", 1));
+        let s = scan(&m[0]);
+        assert_eq!(s.topic, "RLASER");
+        assert_eq!(s.scan.ranges.len(), 180);
+        assert_eq!(s.pose, Some(Pose2::new(1.5, -2.25, 0.5)));
+    }
+
+    #[test]
+    fn flaser_angle_rules() {
+        let deg = PI / 180.0;
+        // (n, first, step, last)
+        let cases = [
+            (180, -90.0, 1.0, 89.0),
+            (181, -90.0, 1.0, 90.0),
+            (360, -90.0, 0.5, 89.5),
+            (361, -90.0, 0.5, 90.0),
+            (5, -90.0, 45.0, 90.0),
+            (91, -90.0, 2.0, 90.0),
+        ];
+        for (n, first, step, last) in cases {
+            let (m, _) = read_all(&flaser_n(n));
+            let s = scan(&m[0]);
+            assert_eq!(s.scan.ranges.len(), n);
+            assert!((s.scan.angle_min - first * deg).abs() < 1e-12, "n={n}");
+            assert!((s.scan.angle_increment - step * deg).abs() < 1e-12, "n={n}");
+            assert!((last_angle(s) - last * deg).abs() < 1e-9, "n={n}");
+        }
+        assert_eq!(flaser_angles(1), (0.0, 0.0));
+        assert_eq!(flaser_angles(0), (0.0, 0.0));
+    }
+
+    #[test]
+    fn flaser_no_return_rule() {
+        let range_max = |ranges: &[&str], options: CarmenOptions| {
+            let line = flaser_line(ranges);
+            let mut r = reader(&line, options);
+            scan(&r.next().unwrap().unwrap()).range_max
+        };
+        let lenient = CarmenOptions::default();
+        // 50 m-mode logs: sentinels 50.0 and up to ≈51.25.
+        assert_eq!(range_max(&["3.0", "50.0"], lenient), 50.0);
+        assert_eq!(range_max(&["3.0", "51.25"], lenient), 50.0);
+        // 80 m-mode logs: sentinels 81.83 / 81.91.
+        assert_eq!(range_max(&["3.0", "81.91"], lenient), 81.0);
+        assert_eq!(range_max(&["3.0", "51.6"], lenient), 81.0);
+        // 16-bit millimetre overflow (Örebro): 32.759–32.767 is no return.
+        assert_eq!(range_max(&["3.0", "32.767"], lenient), 32.7);
+        assert_eq!(range_max(&["3.0", "32.6"], lenient), 50.0);
+        assert_eq!(range_max(&["3.0", "32.8", "32.767"], lenient), 50.0);
+        // Only finite values count: an inf must not make 50 m sentinels into hits.
+        assert_eq!(range_max(&["inf", "50.0"], lenient), 50.0);
+        let fixed = CarmenOptions { flaser_range_max: Some(32.7), ..lenient };
+        assert_eq!(range_max(&["3.0", "32.767"], fixed), 32.7);
+    }
+
+    #[test]
+    fn nan_and_inf_ranges_are_kept() {
+        let (m, stats) = read_all(&flaser_line(&["nan", "inf", "-inf", "NaN", "0", "-1"]));
+        let r = &scan(&m[0]).scan.ranges;
+        assert!(r[0].is_nan() && r[3].is_nan());
+        assert_eq!(&r[1..3], &[f32::INFINITY, f32::NEG_INFINITY]);
+        assert_eq!(&r[4..], &[0.0, -1.0]);
+        assert_eq!(stats.malformed, 0);
+    }
+
+    #[test]
+    #[allow(clippy::approx_constant)] // -1.570796 is the rounded start angle the log writes
+    fn robotlaser1_fields() {
+        let line = "ROBOTLASER1 0 -1.570796 3.150447 0.008727 80.000000 0.010000 0 3 \
+                    4.04 81.91 nan 2 0.5 0.7 \
+                    1.0 2.0 0.1 0.9 1.9 0.2 0.3 0.05 0.5 0.4 1 \
+                    1134864642.914187 b21 0.430003\n";
+        let (m, stats) = read_all(line);
+        assert_eq!(stats.malformed, 0, "{stats:?}");
+        let s = scan(&m[0]);
+        assert_eq!(s.topic, "ROBOTLASER1");
+        assert_eq!(s.scan.angle_min, -1.570796);
+        assert_eq!(s.scan.angle_increment, 0.008727);
+        assert_eq!(s.scan.ranges.len(), 3);
+        assert_eq!(s.range_max, 80.0);
+        assert_eq!(s.laser_pose, Some(Pose2::new(1.0, 2.0, 0.1)));
+        assert_eq!(s.pose, Some(Pose2::new(0.9, 1.9, 0.2)));
+        assert_eq!(s.odom_pose, None);
+        assert_eq!(s.scan.stamp, Stamp(1_134_864_642_914_187_000));
+        assert_eq!(s.receive_stamp, Some(Stamp(430_003_000)));
+    }
+
+    #[test]
+    fn rawlaser_fields() {
+        for k in 1..=4 {
+            let line = format!("RAWLASER{k} 0 -1.5 3.0 0.75 30.0 0.01 0 5 1 2 3 4 30 0 12.5 host 12.75\n");
+            let (m, stats) = read_all(&line);
+            assert_eq!(stats.malformed, 0, "{stats:?}");
+            let s = scan(&m[0]);
+            assert_eq!(s.topic, format!("RAWLASER{k}"));
+            assert_eq!((s.scan.angle_min, s.scan.angle_increment), (-1.5, 0.75));
+            assert_eq!(s.scan.ranges, vec![1.0, 2.0, 3.0, 4.0, 30.0]);
+            assert_eq!(s.range_max, 30.0);
+            assert_eq!((s.pose, s.odom_pose, s.laser_pose), (None, None, None));
+            assert_eq!(s.scan.stamp, Stamp(12_500_000_000));
+            assert_eq!(s.receive_stamp, Some(Stamp(12_750_000_000)));
+        }
+        // No maximum_range on the line: the FLASER rule.
+        let (m, _) = read_all("RAWLASER1 0 -1.5 3.0 1.5 0 0.01 0 3 1 81.91 2 1 7 1 h 1\n");
+        assert_eq!(scan(&m[0]).range_max, 81.0);
+    }
+
+    #[test]
+    fn odom_fields() {
+        let (m, _) = read_all("ODOM 0.600266 -0.0320327 -0.354665 0.1 0.2 0 -0.042 pippo 0\n");
+        let LogMessage::Odometry(o) = &m[0] else { panic!("not odometry") };
+        assert_eq!(o.topic, "ODOM");
+        assert_eq!((o.frame_id.as_str(), o.child_frame_id.as_str()), ("odom", "base_link"));
+        assert_eq!(o.pose, Pose2::new(0.600266, -0.0320327, -0.354665));
+        assert_eq!(o.stamp, Stamp(-42_000_000));
+        assert_eq!(o.receive_stamp, Some(Stamp(0)));
+    }
+
+    #[test]
+    fn params_comments_blank_and_unknown_types() {
+        let log = "# message formats defined: PARAM SYNC ODOM FLASER\n\
+                   ## another comment\n\
+                   \n   \t\r\n\
+                   #PARAM simulator_num_readings 181 nohost 0\n\
+                   PARAM robot_front_laser_max 80.99 1071078718.462518 merci 1071078718.462517\n\
+                   PARAM robot_use_laser on nohost 0\n\
+                   NEFF 15\n\
+                   TRUEPOS 1 2 3 4 5 6 7 h 7\n\
+                   NEFF 16\n\
+                   ODOM 0 0 0 0 0 0 0 pippo 0\r\n";
+        let mut r = reader(log, CarmenOptions::default());
+        let m: Vec<_> = r.by_ref().map(|m| m.unwrap()).collect();
+        assert_eq!(m.len(), 1);
+        assert_eq!(r.param("robot_front_laser_max"), Some("80.99"));
+        assert_eq!(r.param("robot_use_laser"), Some("on"));
+        assert_eq!(r.param("simulator_num_readings"), None);
+        assert_eq!(r.params().len(), 2);
+        let skipped = &r.stats().skipped_by_type;
+        assert_eq!(skipped.get("NEFF"), Some(&2));
+        assert_eq!(skipped.get("TRUEPOS"), Some(&1));
+        assert_eq!(skipped.len(), 2);
+        assert_eq!(r.stats().malformed, 0);
+        assert_eq!(r.line_number(), 11);
+    }
+
+    /// Line 1 good, then one malformed line of each kind, then a good line.
+    fn malformed_log() -> Vec<u8> {
+        let mut log = flaser_n(3).into_bytes();
+        log.extend_from_slice(b"FLASER 180 1 2 3 0 0 0 0 0 0 1 h 1\n"); // 2: too few
+        log.extend_from_slice(b"FLASER 2 1.0 abc 0 0 0 0 0 0 1 h 1\n"); // 3: garbage
+        log.extend_from_slice(b"FLASER 2 1.0 2.0 nan 0 0 0 0 0 1 h 1\n"); // 4: NaN pose
+        log.extend_from_slice(b"ODOM 0 0 0 0 0 0 1.2.3 h 1\n"); // 5: bad stamp
+        log.extend_from_slice(b"ODOM 0 0 0 0 0 0 1 h\n"); // 6: too few
+        log.extend_from_slice(b"FLASER 2 1.0 2.0 0 0 \xff\xfe 0 0 0 1 h 1\n"); // 7: not UTF-8
+        log.extend_from_slice(b"3.5 garbage line\n"); // 8: not a message
+        log.extend_from_slice(b"FLASER -3 1 2 3\n"); // 9: bad count
+        log.extend_from_slice(b"PARAM lonely\n"); // 10: no value
+        log.extend_from_slice(b"ROBOTLASER1 0 0 0 0.1 80 0 0 2 1 2 5 1 2\n"); // 11: count does not fit
+        log.extend_from_slice(b"ODOM 1 2 3 0 0 0 7 h 7\n"); // 12: good
+        log
+    }
+
+    #[test]
+    fn malformed_lines_are_counted_with_their_line() {
+        let log = malformed_log();
+        let mut r = CarmenReader::from_reader("intel.log", &log[..], CarmenOptions::default()).unwrap();
+        let m: Vec<_> = r.by_ref().map(|m| m.unwrap()).collect();
+        assert_eq!(m.len(), 2);
+        let stats = r.stats();
+        assert_eq!(stats.malformed, 10);
+        let lines: Vec<&str> = stats.malformed_examples.iter().map(|d| d.split(": ").next().unwrap()).collect();
+        let expected: Vec<String> = (2..=11).map(|l| format!("intel.log:{l}")).collect();
+        assert_eq!(lines, expected);
+        let ex = &stats.malformed_examples;
+        assert_eq!(ex[0], "intel.log:2: FLASER: expected 191 fields for 180 readings, found 14");
+        assert!(ex[1].contains("field 4 (range reading): `abc` is not a number"), "{}", ex[1]);
+        assert!(ex[2].contains("field 5 (x): `nan` is not a finite number"), "{}", ex[2]);
+        assert!(ex[3].contains("ODOM: field 8 (ipc_timestamp)"), "{}", ex[3]);
+        assert!(ex[4].contains("ODOM: expected 10 fields"), "{}", ex[4]);
+        assert!(ex[5].contains("not UTF-8"), "{}", ex[5]);
+        assert!(ex[6].contains("not a CARMEN message"), "{}", ex[6]);
+        assert!(ex[7].contains("`-3` is not a count"), "{}", ex[7]);
+        assert!(ex[8].contains("PARAM: the line ends"), "{}", ex[8]);
+        assert!(ex[9].contains("ROBOTLASER1:"), "{}", ex[9]);
+        assert!(stats.skipped_by_type.is_empty());
+    }
+
+    #[test]
+    fn strict_mode_returns_format_errors_and_goes_on() {
+        let log = malformed_log();
+        let strict = CarmenOptions { strict: true, ..Default::default() };
+        let r = CarmenReader::from_reader("intel.log", &log[..], strict).unwrap();
+        let items: Vec<_> = r.collect();
+        assert_eq!(items.len(), 12);
+        assert!(items[0].is_ok() && items[11].is_ok());
+        for (i, item) in items[1..11].iter().enumerate() {
+            match item {
+                Err(Error::Format { path, location: Location::Line(l), .. }) => {
+                    assert_eq!(path, Path::new("intel.log"));
+                    assert_eq!(*l, i as u64 + 2);
+                }
+                other => panic!("line {}: {other:?}", i + 2),
+            }
+        }
+        let err = items[3].as_ref().unwrap_err().to_string();
+        assert_eq!(err, "intel.log:4: FLASER: field 5 (x): `nan` is not a finite number");
+    }
+
+    #[test]
+    fn stamps_are_exact() {
+        assert_eq!(parse_stamp("1134864629.895182"), Some(Stamp(1_134_864_629_895_182_000)));
+        assert_eq!(parse_stamp("-0.042"), Some(Stamp(-42_000_000)));
+        assert_eq!(parse_stamp("1.13486e+09"), Some(Stamp(1_134_860_000_000_000_000)));
+        assert_eq!(parse_stamp("4.29497e+09"), Some(Stamp(4_294_970_000_000_000_000)));
+        assert_eq!(parse_stamp("1.5E-3"), Some(Stamp(1_500_000)));
+        assert_eq!(parse_stamp("-2.5e1"), Some(Stamp(-25_000_000_000)));
+        assert_eq!(parse_stamp("12e0"), Some(Stamp(12_000_000_000)));
+        assert_eq!(parse_stamp("1.234567891234e2"), Some(Stamp(123_456_789_123)));
+        // Garbage denormals in some corrected logs: below a nanosecond, so 0.
+        assert_eq!(parse_stamp("6.53023e-43"), Some(Stamp(0)));
+        assert_eq!(parse_stamp("5.29905e-312"), Some(Stamp(0)));
+        assert_eq!(parse_stamp("-1.5e-9"), Some(Stamp(-1)));
+        assert_eq!(parse_stamp("1.5e-10"), Some(Stamp(0)));
+        for bad in ["", "e5", "1e", "1e+", "1.2.3e1", "nan", "inf", "1e99", "0x1p3", "1e5e5", "-e1", ".e1"] {
+            assert_eq!(parse_stamp(bad), None, "{bad}");
+        }
+    }
+
+    fn gzip(bytes: &[u8]) -> Vec<u8> {
+        let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+        e.write_all(bytes).unwrap();
+        e.finish().unwrap()
+    }
+
+    #[test]
+    fn gzip_is_recognised_by_content() {
+        let text = format!("{}ODOM 0 0 0 0 0 0 1 h 1\n", flaser_n(181));
+        // Two members, as `cat a.gz b.gz` makes them.
+        let mut gz = gzip(text.as_bytes());
+        gz.extend(gzip(text.as_bytes()));
+        let r = CarmenReader::from_reader("x.log", &gz[..], CarmenOptions::default()).unwrap();
+        let m: Vec<_> = r.map(|m| m.unwrap()).collect();
+        assert_eq!(m.len(), 4);
+        assert_eq!(scan(&m[2]).scan.ranges.len(), 181);
+
+        // Cut short: an error naming the file and the last whole line, then the end.
+        let cut = &gz[..gz.len() / 2 - 10];
+        let mut r = CarmenReader::from_reader("x.log.gz", cut, CarmenOptions::default()).unwrap();
+        let mut items: Vec<_> = r.by_ref().collect();
+        let last = items.pop().unwrap().unwrap_err();
+        assert!(items.iter().all(|i| i.is_ok()));
+        let Error::Format { path, location: Location::File, message } = &last else { panic!("{last:?}") };
+        assert_eq!(path, Path::new("x.log.gz"));
+        assert!(message.starts_with("gzip stream ends early after line"), "{message}");
+        assert!(r.next().is_none());
+    }
+
+    #[test]
+    fn sniff_recognises_carmen_by_content() {
+        let log = format!("# message formats defined: PARAM ODOM FLASER\n{}", flaser_n(180));
+        assert!(sniff(log.as_bytes()));
+        assert!(sniff(&gzip(log.as_bytes())));
+        // Only part of a gzip stream, as a caller reading the first KiB passes it.
+        let ranges: Vec<String> = (0..20_000u64).map(|i| format!("{:.3}", (i * 7919 % 10007) as f64 / 300.0)).collect();
+        let ranges: Vec<&str> = ranges.iter().map(String::as_str).collect();
+        let big = gzip(format!("{log}{}", flaser_line(&ranges)).as_bytes());
+        assert!(big.len() > 4096);
+        assert!(sniff(&big[..1024]));
+        assert!(sniff(b"ODOM 0 0 0 0 0 0 0 pippo 0\nODOM"));
+        assert!(sniff(b"##  (ODOM, FLASER, PARAM)\n## message formats defined: PARAM\n"));
+        assert!(sniff(b"\n\nROBOTLASER1 0 -1.570796"));
+        assert!(sniff(b"NEFF 15\n"));
+        assert!(!sniff(b"#ROSBAG V2.0\nE\x00\x00\x00"));
+        assert!(!sniff(b"# just a comment\n"));
+        assert!(!sniff(b"x: 1\ny: 2\n"));
+        assert!(!sniff(b"FLASERX 1 2\n"));
+        assert!(!sniff(b"\x89PNG\r\n\x1a\n"));
+        assert!(!sniff(b""));
+        assert!(!sniff(b"\x1f\x8b"));
+        // The first token cut off by the end of the bytes: undecided, so no.
+        assert!(!sniff(b"FLAS"));
+    }
+
+    // ---- The shared CARMEN data (counts as measured in PROVENANCE.md). ----
+
+    #[derive(Debug, Default)]
+    struct Summary {
+        by_topic: BTreeMap<String, u64>,
+        beams: BTreeMap<usize, u64>,
+        first_scan: Option<ScanMessage>,
+        first_odom: Option<OdomMessage>,
+        pose_is_odom: bool,
+        stats: ReadStats,
+        params: BTreeMap<String, String>,
+    }
+
+    fn summarise(relative: &str) -> Option<Summary> {
+        let path = crate::testdata::dataset(relative)?;
+        let mut r = CarmenReader::open(&path, CarmenOptions::default()).unwrap();
+        let mut s = Summary { pose_is_odom: true, ..Default::default() };
+        for m in r.by_ref() {
+            match m.unwrap() {
+                LogMessage::Scan(scan) => {
+                    *s.by_topic.entry(scan.topic.clone()).or_default() += 1;
+                    *s.beams.entry(scan.scan.ranges.len()).or_default() += 1;
+                    s.pose_is_odom &= scan.pose == scan.odom_pose;
+                    s.first_scan.get_or_insert(scan);
+                }
+                LogMessage::Odometry(odom) => {
+                    *s.by_topic.entry(odom.topic.clone()).or_default() += 1;
+                    s.first_odom.get_or_insert(odom);
+                }
+                other => panic!("unexpected {other:?}"),
+            }
+        }
+        s.stats = r.stats().clone();
+        s.params = r.params().clone();
+        Some(s)
+    }
+
+    fn counts(pairs: &[(&str, u64)]) -> BTreeMap<String, u64> {
+        pairs.iter().map(|&(k, v)| (k.to_string(), v)).collect()
+    }
+
+    #[test]
+    fn intel_corrected() {
+        let Some(s) = summarise("intel/intel-corrected.log.gz") else {
+            return;
+        };
+        assert_eq!(s.by_topic, counts(&[("FLASER", 910), ("ODOM", 14541)]));
+        assert_eq!(s.stats.skipped_by_type, counts(&[("NEFF", 910)]));
+        assert_eq!(s.stats.malformed, 0);
+        assert_eq!(s.beams, [(180, 910)].into());
+        assert!(s.pose_is_odom);
+        assert_eq!(s.params.get("robot_frontlaser_offset").unwrap(), "0.0");
+        let first = s.first_scan.unwrap();
+        assert_eq!(first.scan.stamp, Stamp(32_906_800_000));
+        assert_eq!(first.pose, Some(Pose2::new(0.600266, -0.0320327, -0.354665)));
+        assert_eq!(first.range_max, 81.0);
+        assert_eq!(s.first_odom.unwrap().stamp, Stamp(246_000));
+    }
+
+    #[test]
+    fn freiburg_079_corrected() {
+        let Some(s) = summarise("freiburg-079/freiburg-079-corrected.log.gz") else {
+            return;
+        };
+        assert_eq!(s.by_topic, counts(&[("FLASER", 4791), ("ODOM", 9725)]));
+        assert_eq!(s.stats.skipped_by_type, counts(&[("NEFF", 4791)]));
+        assert_eq!(s.stats.malformed, 0);
+        assert_eq!(s.beams, [(360, 4791)].into());
+        assert_eq!(s.params.get("robot_front_laser_max").unwrap(), "80.99");
+        let first = s.first_scan.unwrap();
+        assert_eq!(first.scan.stamp, Stamp(227_623_000));
+        assert_eq!(first.scan.angle_increment, PI / 360.0);
+    }
+
+    /// The other corrected logs: (file, FLASER, ODOM, NEFF, beams).
+    #[test]
+    fn other_corrected_logs() {
+        let table = [
+            ("csail/csail-corrected.log.gz", 406, 2394, 361),
+            ("aces/aces-corrected.log.gz", 440, 7814, 180),
+            ("freiburg-campus/freiburg-campus-corrected.log.gz", 2008, 17691, 360),
+            ("infinite-corridor/infinite-corridor-corrected.log.gz", 1941, 18191, 180),
+            ("seattle/seattle-corrected.log.gz", 241, 19311, 361),
+            ("freiburg-101/freiburg-101-corrected.log.gz", 292, 4569, 360),
+            ("orebro/orebro-corrected.log.gz", 237, 255, 181),
+            ("fhw/fhw-corrected.log.gz", 488, 13935, 180),
+            ("acapulco/acapulco-corrected.log.gz", 861, 12142, 181),
+        ];
+        for (file, flaser, odom, beams) in table {
+            let Some(s) = summarise(file) else {
+                continue;
+            };
+            assert_eq!(s.by_topic, counts(&[("FLASER", flaser), ("ODOM", odom)]), "{file}");
+            assert_eq!(s.stats.skipped_by_type, counts(&[("NEFF", flaser)]), "{file}");
+            assert_eq!(s.stats.malformed, 0, "{file}: {:?}", s.stats);
+            assert_eq!(s.beams, [(beams, flaser)].into(), "{file}");
+            assert!(s.pose_is_odom, "{file}");
+        }
+    }
+
+    #[test]
+    fn csail_corrected_g_printed_stamps() {
+        let Some(s) = summarise("csail/csail-corrected.log.gz") else {
+            return;
+        };
+        // `%g` stamps are passed on as written, exactly.
+        let first = s.first_scan.unwrap();
+        assert_eq!(first.scan.stamp, Stamp(1_134_860_000_000_000_000));
+        assert_eq!(first.receive_stamp, Some(first.scan.stamp));
+    }
+
+    #[test]
+    fn mit_csail_raw() {
+        let Some(s) = summarise("mit-csail-raw/mit-csail.clf") else {
+            return;
+        };
+        assert_eq!(s.by_topic, counts(&[("FLASER", 1988)]));
+        assert!(s.stats.skipped_by_type.is_empty());
+        assert_eq!(s.stats.malformed, 0);
+        assert_eq!(s.beams, [(361, 1988)].into());
+        assert!(s.pose_is_odom);
+        let first = s.first_scan.unwrap();
+        assert_eq!(first.scan.stamp, Stamp(1_134_864_629_895_182_000));
+        assert_eq!(first.receive_stamp, Some(Stamp(86_295_000)));
+        assert_eq!(first.pose, Some(Pose2::new(576.536523, 0.106594, -2.255213)));
+        assert!((last_angle(&first) - PI / 2.0).abs() < 1e-12);
+        assert_eq!(first.range_max, 81.0);
+    }
+
+    #[test]
+    #[allow(clippy::approx_constant)] // -1.570796 is the rounded start angle the log writes
+    fn csail_robotlaser_course() {
+        let Some(s) = summarise("csail-robotlaser-course/csail.log") else {
+            return;
+        };
+        assert_eq!(s.by_topic, counts(&[("ROBOTLASER1", 686)]));
+        assert!(s.stats.skipped_by_type.is_empty());
+        assert_eq!(s.stats.malformed, 0);
+        assert_eq!(s.beams, [(361, 686)].into());
+        let first = s.first_scan.unwrap();
+        assert_eq!(first.scan.angle_min, -1.570796);
+        assert_eq!(first.scan.angle_increment, 0.008727);
+        assert_eq!(first.range_max, 80.0);
+        assert_eq!(first.scan.stamp, Stamp(1_134_864_642_914_187_000));
+        assert_eq!(first.receive_stamp, Some(Stamp(430_003_000)));
+        assert_eq!(first.pose, Some(Pose2::IDENTITY));
+        assert_eq!(first.laser_pose, Some(Pose2::IDENTITY));
+        assert_eq!(first.odom_pose, None);
+    }
+
+    /// What `open`-by-content passes: the first 4 KiB of the file, gzipped or not.
+    #[test]
+    fn sniff_on_shared_files() {
+        let carmen = [
+            "intel/intel-corrected.log.gz",
+            "freiburg-079/freiburg-079-corrected.log.gz",
+            "freiburg-campus/freiburg-campus-corrected.log.gz",
+            "infinite-corridor/infinite-corridor-corrected.log.gz",
+            "orebro/orebro-corrected.log.gz",
+            "mit-csail-raw/mit-csail.clf",
+            "csail-robotlaser-course/csail.log",
+        ];
+        let other = ["rosbag1-slam-benchmark/intel.orig.bag", "slam-benchmark-relations/intel.relations"];
+        for (files, expected) in [(&carmen[..], true), (&other[..], false)] {
+            for file in files {
+                let Some(path) = crate::testdata::dataset(file) else {
+                    continue;
+                };
+                let mut head = Vec::new();
+                File::open(path).unwrap().take(4096).read_to_end(&mut head).unwrap();
+                assert_eq!(sniff(&head), expected, "{file}");
+            }
+        }
+    }
+
+    #[test]
+    fn truncated_gzip_file_is_a_format_error() {
+        let Some(src) = crate::testdata::dataset("intel/intel-corrected.log.gz") else {
+            return;
+        };
+        let bytes = std::fs::read(src).unwrap();
+        let dir = std::env::temp_dir().join(format!("fusemap-carmen-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let cut = dir.join("intel-truncated.log.gz");
+        std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
+        let mut r = CarmenReader::open(&cut, CarmenOptions::default()).unwrap();
+        let mut ok = 0;
+        let mut error = None;
+        for m in r.by_ref() {
+            match m {
+                Ok(_) => ok += 1,
+                Err(e) => error = Some(e),
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+        let error = error.expect("a truncated stream must be an error").to_string();
+        let lines = r.line_number();
+        assert!(ok > 1000 && lines > 1000, "{ok} messages, {lines} lines");
+        assert_eq!(error, format!("{}: gzip stream ends early after line {lines}", cut.display()));
+    }
+}

@@ -1,0 +1,77 @@
+//! Opening a log by its content, not its name.
+
+use super::LogReader;
+use crate::{Error, Location, Result};
+use std::fmt;
+use std::io::Read;
+use std::path::Path;
+
+/// The formats fusemap reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LogFormat {
+    /// A CARMEN text log, plain or gzipped.
+    Carmen,
+    /// A ROS 1 bag (v2.0).
+    Ros1Bag,
+    /// A bare MCAP file.
+    Mcap,
+    /// A rosbag2 directory (MCAP or SQLite storage).
+    Rosbag2,
+}
+
+impl fmt::Display for LogFormat {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            LogFormat::Carmen => "carmen",
+            LogFormat::Ros1Bag => "ros1-bag",
+            LogFormat::Mcap => "mcap",
+            LogFormat::Rosbag2 => "rosbag2",
+        })
+    }
+}
+
+/// An opened log.
+pub struct OpenedLog {
+    /// What it was recognised as.
+    pub format: LogFormat,
+    /// Its messages.
+    pub reader: Box<dyn LogReader>,
+}
+
+/// Recognises the format of `path` by content.
+pub fn detect(path: &Path) -> Result<LogFormat> {
+    if path.is_dir() {
+        if super::ros2::is_rosbag2_dir(path) {
+            return Ok(LogFormat::Rosbag2);
+        }
+        return Err(Error::format(path, Location::File, "a directory, but not a rosbag2 one (no metadata.yaml)"));
+    }
+    let mut head = Vec::with_capacity(4096);
+    std::fs::File::open(path).and_then(|f| f.take(4096).read_to_end(&mut head)).map_err(|e| Error::io(path, e))?;
+    if super::ros1::sniff(&head) {
+        Ok(LogFormat::Ros1Bag)
+    } else if super::ros2::sniff_mcap(&head) {
+        Ok(LogFormat::Mcap)
+    } else if super::carmen::sniff(&head) {
+        Ok(LogFormat::Carmen)
+    } else if head.is_empty() {
+        Err(Error::format(path, Location::File, "the file is empty"))
+    } else {
+        Err(Error::format(
+            path,
+            Location::File,
+            "not a log fusemap reads (CARMEN text or .gz, ROS 1 bag v2.0, MCAP, or a rosbag2 directory)",
+        ))
+    }
+}
+
+/// Opens `path`, recognising the format by content.
+pub fn open_log(path: &Path) -> Result<OpenedLog> {
+    let format = detect(path)?;
+    let reader: Box<dyn LogReader> = match format {
+        LogFormat::Carmen => Box::new(super::carmen::CarmenReader::open(path, Default::default())?),
+        LogFormat::Ros1Bag => Box::new(super::ros1::BagReader::open(path)?),
+        LogFormat::Mcap | LogFormat::Rosbag2 => super::ros2::open_ros2(path)?,
+    };
+    Ok(OpenedLog { format, reader })
+}

@@ -1,0 +1,398 @@
+//! Little-endian CDR, the way ROS 2 serialises messages on the wire and in bags.
+//!
+//! A payload starts with a 4-byte encapsulation header: two bytes naming the
+//! representation (`0x00 0x01` is plain CDR, little-endian) and two option bytes that
+//! readers ignore. The message follows, each primitive aligned to its own size (at most 8)
+//! *counted from the first byte after the header*. Strings are a `u32` byte count that
+//! includes a terminating NUL, then the bytes; sequences are a `u32` element count, then
+//! the elements; fixed-size arrays have no count.
+//!
+//! [`CdrReader`] is a bounds-checked cursor over such a payload: every read checks the
+//! remaining length first, so a truncated or corrupt payload gives a [`CdrError`] naming
+//! the field and the byte offset, never a panic. Message types implement [`CdrDecode`];
+//! [`decode_cdr`] checks the header and decodes one.
+
+use std::fmt;
+
+/// Length of the encapsulation header in front of every CDR payload.
+pub const ENCAPSULATION_HEADER_LEN: usize = 4;
+
+/// The encapsulation bytes fusemap reads: plain CDR, little-endian.
+pub const CDR_LE: [u8; 2] = [0x00, 0x01];
+
+/// Why a CDR payload could not be decoded. Offsets count from the first byte of the
+/// payload, encapsulation header included, so they match a hex dump of the message.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum CdrError {
+    /// Fewer than 4 bytes: not even an encapsulation header.
+    #[error("payload is {len} bytes, shorter than the 4-byte CDR encapsulation header")]
+    NoHeader {
+        /// Payload length.
+        len: usize,
+    },
+    /// `0x00 0x00`: the sender wrote big-endian CDR.
+    #[error("CDR encapsulation is big-endian (0x0000); fusemap reads little-endian CDR (0x0001)")]
+    BigEndian,
+    /// Any representation other than plain little-endian CDR.
+    #[error(
+        "CDR encapsulation is {} (0x{:02x}{:02x}); fusemap reads little-endian CDR (0x0001)",
+        representation_name(*.bytes),
+        .bytes[0],
+        .bytes[1]
+    )]
+    UnsupportedEncapsulation {
+        /// The two representation bytes as found.
+        bytes: [u8; 2],
+    },
+    /// The payload ends before a field does.
+    #[error("truncated: `{field}` at byte {offset} needs {needed} bytes, {available} left")]
+    Truncated {
+        /// Dotted path of the field (`header.frame_id`, `transforms[2].transform`).
+        field: String,
+        /// Byte offset where the field starts.
+        offset: usize,
+        /// Bytes the field needs (alignment padding included).
+        needed: usize,
+        /// Bytes left in the payload.
+        available: usize,
+    },
+    /// A field holds a value its type does not allow.
+    #[error("`{field}` at byte {offset}: {what}")]
+    Invalid {
+        /// Dotted path of the field.
+        field: String,
+        /// Byte offset where the field starts.
+        offset: usize,
+        /// What is wrong.
+        what: String,
+    },
+}
+
+/// A readable name for the representation identifiers of the DDS-XTypes specification.
+fn representation_name(bytes: [u8; 2]) -> &'static str {
+    match u16::from_be_bytes(bytes) {
+        0x0000 => "big-endian CDR",
+        0x0001 => "little-endian CDR",
+        0x0002 => "big-endian parameter-list CDR",
+        0x0003 => "little-endian parameter-list CDR",
+        0x0006 => "big-endian XCDR2",
+        0x0007 => "little-endian XCDR2",
+        0x0008 => "big-endian delimited XCDR2",
+        0x0009 => "little-endian delimited XCDR2",
+        0x000a => "big-endian parameter-list XCDR2",
+        0x000b => "little-endian parameter-list XCDR2",
+        _ => "an unknown representation",
+    }
+}
+
+/// Checks the encapsulation header and returns the message body after it.
+pub fn check_encapsulation(payload: &[u8]) -> Result<&[u8], CdrError> {
+    if payload.len() < ENCAPSULATION_HEADER_LEN {
+        return Err(CdrError::NoHeader { len: payload.len() });
+    }
+    match [payload[0], payload[1]] {
+        CDR_LE => Ok(&payload[ENCAPSULATION_HEADER_LEN..]),
+        [0x00, 0x00] => Err(CdrError::BigEndian),
+        bytes => Err(CdrError::UnsupportedEncapsulation { bytes }),
+    }
+}
+
+/// A message type that can be read from little-endian CDR.
+pub trait CdrDecode: Sized {
+    /// Reads the fields in declaration order from `r`.
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError>;
+}
+
+/// Decodes a whole payload (encapsulation header included) as a `T`.
+///
+/// Bytes after the message are ignored: writers may pad the payload to a multiple of 4.
+pub fn decode_cdr<T: CdrDecode>(payload: &[u8]) -> Result<T, CdrError> {
+    let body = check_encapsulation(payload)?;
+    let mut r = CdrReader::new(body);
+    T::decode(&mut r)
+}
+
+/// One step of a field path: a field name or a sequence index.
+#[derive(Clone, Copy, Debug)]
+enum PathPart {
+    Field(&'static str),
+    Index(usize),
+}
+
+/// A bounds-checked little-endian CDR cursor over a message body (the bytes after the
+/// encapsulation header). It remembers the path of nested fields being read, so errors
+/// name `transforms[1].header.frame_id` rather than just `frame_id`.
+pub struct CdrReader<'a> {
+    body: &'a [u8],
+    pos: usize,
+    path: Vec<PathPart>,
+}
+
+impl<'a> CdrReader<'a> {
+    /// A cursor at the start of `body`, which must *not* include the encapsulation header
+    /// (alignment counts from its first byte).
+    pub fn new(body: &'a [u8]) -> Self {
+        Self { body, pos: 0, path: Vec::new() }
+    }
+
+    /// Bytes consumed so far.
+    pub fn position(&self) -> usize {
+        self.pos
+    }
+
+    /// Bytes not yet consumed.
+    pub fn remaining(&self) -> usize {
+        self.body.len() - self.pos
+    }
+
+    /// Reads a nested struct field: errors inside name it as `name.inner`.
+    pub fn field<T>(
+        &mut self,
+        name: &'static str,
+        read: impl FnOnce(&mut Self) -> Result<T, CdrError>,
+    ) -> Result<T, CdrError> {
+        self.path.push(PathPart::Field(name));
+        let value = read(self)?;
+        self.path.pop();
+        Ok(value)
+    }
+
+    /// Reads a nested struct that implements [`CdrDecode`].
+    pub fn decode_field<T: CdrDecode>(&mut self, name: &'static str) -> Result<T, CdrError> {
+        self.field(name, T::decode)
+    }
+
+    fn path_to(&self, leaf: &str) -> String {
+        let mut s = String::new();
+        for part in &self.path {
+            match part {
+                PathPart::Field(f) => {
+                    if !s.is_empty() {
+                        s.push('.');
+                    }
+                    s.push_str(f);
+                }
+                PathPart::Index(i) => {
+                    s.push('[');
+                    s.push_str(&i.to_string());
+                    s.push(']');
+                }
+            }
+        }
+        if !leaf.is_empty() {
+            if !s.is_empty() {
+                s.push('.');
+            }
+            s.push_str(leaf);
+        }
+        s
+    }
+
+    /// The error for `field` at the current position.
+    pub fn invalid(&self, field: &str, what: impl fmt::Display) -> CdrError {
+        CdrError::Invalid {
+            field: self.path_to(field),
+            offset: ENCAPSULATION_HEADER_LEN + self.pos,
+            what: what.to_string(),
+        }
+    }
+
+    /// Skips padding up to a multiple of `align`, then takes `n` bytes.
+    fn take(&mut self, field: &str, align: usize, n: usize) -> Result<&'a [u8], CdrError> {
+        let pad = (align - self.pos % align) % align;
+        let needed = pad.checked_add(n);
+        match needed {
+            Some(needed) if needed <= self.remaining() => {
+                let start = self.pos + pad;
+                self.pos = start + n;
+                Ok(&self.body[start..start + n])
+            }
+            _ => Err(CdrError::Truncated {
+                field: self.path_to(field),
+                offset: ENCAPSULATION_HEADER_LEN + self.pos,
+                needed: needed.unwrap_or(usize::MAX),
+                available: self.remaining(),
+            }),
+        }
+    }
+
+    fn array<const N: usize>(&mut self, field: &str) -> Result<[u8; N], CdrError> {
+        let bytes = self.take(field, N, N)?;
+        let mut out = [0u8; N];
+        out.copy_from_slice(bytes);
+        Ok(out)
+    }
+
+    /// An `int32`.
+    pub fn i32(&mut self, field: &str) -> Result<i32, CdrError> {
+        self.array(field).map(i32::from_le_bytes)
+    }
+
+    /// A `uint32`.
+    pub fn u32(&mut self, field: &str) -> Result<u32, CdrError> {
+        self.array(field).map(u32::from_le_bytes)
+    }
+
+    /// A `float32`.
+    pub fn f32(&mut self, field: &str) -> Result<f32, CdrError> {
+        self.array(field).map(f32::from_le_bytes)
+    }
+
+    /// A `float64` (aligned to 8).
+    pub fn f64(&mut self, field: &str) -> Result<f64, CdrError> {
+        self.array(field).map(f64::from_le_bytes)
+    }
+
+    /// A fixed-size `float64[N]` array (no length prefix).
+    pub fn f64_array<const N: usize>(&mut self, field: &str) -> Result<[f64; N], CdrError> {
+        let mut out = [0.0; N];
+        if N > 0 {
+            let bytes = self.take(field, 8, N * 8)?;
+            for (o, b) in out.iter_mut().zip(bytes.chunks_exact(8)) {
+                let mut a = [0u8; 8];
+                a.copy_from_slice(b);
+                *o = f64::from_le_bytes(a);
+            }
+        }
+        Ok(out)
+    }
+
+    /// A sequence length, checked against the bytes left for elements of at least
+    /// `min_element_size` bytes each, so a corrupt count never allocates.
+    pub fn sequence_len(&mut self, field: &str, min_element_size: usize) -> Result<usize, CdrError> {
+        let at = self.pos;
+        let n = self.u32(field)? as usize;
+        let fits = n.checked_mul(min_element_size.max(1)).is_some_and(|bytes| bytes <= self.remaining());
+        if fits {
+            Ok(n)
+        } else {
+            Err(CdrError::Truncated {
+                field: self.path_to(field),
+                offset: ENCAPSULATION_HEADER_LEN + at,
+                needed: n.saturating_mul(min_element_size.max(1)),
+                available: self.remaining(),
+            })
+        }
+    }
+
+    /// A `float32[]` sequence, bit for bit.
+    pub fn f32_seq(&mut self, field: &str) -> Result<Vec<f32>, CdrError> {
+        let n = self.sequence_len(field, 4)?;
+        let bytes = self.take(field, 4, n * 4)?;
+        Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
+    }
+
+    /// A `string`: `u32` length including the NUL terminator, the bytes, the NUL.
+    /// A length of 0 (written by some encoders for the empty string) is accepted.
+    pub fn string(&mut self, field: &str) -> Result<String, CdrError> {
+        let n = self.sequence_len(field, 1)?;
+        let at = self.pos;
+        let bytes = self.take(field, 1, n)?;
+        let text = match bytes.split_last() {
+            None => &[][..],
+            Some((0, text)) => text,
+            Some(_) => {
+                self.pos = at;
+                return Err(self.invalid(field, format!("string of {n} bytes does not end in NUL")));
+            }
+        };
+        match std::str::from_utf8(text) {
+            Ok(s) => Ok(s.to_owned()),
+            Err(e) => {
+                self.pos = at;
+                Err(self.invalid(field, format!("string is not UTF-8 ({e})")))
+            }
+        }
+    }
+
+    /// A sequence of structs: the count, then `read` for each element, which errors name
+    /// `field[i]`. `min_element_size` bounds the count by the bytes left.
+    pub fn seq<T>(
+        &mut self,
+        field: &'static str,
+        min_element_size: usize,
+        mut read: impl FnMut(&mut Self) -> Result<T, CdrError>,
+    ) -> Result<Vec<T>, CdrError> {
+        let n = self.sequence_len(field, min_element_size)?;
+        let mut out = Vec::with_capacity(n);
+        self.path.push(PathPart::Field(field));
+        for i in 0..n {
+            self.path.push(PathPart::Index(i));
+            out.push(read(self)?);
+            self.path.pop();
+        }
+        self.path.pop();
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_is_checked() {
+        let r: Result<&[u8], _> = check_encapsulation(&[0, 1, 0, 0, 7]);
+        assert_eq!(r, Ok(&[7u8][..]));
+        assert_eq!(check_encapsulation(&[0, 1, 0]), Err(CdrError::NoHeader { len: 3 }));
+        let be = check_encapsulation(&[0, 0, 0, 0]).unwrap_err();
+        assert_eq!(
+            be.to_string(),
+            "CDR encapsulation is big-endian (0x0000); fusemap reads little-endian CDR (0x0001)"
+        );
+        let x2 = check_encapsulation(&[0, 7, 0, 0]).unwrap_err();
+        assert_eq!(
+            x2.to_string(),
+            "CDR encapsulation is little-endian XCDR2 (0x0007); fusemap reads little-endian CDR (0x0001)"
+        );
+        let odd = check_encapsulation(&[0x12, 0x34, 0, 0]).unwrap_err();
+        assert!(odd.to_string().contains("(0x1234)"), "{odd}");
+    }
+
+    #[test]
+    fn alignment_counts_from_the_body() {
+        // u8-sized string "ab\0" (len 3) leaves the cursor at 7; the double starts at 8.
+        let mut body = Vec::new();
+        body.extend_from_slice(&3u32.to_le_bytes());
+        body.extend_from_slice(b"ab\0");
+        body.push(0xEE); // padding
+        body.extend_from_slice(&1.5f64.to_le_bytes());
+        let mut r = CdrReader::new(&body);
+        assert_eq!(r.string("s").unwrap(), "ab");
+        assert_eq!(r.position(), 7);
+        assert_eq!(r.f64("d").unwrap(), 1.5);
+        assert_eq!(r.remaining(), 0);
+    }
+
+    #[test]
+    fn errors_name_the_path_and_offset() {
+        let body = [2u8, 0, 0, 0, 5, 0, 0, 0];
+        let mut r = CdrReader::new(&body);
+        let e = r.seq("items", 1, |r| r.field("inner", |r| r.u32("value"))).unwrap_err();
+        assert_eq!(
+            e,
+            CdrError::Truncated { field: "items[1].inner.value".into(), offset: 12, needed: 4, available: 0 }
+        );
+    }
+
+    #[test]
+    fn huge_counts_do_not_allocate() {
+        let body = u32::MAX.to_le_bytes();
+        let e = CdrReader::new(&body).f32_seq("ranges").unwrap_err();
+        assert!(matches!(e, CdrError::Truncated { ref field, offset: 4, .. } if field == "ranges"));
+        let e = CdrReader::new(&body).string("frame_id").unwrap_err();
+        assert!(matches!(e, CdrError::Truncated { .. }));
+    }
+
+    #[test]
+    fn strings_need_their_nul_and_utf8() {
+        let mut r = CdrReader::new(&[0, 0, 0, 0]);
+        assert_eq!(r.string("empty").unwrap(), "");
+        let mut r = CdrReader::new(&[1, 0, 0, 0, 0]);
+        assert_eq!(r.string("empty").unwrap(), "");
+        let e = CdrReader::new(&[2, 0, 0, 0, b'a', b'b']).string("s").unwrap_err();
+        assert!(e.to_string().contains("does not end in NUL"), "{e}");
+        let e = CdrReader::new(&[2, 0, 0, 0, 0xff, 0]).string("s").unwrap_err();
+        assert!(e.to_string().contains("not UTF-8"), "{e}");
+    }
+}

@@ -1,0 +1,161 @@
+//! MCAP storage: a file read front to back in bounded memory (the `mcap` crate's
+//! sans-io linear reader, which decompresses zstd and lz4 chunks one at a time).
+//!
+//! Schema records give the ROS type name (`sensor_msgs/msg/LaserScan`), channel records
+//! the topic and the message encoding (`cdr`), and each message's `log_time` becomes its
+//! receive stamp. Messages come in file order.
+
+use super::{error_chain, RawMessage, Source, Topic};
+use crate::error::{Error, Location, Result};
+use fusemap_core::time::Stamp;
+use mcap::records::Record;
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::{Path, PathBuf};
+
+/// Largest MCAP record accepted, so a corrupt length cannot make the reader allocate
+/// without bound. No sensor message fusemap reads comes near it.
+const MAX_RECORD_LEN: usize = 1 << 30;
+
+/// One MCAP file being read.
+pub(crate) struct McapSource {
+    path: PathBuf,
+    input: Box<dyn Read + Send>,
+    reader: LinearReader,
+    /// Bytes of the (decompressed) file fed to the reader so far.
+    bytes_read: u64,
+    /// Schema id → (name, encoding).
+    schemas: HashMap<u16, (String, String)>,
+    channels: HashMap<u16, Topic>,
+    /// The current message's channel, log time and payload (copied out of the reader's
+    /// buffer, which the next read may move).
+    current: Option<(u16, Stamp)>,
+    payload: Vec<u8>,
+}
+
+impl McapSource {
+    /// Opens `path`; with `zstd` the whole file is a zstd stream around the MCAP
+    /// (rosbag2's `file` compression, `*.mcap.zstd`).
+    pub(crate) fn open(path: &Path, zstd: bool) -> Result<Self> {
+        let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        let input: Box<dyn Read + Send> = if zstd {
+            Box::new(zstd::stream::read::Decoder::new(file).map_err(|e| Error::io(path, e))?)
+        } else {
+            Box::new(BufReader::with_capacity(1 << 16, file))
+        };
+        let options =
+            LinearReaderOptions::default().with_validate_chunk_crcs(true).with_record_length_limit(MAX_RECORD_LEN);
+        Ok(Self {
+            path: path.to_path_buf(),
+            input,
+            reader: LinearReader::new_with_options(options),
+            bytes_read: 0,
+            schemas: HashMap::new(),
+            channels: HashMap::new(),
+            current: None,
+            payload: Vec::new(),
+        })
+    }
+
+    fn container_error(&self, what: &str) -> Error {
+        Error::format(
+            &self.path,
+            Location::File,
+            format!("MCAP: {what} (found after reading {} bytes)", self.bytes_read),
+        )
+    }
+
+    /// Advances to the next message record, handling schema and channel records on the
+    /// way. `Ok(false)` at the end of the file.
+    fn advance(&mut self, index: u64) -> Result<bool> {
+        loop {
+            let event = match self.reader.next_event() {
+                None => return Ok(false),
+                Some(Ok(event)) => event,
+                Some(Err(e)) => {
+                    let what = error_chain(&e);
+                    return Err(self.container_error(&what));
+                }
+            };
+            match event {
+                LinearReadEvent::ReadRequest(need) => {
+                    let buf = self.reader.insert(need);
+                    let n = loop {
+                        match self.input.read(buf) {
+                            Ok(n) => break n,
+                            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                            Err(e) => return Err(Error::io(&self.path, e)),
+                        }
+                    };
+                    self.reader.notify_read(n);
+                    self.bytes_read += n as u64;
+                }
+                LinearReadEvent::Record { opcode, data } => {
+                    let record = match mcap::parse_record(opcode, data) {
+                        Ok(r) => r,
+                        Err(e) => {
+                            let what = format!("record with opcode {opcode:#04x}: {}", error_chain(&e));
+                            return Err(self.container_error(&what));
+                        }
+                    };
+                    match record {
+                        Record::Schema { header, .. } => {
+                            self.schemas.insert(header.id, (header.name, header.encoding));
+                        }
+                        Record::Channel(c) => {
+                            let type_name = match self.schemas.get(&c.schema_id) {
+                                Some((name, _)) => name.clone(),
+                                None => String::new(),
+                            };
+                            self.channels
+                                .insert(c.id, Topic { name: c.topic, type_name, encoding: c.message_encoding });
+                        }
+                        Record::Message { header, data } => {
+                            self.payload.clear();
+                            self.payload.extend_from_slice(&data);
+                            let log_time = i64::try_from(header.log_time).map_err(|_| {
+                                self.message_error(
+                                    index,
+                                    header.channel_id,
+                                    format!("log_time {} ns is beyond year 2262", header.log_time),
+                                )
+                            })?;
+                            self.current = Some((header.channel_id, Stamp(log_time)));
+                            return Ok(true);
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+    }
+
+    fn message_error(&self, index: u64, channel: u16, message: String) -> Error {
+        let topic = match self.channels.get(&channel) {
+            Some(t) => t.name.clone(),
+            None => format!("(channel {channel})"),
+        };
+        Error::format(&self.path, Location::Message { index, topic }, message)
+    }
+}
+
+impl Source for McapSource {
+    fn next_raw(&mut self, index: u64) -> Option<Result<RawMessage<'_>>> {
+        match self.advance(index) {
+            Ok(true) => {}
+            Ok(false) => return None,
+            Err(e) => return Some(Err(e)),
+        }
+        let (channel, log_time) = self.current?;
+        match self.channels.get(&channel) {
+            Some(topic) => Some(Ok(RawMessage { path: &self.path, topic, log_time, data: &self.payload })),
+            None => Some(Err(self.message_error(
+                index,
+                channel,
+                format!("message on channel {channel}, which no Channel record declared"),
+            ))),
+        }
+    }
+}

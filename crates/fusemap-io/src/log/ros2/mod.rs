@@ -1,0 +1,447 @@
+//! ROS 2 logs in: bare `.mcap` files and rosbag2 directories (`metadata.yaml` beside
+//! MCAP or SQLite `.db3` storage files), with CDR-encoded messages.
+//!
+//! The containers (MCAP files, SQLite `.db3` files, [`rosbag2`] directories of either)
+//! yield raw messages with their topic, type name, encoding and log time; one
+//! [`Ros2Reader`] decodes those fusemap uses (`sensor_msgs/msg/LaserScan`,
+//! `nav_msgs/msg/Odometry`, `tf2_msgs/msg/TFMessage`, `sensor_msgs/msg/Imu`; see
+//! [`cdr`] and [`msgs`]) into [`LogMessage`]s and counts the rest in
+//! [`ReadStats::skipped_by_type`]. A message whose payload does not decode is an
+//! [`Error::Format`] at [`Location::Message`] (file, 1-based index in the log, topic),
+//! and reading can go on with the next one; a container error (a truncated or corrupt
+//! file) ends the log.
+//!
+//! Every message gets its container's log time as `receive_stamp` (MCAP `log_time`,
+//! `.db3` `timestamp`); the header stamp is passed on as written.
+//!
+//! ```no_run
+//! use fusemap_io::log::ros2::open_ros2;
+//! use fusemap_io::log::LogMessage;
+//!
+//! # fn main() -> fusemap_io::Result<()> {
+//! let mut log = open_ros2("run1/".as_ref())?; // a rosbag2 directory or a .mcap file
+//! while let Some(message) = log.next_message() {
+//!     if let LogMessage::Scan(scan) = message? {
+//!         println!("{} beams at {:?}", scan.scan.ranges.len(), scan.scan.stamp);
+//!     }
+//! }
+//! println!("skipped: {:?}", log.stats().skipped_by_type);
+//! # Ok(())
+//! # }
+//! ```
+
+pub mod cdr;
+mod db3;
+mod mcap_reader;
+pub mod msgs;
+pub mod rosbag2;
+
+use crate::error::{Error, Location, Result};
+use crate::log::{ImuMessage, LogMessage, LogReader, OdomMessage, ReadStats, ScanMessage, TfMessage, Transform};
+use cdr::{decode_cdr, CdrError};
+use fusemap_core::geometry::{quaternion_yaw, Pose2};
+use fusemap_core::sensor::LaserScan;
+use fusemap_core::time::Stamp;
+use std::collections::VecDeque;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// The 8 bytes every MCAP file starts (and ends) with.
+pub const MCAP_MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
+
+/// The 16 bytes every SQLite 3 database starts with.
+pub const SQLITE_MAGIC: &[u8; 16] = b"SQLite format 3\0";
+
+/// True when `first_bytes` (at least the first 8 bytes of a file) start with the MCAP magic.
+pub fn sniff_mcap(first_bytes: &[u8]) -> bool {
+    first_bytes.starts_with(MCAP_MAGIC)
+}
+
+/// True when `path` is a directory holding a `metadata.yaml` (a rosbag2 bag).
+pub fn is_rosbag2_dir(path: &Path) -> bool {
+    path.is_dir() && path.join(rosbag2::METADATA_FILE).is_file()
+}
+
+/// Opens a ROS 2 log: a rosbag2 directory (or its `metadata.yaml`), a bare `.mcap` file,
+/// or a bare rosbag2 `.db3` file, told apart by their content rather than their names.
+pub fn open_ros2(path: &Path) -> Result<Box<dyn LogReader>> {
+    Ok(Box::new(Ros2Reader::open(path)?))
+}
+
+/// The kinds of ROS 2 message fusemap decodes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KnownType {
+    /// `sensor_msgs/msg/LaserScan`.
+    LaserScan,
+    /// `nav_msgs/msg/Odometry`.
+    Odometry,
+    /// `tf2_msgs/msg/TFMessage`.
+    TfMessage,
+    /// `sensor_msgs/msg/Imu`.
+    Imu,
+}
+
+impl KnownType {
+    /// All of them, for tests and fuzzing.
+    pub const ALL: [KnownType; 4] = [KnownType::LaserScan, KnownType::Odometry, KnownType::TfMessage, KnownType::Imu];
+
+    /// The type from its ROS 2 name (`sensor_msgs/msg/LaserScan`); the ROS 1 spelling
+    /// without `/msg/` is accepted too. `None` for types fusemap does not use.
+    pub fn from_name(type_name: &str) -> Option<Self> {
+        match type_name {
+            "sensor_msgs/msg/LaserScan" | "sensor_msgs/LaserScan" => Some(KnownType::LaserScan),
+            "nav_msgs/msg/Odometry" | "nav_msgs/Odometry" => Some(KnownType::Odometry),
+            "tf2_msgs/msg/TFMessage" | "tf2_msgs/TFMessage" => Some(KnownType::TfMessage),
+            "sensor_msgs/msg/Imu" | "sensor_msgs/Imu" => Some(KnownType::Imu),
+            _ => None,
+        }
+    }
+
+    /// The ROS 2 type name.
+    pub fn name(self) -> &'static str {
+        match self {
+            KnownType::LaserScan => "sensor_msgs/msg/LaserScan",
+            KnownType::Odometry => "nav_msgs/msg/Odometry",
+            KnownType::TfMessage => "tf2_msgs/msg/TFMessage",
+            KnownType::Imu => "sensor_msgs/msg/Imu",
+        }
+    }
+}
+
+/// Decodes one CDR payload (encapsulation header included) of type `kind` received on
+/// `topic` into fusemap's message type.
+pub fn decode_known(
+    kind: KnownType,
+    topic: &str,
+    receive_stamp: Option<Stamp>,
+    payload: &[u8],
+) -> std::result::Result<LogMessage, CdrError> {
+    use msgs::{nav_msgs, sensor_msgs, tf2_msgs};
+    Ok(match kind {
+        KnownType::LaserScan => {
+            let m: sensor_msgs::LaserScan = decode_cdr(payload)?;
+            LogMessage::Scan(ScanMessage {
+                topic: topic.to_owned(),
+                frame_id: m.header.frame_id,
+                receive_stamp,
+                scan: LaserScan {
+                    stamp: m.header.stamp.to_stamp(),
+                    angle_min: f64::from(m.angle_min),
+                    angle_increment: f64::from(m.angle_increment),
+                    ranges: m.ranges,
+                },
+                time_increment: m.time_increment,
+                scan_time: m.scan_time,
+                range_min: m.range_min,
+                range_max: m.range_max,
+                pose: None,
+                odom_pose: None,
+                laser_pose: None,
+            })
+        }
+        KnownType::Odometry => {
+            let m: nav_msgs::Odometry = decode_cdr(payload)?;
+            let p = m.pose.pose;
+            LogMessage::Odometry(OdomMessage {
+                topic: topic.to_owned(),
+                stamp: m.header.stamp.to_stamp(),
+                receive_stamp,
+                frame_id: m.header.frame_id,
+                child_frame_id: m.child_frame_id,
+                pose: Pose2::new(p.position.x, p.position.y, quaternion_yaw(p.orientation.to_array())),
+            })
+        }
+        KnownType::TfMessage => {
+            let m: tf2_msgs::TfMessage = decode_cdr(payload)?;
+            LogMessage::Tf(TfMessage {
+                topic: topic.to_owned(),
+                is_static: topic == "/tf_static",
+                receive_stamp,
+                transforms: m
+                    .transforms
+                    .into_iter()
+                    .map(|t| Transform {
+                        stamp: t.header.stamp.to_stamp(),
+                        parent: t.header.frame_id,
+                        child: t.child_frame_id,
+                        translation: t.transform.translation.to_array(),
+                        rotation: t.transform.rotation.to_array(),
+                    })
+                    .collect(),
+            })
+        }
+        KnownType::Imu => {
+            let m: sensor_msgs::Imu = decode_cdr(payload)?;
+            LogMessage::Imu(ImuMessage {
+                topic: topic.to_owned(),
+                stamp: m.header.stamp.to_stamp(),
+                receive_stamp,
+                frame_id: m.header.frame_id,
+                orientation: m.orientation.to_array(),
+                angular_velocity: m.angular_velocity.to_array(),
+                linear_acceleration: m.linear_acceleration.to_array(),
+            })
+        }
+    })
+}
+
+/// Decodes a payload by its ROS type name: `Ok(None)` for a type fusemap does not use.
+pub fn decode_message(
+    type_name: &str,
+    topic: &str,
+    receive_stamp: Option<Stamp>,
+    payload: &[u8],
+) -> std::result::Result<Option<LogMessage>, CdrError> {
+    match KnownType::from_name(type_name) {
+        Some(kind) => decode_known(kind, topic, receive_stamp, payload).map(Some),
+        None => Ok(None),
+    }
+}
+
+/// A topic as a container declares it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Topic {
+    /// Topic name (`/scan`).
+    pub name: String,
+    /// ROS type name (`sensor_msgs/msg/LaserScan`), empty when the container has none.
+    pub type_name: String,
+    /// Serialisation (`cdr`).
+    pub encoding: String,
+}
+
+/// One message as a container stores it.
+pub(crate) struct RawMessage<'a> {
+    /// The storage file it is in.
+    pub path: &'a Path,
+    pub topic: &'a Topic,
+    pub log_time: Stamp,
+    pub data: &'a [u8],
+}
+
+/// A storage file that yields raw messages in its order.
+pub(crate) trait Source {
+    /// The next message; `index` is its 1-based position in the whole log, for errors.
+    fn next_raw(&mut self, index: u64) -> Option<Result<RawMessage<'_>>>;
+}
+
+/// Storage that is opened when the reader reaches it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) enum PendingFile {
+    /// An MCAP file, whole-file zstd-compressed when `zstd` (rosbag2 `file` compression).
+    Mcap { path: PathBuf, zstd: bool },
+    /// A SQLite3 rosbag2 storage file.
+    Db3 { path: PathBuf },
+}
+
+impl PendingFile {
+    fn open(&self) -> Result<Box<dyn Source + Send>> {
+        Ok(match self {
+            PendingFile::Mcap { path, zstd } => Box::new(mcap_reader::McapSource::open(path, *zstd)?),
+            PendingFile::Db3 { path } => Box::new(db3::Db3Source::open(path)?),
+        })
+    }
+}
+
+/// Largest decompressed size of one message in a bag with per-message zstd compression.
+const MAX_MESSAGE_LEN: u64 = 1 << 30;
+
+/// Reads a ROS 2 log (one or more storage files) as [`LogMessage`]s in storage order:
+/// MCAP files in file order, `.db3` files by timestamp, the files of a rosbag2 directory
+/// one after another as `metadata.yaml` lists them.
+pub struct Ros2Reader {
+    pending: VecDeque<PendingFile>,
+    current: Option<Box<dyn Source + Send>>,
+    /// rosbag2 `message` compression: every payload is a zstd frame.
+    zstd_messages: bool,
+    index: u64,
+    stats: ReadStats,
+    finished: bool,
+    scratch: Vec<u8>,
+}
+
+impl Ros2Reader {
+    /// Opens a rosbag2 directory (or its `metadata.yaml`), a `.mcap` or a `.db3` file.
+    pub fn open(path: &Path) -> Result<Self> {
+        if path.is_dir() {
+            return Self::open_rosbag2(path);
+        }
+        if path.file_name().is_some_and(|n| n == rosbag2::METADATA_FILE) {
+            let dir = match path.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => Path::new("."),
+            };
+            return Self::open_rosbag2(dir);
+        }
+        let mut head = [0u8; 16];
+        let n = read_head(path, &mut head)?;
+        let head = &head[..n];
+        if sniff_mcap(head) {
+            Self::open_mcap(path)
+        } else if head.starts_with(SQLITE_MAGIC) {
+            Self::open_db3(path)
+        } else {
+            Err(Error::format(
+                path,
+                Location::File,
+                format!(
+                    "neither an MCAP file (which starts with \\x89MCAP0\\r\\n) nor a rosbag2 \
+                     SQLite file; the first bytes are {}",
+                    hex(head)
+                ),
+            ))
+        }
+    }
+
+    /// Opens a bare MCAP file.
+    pub fn open_mcap(path: &Path) -> Result<Self> {
+        Self::from_files(vec![PendingFile::Mcap { path: path.to_path_buf(), zstd: false }], false)
+    }
+
+    /// Opens a bare rosbag2 SQLite storage file (its `topics` table names the types).
+    pub fn open_db3(path: &Path) -> Result<Self> {
+        Self::from_files(vec![PendingFile::Db3 { path: path.to_path_buf() }], false)
+    }
+
+    /// Opens a rosbag2 directory as its `metadata.yaml` describes it.
+    pub fn open_rosbag2(dir: &Path) -> Result<Self> {
+        let bag = rosbag2::Rosbag2Dir::open(dir)?;
+        Self::from_files(bag.files, bag.zstd_messages)
+    }
+
+    /// Opens the first file now, so that a missing or unreadable log fails at open.
+    fn from_files(files: Vec<PendingFile>, zstd_messages: bool) -> Result<Self> {
+        let mut pending: VecDeque<PendingFile> = files.into();
+        let current = match pending.pop_front() {
+            Some(f) => Some(f.open()?),
+            None => None,
+        };
+        Ok(Self {
+            pending,
+            current,
+            zstd_messages,
+            index: 0,
+            stats: ReadStats::default(),
+            finished: false,
+            scratch: Vec::new(),
+        })
+    }
+
+    fn next_inner(&mut self) -> Option<Result<LogMessage>> {
+        loop {
+            let source = match &mut self.current {
+                Some(s) => s,
+                None => {
+                    let file = self.pending.pop_front()?;
+                    match file.open() {
+                        Ok(s) => self.current.insert(s),
+                        Err(e) => {
+                            self.finished = true;
+                            return Some(Err(e));
+                        }
+                    }
+                }
+            };
+            let index = self.index + 1;
+            let raw = match source.next_raw(index) {
+                None => {
+                    self.current = None;
+                    continue;
+                }
+                Some(Err(e)) => {
+                    self.finished = true;
+                    return Some(Err(e));
+                }
+                Some(Ok(raw)) => raw,
+            };
+            self.index = index;
+            let topic = raw.topic;
+            let Some(kind) = KnownType::from_name(&topic.type_name) else {
+                let t = if topic.type_name.is_empty() { "(no schema)" } else { &topic.type_name };
+                self.stats.skip_type(t);
+                continue;
+            };
+            if !topic.encoding.eq_ignore_ascii_case("cdr") {
+                self.stats.skip_type(&format!("{} ({} encoding)", topic.type_name, topic.encoding));
+                continue;
+            }
+            let at = |message: String| {
+                Error::format(raw.path, Location::Message { index, topic: topic.name.clone() }, message)
+            };
+            let mut payload = raw.data;
+            if self.zstd_messages {
+                self.scratch.clear();
+                let decoded = zstd::stream::read::Decoder::new(payload)
+                    .and_then(|d| d.take(MAX_MESSAGE_LEN).read_to_end(&mut self.scratch));
+                if let Err(e) = decoded {
+                    return Some(Err(at(format!(
+                        "{}: the bag says messages are zstd-compressed, but: {e}",
+                        topic.type_name
+                    ))));
+                }
+                payload = &self.scratch;
+            }
+            let log_time = Some(raw.log_time);
+            return Some(
+                decode_known(kind, &topic.name, log_time, payload).map_err(|e| at(format!("{}: {e}", topic.type_name))),
+            );
+        }
+    }
+}
+
+impl LogReader for Ros2Reader {
+    fn next_message(&mut self) -> Option<Result<LogMessage>> {
+        if self.finished {
+            return None;
+        }
+        let next = self.next_inner();
+        if next.is_none() {
+            self.finished = true;
+        }
+        next
+    }
+
+    fn stats(&self) -> &ReadStats {
+        &self.stats
+    }
+}
+
+/// Reads up to `buf.len()` bytes from the start of `path`.
+fn read_head(path: &Path, buf: &mut [u8]) -> Result<usize> {
+    let mut f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut n = 0;
+    while n < buf.len() {
+        match f.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(Error::io(path, e)),
+        }
+    }
+    Ok(n)
+}
+
+/// `de ad be ef` for error messages.
+fn hex(bytes: &[u8]) -> String {
+    if bytes.is_empty() {
+        return "(empty file)".into();
+    }
+    bytes.iter().map(|b| format!("{b:02x}")).collect::<Vec<_>>().join(" ")
+}
+
+/// An error and its sources, `outer: inner: innermost`.
+pub(crate) fn error_chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut source = e.source();
+    while let Some(inner) = source {
+        let text = inner.to_string();
+        if !s.contains(&text) {
+            s.push_str(": ");
+            s.push_str(&text);
+        }
+        source = inner.source();
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,354 @@
+//! rosbag2 directories: `metadata.yaml` names the storage plugin (`mcap` or `sqlite3`),
+//! the storage files in recording order, and the compression.
+//!
+//! Only five keys of `metadata.yaml` matter here, all direct children of
+//! `rosbag2_bagfile_information`: `version`, `storage_identifier`,
+//! `relative_file_paths`, `compression_mode` and `compression_format`. They are read by
+//! hand (block or flow list, plain or quoted scalars) rather than with a YAML library:
+//! nested keys (topic lists, QoS profiles) are skipped by their indentation.
+
+use super::PendingFile;
+use crate::error::{Error, Location, Result};
+use std::path::{Path, PathBuf};
+
+/// The file that makes a directory a rosbag2 bag.
+pub const METADATA_FILE: &str = "metadata.yaml";
+
+/// The keys of `metadata.yaml` that fusemap uses.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Metadata {
+    /// Bag format version (1–9 so far), if given.
+    pub version: Option<u32>,
+    /// Storage plugin: `mcap` or `sqlite3` (empty when the file does not say).
+    pub storage_identifier: String,
+    /// Storage files relative to the bag directory, in recording order.
+    pub relative_file_paths: Vec<String>,
+    /// `""`, `file` or `message` (rosbag2 writes these in either case).
+    pub compression_mode: String,
+    /// `""` or `zstd`.
+    pub compression_format: String,
+}
+
+/// A parse error: the 1-based line (0 for the file as a whole) and what is wrong.
+pub type MetadataError = (u64, String);
+
+const ROOT_KEY: &str = "rosbag2_bagfile_information";
+
+/// Reads the keys fusemap needs from the text of a `metadata.yaml`.
+pub fn parse_metadata(text: &str) -> std::result::Result<Metadata, MetadataError> {
+    let lines: Vec<(u64, usize, &str)> = text
+        .lines()
+        .enumerate()
+        .filter_map(|(i, line)| {
+            let line = line.trim_end_matches('\r');
+            let body = line.trim_start_matches(' ');
+            if body.is_empty() || body.starts_with('#') || line == "---" {
+                return None;
+            }
+            if body.starts_with('\t') {
+                // Tabs are not YAML indentation; let the caller see the line.
+                return Some((i as u64 + 1, usize::MAX, body));
+            }
+            Some((i as u64 + 1, line.len() - body.len(), body))
+        })
+        .collect();
+
+    let root = lines
+        .iter()
+        .position(|&(_, indent, body)| indent == 0 && key_of(body).is_some_and(|(k, _)| k == ROOT_KEY))
+        .ok_or_else(|| (0, format!("no `{ROOT_KEY}:` key at the top level; not rosbag2 metadata")))?;
+    let Some(&(_, child_indent, _)) = lines.get(root + 1) else {
+        return Err((lines[root].0, format!("`{ROOT_KEY}` is empty")));
+    };
+    if child_indent == 0 || child_indent == usize::MAX {
+        return Err((lines[root].0 + 1, format!("`{ROOT_KEY}` has no indented keys")));
+    }
+
+    let mut meta = Metadata::default();
+    let mut found_paths = false;
+    let mut i = root + 1;
+    while i < lines.len() {
+        let (line_no, indent, body) = lines[i];
+        i += 1;
+        if indent == usize::MAX {
+            return Err((line_no, "tab used for indentation".into()));
+        }
+        if indent == 0 {
+            break;
+        }
+        if indent != child_indent || body.starts_with("- ") || body == "-" {
+            continue;
+        }
+        let Some((key, value)) = key_of(body) else {
+            continue;
+        };
+        match key {
+            "version" => {
+                let v = scalar(value);
+                meta.version = Some(v.parse().map_err(|_| (line_no, format!("`version: {v}` is not a whole number")))?);
+            }
+            "storage_identifier" => meta.storage_identifier = scalar(value),
+            "compression_mode" => meta.compression_mode = scalar(value),
+            "compression_format" => meta.compression_format = scalar(value),
+            "relative_file_paths" => {
+                found_paths = true;
+                let value = strip_comment(value).trim();
+                if let Some(flow) = value.strip_prefix('[') {
+                    let inner = flow
+                        .strip_suffix(']')
+                        .ok_or((line_no, "`relative_file_paths: [` without a closing `]`".to_string()))?;
+                    meta.relative_file_paths = inner.split(',').map(scalar).filter(|s| !s.is_empty()).collect();
+                } else if !value.is_empty() {
+                    return Err((line_no, format!("`relative_file_paths` should be a list, not `{value}`")));
+                } else {
+                    // Block list: `- item` lines, indented deeper or (a style some writers
+                    // use) at the key's own indentation.
+                    while let Some(&(_, item_indent, item)) = lines.get(i) {
+                        let is_item = item_indent != usize::MAX
+                            && item_indent >= child_indent
+                            && (item.starts_with("- ") || item == "-");
+                        if !is_item {
+                            break;
+                        }
+                        meta.relative_file_paths.push(scalar(&item[1..]));
+                        i += 1;
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    if !found_paths {
+        return Err((0, format!("no `relative_file_paths` under `{ROOT_KEY}`")));
+    }
+    Ok(meta)
+}
+
+/// `key: rest` of a mapping line, with the key unquoted.
+fn key_of(body: &str) -> Option<(&str, &str)> {
+    let (key, rest) = if let Some(quoted) = body.strip_prefix('"') {
+        let end = quoted.find('"')?;
+        (&quoted[..end], quoted[end + 1..].strip_prefix(':')?)
+    } else {
+        let colon = body.find(':')?;
+        let rest = &body[colon + 1..];
+        if !(rest.is_empty() || rest.starts_with(' ')) {
+            return None;
+        }
+        (&body[..colon], rest)
+    };
+    Some((key.trim(), rest))
+}
+
+/// Drops a ` # comment` outside quotes.
+fn strip_comment(value: &str) -> &str {
+    let mut quote = None;
+    let bytes = value.as_bytes();
+    for (i, &b) in bytes.iter().enumerate() {
+        match (quote, b) {
+            (None, b'"' | b'\'') => quote = Some(b),
+            (Some(q), _) if b == q => quote = None,
+            (None, b'#') if i == 0 || bytes[i - 1] == b' ' => return &value[..i],
+            _ => {}
+        }
+    }
+    value
+}
+
+/// A plain, 'single' or "double" quoted scalar.
+fn scalar(value: &str) -> String {
+    let v = strip_comment(value).trim();
+    if v.len() >= 2 && v.starts_with('"') && v.ends_with('"') {
+        let inner = &v[1..v.len() - 1];
+        let mut out = String::with_capacity(inner.len());
+        let mut chars = inner.chars();
+        while let Some(c) = chars.next() {
+            if c == '\\' {
+                match chars.next() {
+                    Some('n') => out.push('\n'),
+                    Some('t') => out.push('\t'),
+                    Some(other) => out.push(other),
+                    None => out.push('\\'),
+                }
+            } else {
+                out.push(c);
+            }
+        }
+        out
+    } else if v.len() >= 2 && v.starts_with('\'') && v.ends_with('\'') {
+        v[1..v.len() - 1].replace("''", "'")
+    } else if v == "~" || v == "null" {
+        String::new()
+    } else {
+        v.to_string()
+    }
+}
+
+/// A rosbag2 directory resolved to its storage files.
+pub(crate) struct Rosbag2Dir {
+    pub files: Vec<PendingFile>,
+    pub zstd_messages: bool,
+}
+
+impl Rosbag2Dir {
+    pub(crate) fn open(dir: &Path) -> Result<Self> {
+        let meta_path = dir.join(METADATA_FILE);
+        let text = std::fs::read_to_string(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
+        let meta = parse_metadata(&text).map_err(|(line, message)| {
+            let location = if line == 0 { Location::File } else { Location::Line(line) };
+            Error::format(&meta_path, location, message)
+        })?;
+        let field_error = |key: &str, message: String| Error::format(&meta_path, Location::Field(key.into()), message);
+
+        let mode = meta.compression_mode.to_ascii_lowercase();
+        let format = meta.compression_format.to_ascii_lowercase();
+        let (zstd_file, zstd_messages) = match mode.as_str() {
+            "" | "none" => (false, false),
+            "file" | "message" if format != "zstd" => {
+                return Err(field_error(
+                    "compression_format",
+                    format!(
+                        "compression `{}` is not supported; fusemap reads zstd-compressed bags",
+                        meta.compression_format
+                    ),
+                ))
+            }
+            "file" => (true, false),
+            "message" => (false, true),
+            _ => {
+                return Err(field_error(
+                    "compression_mode",
+                    format!("unknown compression mode `{}` (expected file or message)", meta.compression_mode),
+                ))
+            }
+        };
+
+        if meta.relative_file_paths.is_empty() {
+            return Err(field_error("relative_file_paths", "the bag lists no storage files".into()));
+        }
+        let storage = meta.storage_identifier.to_ascii_lowercase();
+        let mut files = Vec::new();
+        for rel in &meta.relative_file_paths {
+            let path = resolve(dir, rel).ok_or_else(|| {
+                field_error("relative_file_paths", format!("lists `{rel}`, which is not in {}", dir.display()))
+            })?;
+            let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+            let compressed = zstd_file || name.ends_with(".zstd");
+            let base = name.trim_end_matches(".zstd");
+            let is_mcap = match storage.as_str() {
+                "mcap" => true,
+                "sqlite3" => false,
+                _ if base.ends_with(".mcap") => true,
+                _ if base.ends_with(".db3") => false,
+                _ => {
+                    return Err(field_error(
+                        "storage_identifier",
+                        format!(
+                            "storage `{}` is not supported (fusemap reads `mcap` and `sqlite3` bags)",
+                            meta.storage_identifier
+                        ),
+                    ))
+                }
+            };
+            if is_mcap {
+                files.push(PendingFile::Mcap { path, zstd: compressed });
+            } else if compressed {
+                return Err(field_error(
+                    "compression_mode",
+                    format!(
+                        "`{rel}` is a whole-file zstd-compressed SQLite bag; decompress it first \
+                         (`zstd -d`, then list the .db3 in metadata.yaml) or convert the bag to MCAP"
+                    ),
+                ));
+            } else {
+                files.push(PendingFile::Db3 { path });
+            }
+        }
+        Ok(Self { files, zstd_messages })
+    }
+}
+
+/// The storage file `rel` names: relative to the bag directory, or (as early rosbag2
+/// versions wrote it, with the directory name in front) just its file name there.
+fn resolve(dir: &Path, rel: &str) -> Option<PathBuf> {
+    let direct = dir.join(rel);
+    if direct.is_file() {
+        return Some(direct);
+    }
+    let by_name = dir.join(Path::new(rel).file_name()?);
+    by_name.is_file().then_some(by_name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_the_rosbag2_cli_layout() {
+        let text = "\
+rosbag2_bagfile_information:
+  version: 5
+  storage_identifier: sqlite3
+  duration:
+    nanoseconds: 120
+  topics_with_message_count:
+    - topic_metadata:
+        name: /scan
+        type: sensor_msgs/msg/LaserScan
+        serialization_format: cdr
+        offered_qos_profiles: \"- history: 3\\n  depth: 0\\n  storage_identifier: x\\n\"
+      message_count: 3
+  compression_format: \"\"
+  compression_mode: \"\"
+  relative_file_paths:
+    - bag_0.db3
+    - \"bag_1.db3\"
+  files:
+    - path: bag_0.db3
+      message_count: 2
+";
+        let m = parse_metadata(text).unwrap();
+        assert_eq!(m.version, Some(5));
+        assert_eq!(m.storage_identifier, "sqlite3");
+        assert_eq!(m.relative_file_paths, ["bag_0.db3", "bag_1.db3"]);
+        assert_eq!(m.compression_mode, "");
+    }
+
+    #[test]
+    fn reads_dash_at_key_indent_flow_lists_and_comments() {
+        let text = "\
+# written by hand
+rosbag2_bagfile_information:
+  storage_identifier: 'mcap'   # the plugin
+  relative_file_paths:
+  - a_0.mcap
+  - a_1.mcap
+  topics_with_message_count:
+  - message_count: 1
+    topic_metadata:
+      name: /storage_identifier
+  version: 9
+";
+        let m = parse_metadata(text).unwrap();
+        assert_eq!(m.storage_identifier, "mcap");
+        assert_eq!(m.relative_file_paths, ["a_0.mcap", "a_1.mcap"]);
+        assert_eq!(m.version, Some(9));
+
+        let flow = "rosbag2_bagfile_information:\n    relative_file_paths: [x.db3, \"y.db3\"]\n";
+        assert_eq!(parse_metadata(flow).unwrap().relative_file_paths, ["x.db3", "y.db3"]);
+    }
+
+    #[test]
+    fn says_what_is_missing() {
+        assert!(parse_metadata("foo: 1\n").unwrap_err().1.contains("rosbag2_bagfile_information"));
+        assert!(parse_metadata("rosbag2_bagfile_information:\n  version: 5\n")
+            .unwrap_err()
+            .1
+            .contains("relative_file_paths"));
+        assert_eq!(
+            parse_metadata("rosbag2_bagfile_information:\n  version: five\n  relative_file_paths: []\n").unwrap_err().0,
+            2
+        );
+        assert!(parse_metadata("rosbag2_bagfile_information:\n").is_err());
+    }
+}
