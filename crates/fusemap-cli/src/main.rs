@@ -1,8 +1,11 @@
 //! `fusemap`: multi-sensor occupancy-grid mapping.
 
 mod commands;
+mod output;
+mod summary;
 
 use clap::{Parser, Subcommand};
+use std::path::PathBuf;
 
 /// Turns a robot's sensor observations into a probabilistic occupancy-grid map.
 #[derive(Parser)]
@@ -14,6 +17,39 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Map the design document's corridor (40 poses, 181 beams, 0.05 m) end to end.
+    Demo {
+        /// Output directory (created if needed).
+        #[arg(long)]
+        out: PathBuf,
+        /// A config file (TOML) instead of the built-in defaults.
+        #[arg(long)]
+        config: Option<PathBuf>,
+    },
+    /// Map a robot log (CARMEN .log/.clf/.gz, ROS 1 .bag, .mcap, rosbag2 directory) or a
+    /// simulated run of a world file.
+    Map {
+        /// Config file (TOML); see configs/example.toml. Default: built-in defaults.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// A world file (TOML) to simulate instead of a log.
+        #[arg(long)]
+        world: Option<PathBuf>,
+        /// Output directory (created if needed).
+        #[arg(long)]
+        out: PathBuf,
+        /// The log, recognised by its content.
+        log: Option<PathBuf>,
+    },
+    /// Check a log's timing: rates, jitter, delays, stamps going backwards, gaps, and how
+    /// many scans get a pose.
+    Doctor {
+        /// Config file (TOML) for topics and sync settings.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// The log.
+        log: PathBuf,
+    },
     /// Insertion throughput on fixed synthetic workloads (a: corridor, b: corridor x500,
     /// c: 39 m box with 1,081-beam scans).
     Bench {
@@ -29,6 +65,11 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Demo { out, config } => commands::map::demo(&out, config.as_deref()),
+        Command::Map { config, world, out, log } => {
+            commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out)
+        }
+        Command::Doctor { config, log } => commands::doctor::run(config.as_deref(), &log),
         Command::Bench { workload, json } => commands::bench::run(workload, json),
     };
     if let Err(e) = result {

@@ -103,14 +103,23 @@ impl Summary {
         );
         println!(
             "cells updated {} (occupied {}, free {}); {} cell visits by {} rays",
-            self.cells_updated.total, self.cells_updated.occupied, self.cells_updated.free, self.cell_visits, self.rays_walked
+            self.cells_updated.total,
+            self.cells_updated.occupied,
+            self.cells_updated.free,
+            self.cell_visits,
+            self.rays_walked
         );
         if self.rays_rejected > 0 {
             println!("rays refused  {}", self.rays_rejected);
         }
         println!(
             "map           {} x {} cells at {} m, origin ({:.3}, {:.3}), {} tiles",
-            self.map.width, self.map.height, self.map.resolution, self.map.origin[0], self.map.origin[1], self.map.tiles
+            self.map.width,
+            self.map.height,
+            self.map.resolution,
+            self.map.origin[0],
+            self.map.origin[1],
+            self.map.tiles
         );
         if let Some(e) = &self.entropy {
             println!(

@@ -91,6 +91,11 @@ pub struct LogConfig {
     pub nearest_tolerance_s: f64,
     /// Longest gap in the pose track to interpolate across, seconds.
     pub max_pose_gap_s: f64,
+    /// Interpolate across a longer gap when the robot moved at most this far over it,
+    /// metres (0 disables).
+    pub gap_bridge_motion_m: f64,
+    /// … and turned at most this much, degrees.
+    pub gap_bridge_motion_deg: f64,
     /// Place each beam with the pose at its own time (needs `time_increment`).
     pub deskew: bool,
     /// Where the laser mount comes from.
@@ -113,6 +118,8 @@ impl Default for LogConfig {
             sync: SyncConfig::Interpolate,
             nearest_tolerance_s: 0.0,
             max_pose_gap_s: 0.5,
+            gap_bridge_motion_m: 0.05,
+            gap_bridge_motion_deg: 2.0,
             deskew: true,
             extrinsics: ExtrinsicsSource::Auto,
             extrinsics_tolerance_m: 0.02,
@@ -340,6 +347,13 @@ impl Config {
         finite("log.nearest_tolerance_s", g.nearest_tolerance_s)?;
         if g.nearest_tolerance_s < 0.0 {
             return Err(err("log.nearest_tolerance_s", "must be >= 0 (0 = half the scan period)"));
+        }
+        for (name, v) in
+            [("log.gap_bridge_motion_m", g.gap_bridge_motion_m), ("log.gap_bridge_motion_deg", g.gap_bridge_motion_deg)]
+        {
+            if finite(name, v)? < 0.0 {
+                return Err(err(name, format!("must be >= 0, got {v}")));
+            }
         }
         for (name, v) in [
             ("log.max_pose_gap_s", g.max_pose_gap_s),
