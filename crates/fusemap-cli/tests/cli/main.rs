@@ -1,0 +1,4 @@
+//! Integration tests: the `fusemap` binary on real files. One test binary with a module
+//! per area, so it links once.
+
+mod util;
