@@ -7,6 +7,6 @@ mod workloads;
 mod world;
 
 pub use rng::SplitMix64;
-pub use scanner::{simulate_scan, ScannerSpec, SimulatedRun};
+pub use scanner::{simulate_moving_scan, simulate_scan, ScannerSpec, SimulatedRun};
 pub use workloads::{workload, Workload, WORKLOADS};
 pub use world::{box_world, corridor, BoxWorld, Segment, World};

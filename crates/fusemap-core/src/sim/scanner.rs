@@ -68,6 +68,37 @@ pub fn simulate_scan(
     LaserScan { stamp, angle_min: spec.angle_min, angle_increment: inc, ranges }
 }
 
+/// Simulates one scan taken while the robot moves: beam `i` is fired at
+/// `t0 + i · time_increment` seconds from the pose `world_from_base_at(t)`, as a rotating
+/// lidar does (the motion distortion de-skewing removes).
+pub fn simulate_moving_scan(
+    world: &World,
+    spec: &ScannerSpec,
+    mount: &PlanarMount,
+    world_from_base_at: impl Fn(f64) -> Pose2,
+    t0: f64,
+    time_increment: f64,
+) -> LaserScan {
+    let inc = spec.angle_increment();
+    let ranges = (0..spec.beams)
+        .map(|i| {
+            let pose = world_from_base_at(t0 + i as f64 * time_increment);
+            let origin = pose * mount.origin_in_base();
+            let a = pose.theta + mount.beam_angle_in_base(spec.angle_min + i as f64 * inc);
+            match world.cast(origin, a) {
+                Some(d) if d < spec.range_max => d as f32,
+                _ => spec.range_max as f32,
+            }
+        })
+        .collect();
+    LaserScan {
+        stamp: Stamp::from_secs_f64(t0).unwrap_or(Stamp::ZERO),
+        angle_min: spec.angle_min,
+        angle_increment: inc,
+        ranges,
+    }
+}
+
 /// A whole simulated run: a trajectory of base poses, one scan at each.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimulatedRun {
