@@ -13,5 +13,5 @@ pub use geometry::{
 pub use logodds::{LogOddsTable, OccupancyParams, Ternary};
 pub use occupancy::{InsertStats, OccupancyGrid, OccupancyTile, MAX_RAY_CELLS};
 pub use raster::Raster;
-pub use raycast::CellRay;
+pub use raycast::{CellRay, Step};
 pub use tiles::{Tile, TileKeyHasher, TileMap};

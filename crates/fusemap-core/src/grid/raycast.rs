@@ -91,9 +91,16 @@ impl CellRay {
     /// Moves to the next cell; `false` when the current cell was the last one.
     #[inline(always)]
     pub fn advance(&mut self) -> bool {
+        self.step() != Step::Done
+    }
+
+    /// Moves to the next cell and says which way it went, so that a caller walking
+    /// inside a tile can update its own offset instead of recomputing it from the cell.
+    #[inline(always)]
+    pub fn step(&mut self) -> Step {
         let go_x = if self.remaining_y == 0 {
             if self.remaining_x == 0 {
-                return false;
+                return Step::Done;
             }
             true
         } else {
@@ -103,12 +110,25 @@ impl CellRay {
             self.x += self.step_x;
             self.t_max_x += self.t_delta_x;
             self.remaining_x -= 1;
+            Step::X
         } else {
             self.y += self.step_y;
             self.t_max_y += self.t_delta_y;
             self.remaining_y -= 1;
+            Step::Y
         }
-        true
+    }
+
+    /// The x step direction: -1, 0 or +1.
+    #[inline(always)]
+    pub fn step_x(&self) -> i64 {
+        self.step_x
+    }
+
+    /// The y step direction: -1, 0 or +1.
+    #[inline(always)]
+    pub fn step_y(&self) -> i64 {
+        self.step_y
     }
 
     /// Calls `visit` on every cell in order; stops early when it returns `false`.
@@ -127,6 +147,17 @@ impl CellRay {
             }
         }
     }
+}
+
+/// Which way [`CellRay::step`] moved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// The previous cell was the last one.
+    Done,
+    /// One cell along x (by [`CellRay::step_x`]).
+    X,
+    /// One cell along y (by [`CellRay::step_y`]).
+    Y,
 }
 
 impl Iterator for CellRay {
