@@ -56,6 +56,10 @@ enum Command {
         /// Run one workload in this process (a, b or c); default: each in a child process.
         #[arg(long)]
         workload: Option<char>,
+        /// Insert the scans of a SCAN2D01 scan file instead (the baselines' format), on
+        /// its grid and range limits, for side-by-side comparisons.
+        #[arg(long, conflicts_with = "workload")]
+        scanfile: Option<PathBuf>,
         /// One JSON object per line per workload instead of a table.
         #[arg(long)]
         json: bool,
@@ -70,7 +74,7 @@ fn main() {
             commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out)
         }
         Command::Doctor { config, log } => commands::doctor::run(config.as_deref(), &log),
-        Command::Bench { workload, json } => commands::bench::run(workload, json),
+        Command::Bench { workload, scanfile, json } => commands::bench::run(workload, scanfile.as_deref(), json),
     };
     if let Err(e) = result {
         eprintln!("error: {}", format_chain(&e));

@@ -1,13 +1,13 @@
-//! ROS 2 logs written by third-party tools (`rosbags`, `mcap` + `mcap-ros2-support`) from
-//! one CARMEN log, read back with fusemap's readers: the three containers must give the
-//! same scans, odometry and transforms, bit for bit, and as many as the writer reports.
+//! ROS 2 and ROS 1 logs written by third-party tools (`rosbags`, `mcap` +
+//! `mcap-ros2-support`) from one CARMEN log, read back with fusemap's readers: the three
+//! ROS 2 containers and the ROS 1 bag must give the same scans, odometry and transforms,
+//! bit for bit, and as many as the writer reports.
 //!
-//! The fixtures are made at test time by `tests/fixtures/make_ros2_fixtures.py` (see
+//! The fixtures are made at test time by `tests/fixtures/make_ros_fixtures.py` (see
 //! `tests/fixtures/README.md`); without python3 and those packages the test is skipped,
 //! or fails under `FUSEMAP_NO_SKIP=1`.
 
-use fusemap_io::log::ros2::open_ros2;
-use fusemap_io::log::{LogMessage, OdomMessage, ScanMessage, TfMessage};
+use fusemap_io::log::{open_log, LogMessage, OdomMessage, ScanMessage, TfMessage};
 use fusemap_io::testdata;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -16,7 +16,7 @@ use std::process::Command;
 fn python_with_writers() -> Option<String> {
     let python = std::env::var("FUSEMAP_PYTHON").unwrap_or_else(|_| "python3".into());
     let ok = Command::new(&python)
-        .args(["-c", "import rosbags.rosbag2, mcap, mcap_ros2.writer, numpy"])
+        .args(["-c", "import rosbags.rosbag1, rosbags.rosbag2, mcap, mcap_ros2.writer, numpy"])
         .output()
         .is_ok_and(|o| o.status.success());
     if ok {
@@ -39,7 +39,7 @@ struct Decoded {
 }
 
 fn read(path: &Path) -> Decoded {
-    let mut reader = open_ros2(path).unwrap_or_else(|e| panic!("{e}"));
+    let mut reader = open_log(path).unwrap_or_else(|e| panic!("{e}")).reader;
     let mut d = Decoded::default();
     while let Some(m) = reader.next_message() {
         match m.unwrap_or_else(|e| panic!("{e}")) {
@@ -72,10 +72,10 @@ fn assert_same_scans(a: &[ScanMessage], b: &[ScanMessage], what: &str) {
 }
 
 #[test]
-fn third_party_ros2_logs_decode_identically() {
+fn third_party_ros_logs_decode_identically() {
     let Some(python) = python_with_writers() else { return };
     let Some(carmen) = testdata::dataset("intel/intel-corrected.log.gz") else { return };
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/fixtures/make_ros2_fixtures.py");
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/fixtures/make_ros_fixtures.py");
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
     let run = Command::new(&python)
@@ -89,7 +89,7 @@ fn third_party_ros2_logs_decode_identically() {
     let summary: serde_json::Value = serde_json::from_slice(&run.stdout).expect("the script's JSON summary");
     let count = |topic: &str| summary["counts"][topic].as_u64().unwrap_or_else(|| panic!("count of {topic}")) as usize;
 
-    let outputs = ["rosbag2_mcap", "rosbag2_sqlite3", "bare.mcap"];
+    let outputs = ["rosbag2_mcap", "rosbag2_sqlite3", "bare.mcap", "ros1.bag"];
     let decoded: Vec<Decoded> = outputs.iter().map(|o| read(&out.join(o))).collect();
     let first = &decoded[0];
 

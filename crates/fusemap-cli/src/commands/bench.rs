@@ -30,7 +30,7 @@ pub struct BenchRow {
     pub cell_visits: u64,
     /// Mean cells visited per walked ray.
     pub cell_visits_per_ray: f64,
-    /// Seconds simulating the scans (not part of the rates).
+    /// Seconds simulating (or reading) the scans (not part of the rates).
     pub simulate_s: f64,
     /// Seconds inserting (the rates' denominator).
     pub insert_s: f64,
@@ -80,6 +80,55 @@ pub fn run_one(name: char) -> Result<BenchRow> {
     })
 }
 
+/// Maps the scans of a `SCAN2D01` scan file (the baselines' input) in this process, on
+/// the file's grid alignment and range limits, so that fusemap and the baselines insert
+/// exactly the same beams.
+pub fn run_scanfile(path: &std::path::Path) -> Result<BenchRow> {
+    let t0 = Instant::now();
+    let f = fusemap_io::scanfile::read_scanfile(path)?;
+    let simulate_s = t0.elapsed().as_secs_f64();
+    let geometry = GridGeometry::new(f.resolution, fusemap_core::geometry::Point2::new(f.origin[0], f.origin[1]))?;
+    let mut engine = Engine::new(OccupancyGrid::new(geometry, OccupancyParams::default()));
+    let params =
+        fusemap_core::sensor::LidarParams { min_range: f.range_min, max_range: f.range_max, ..Default::default() };
+    let laser = engine.add_lidar("laser", LidarModel::new(params, PlanarMount::default()));
+    let mut scan = fusemap_core::sensor::LaserScan {
+        stamp: fusemap_core::time::Stamp::ZERO,
+        angle_min: f.angle_min,
+        angle_increment: f.angle_increment,
+        ranges: Vec::new(),
+    };
+    let t1 = Instant::now();
+    for (i, pose) in f.poses.iter().enumerate() {
+        scan.ranges.clear();
+        scan.ranges.extend_from_slice(&f.ranges[i * f.beams..(i + 1) * f.beams]);
+        engine.insert_scan(laser, &scan, *pose)?;
+    }
+    let insert_s = t1.elapsed().as_secs_f64();
+    let st = engine.stats().insert;
+    let scans = f.poses.len() as u64;
+    let beams = f.ranges.len() as u64;
+    Ok(BenchRow {
+        workload: format!(
+            "scanfile:{}",
+            path.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+        ),
+        description: format!("{} scans x {} beams from {}", scans, f.beams, path.display()),
+        scans,
+        beams,
+        rays: st.rays,
+        cell_visits: st.cell_visits,
+        cell_visits_per_ray: st.cell_visits as f64 / st.rays.max(1) as f64,
+        simulate_s,
+        insert_s,
+        scans_per_s: scans as f64 / insert_s,
+        beams_per_s: beams as f64 / insert_s,
+        cell_visits_per_s: st.cell_visits as f64 / insert_s,
+        peak_rss_bytes: peak_rss_bytes(),
+        tiles: engine.grid().tile_count() as u64,
+    })
+}
+
 /// Peak resident set size of this process (`VmHWM` in `/proc/self/status`), 0 where
 /// unavailable.
 pub fn peak_rss_bytes() -> u64 {
@@ -95,10 +144,11 @@ pub fn peak_rss_bytes() -> u64 {
 }
 
 /// `fusemap bench`.
-pub fn run(which: Option<char>, json: bool) -> Result<()> {
-    let rows = match which {
-        Some(w) => vec![run_one(w)?],
-        None => {
+pub fn run(which: Option<char>, scanfile: Option<&std::path::Path>, json: bool) -> Result<()> {
+    let rows = match (which, scanfile) {
+        (_, Some(path)) => vec![run_scanfile(path)?],
+        (Some(w), None) => vec![run_one(w)?],
+        (None, None) => {
             let exe = std::env::current_exe().context("cannot find the fusemap executable to run workloads")?;
             let mut rows = Vec::new();
             for w in WORKLOADS {

@@ -5,11 +5,19 @@
 //! time order with the pose at each scan's own stamp (or each beam's, de-skewed). Every
 //! scan that cannot be posed is skipped and counted with its reason; clock faults are
 //! detected and reported, and the usable part of the log is still mapped.
+//!
+//! With a pose track (odometry or TF), both the track and the scans are taken in header
+//! stamp order (the design document's "time-sorted odometry and scans", §4.1), not in the
+//! order the log holds them: a pose sample or a scan that arrives after a later-stamped
+//! one is still good data at its own stamp. So the map depends only on the stamps and
+//! values, and the same messages give the same map whatever the container and its
+//! storage order (CARMEN file order, a bag's log-time order). Only messages with equal
+//! stamps keep their log order: the first pose sample of a stamp is used.
 
 use super::map::{engine_for, finish, progress};
 use crate::output;
 use crate::summary::Summary;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use fusemap_core::config::{ExtrinsicsSource, LogConfig, Plan, PoseSource, SyncConfig};
 use fusemap_core::geometry::{normalize_angle, Mount3, PlanarMount, Pose2, Pose3};
 use fusemap_core::measurement::SensorId;
@@ -56,16 +64,32 @@ pub fn load(path: &Path) -> Result<LoadedLog> {
         stats: ReadStats::default(),
         decode_s: 0.0,
     };
+    let mut tf = Vec::new();
+    let mut undecodable = ReadStats::default();
     while let Some(m) = reader.next_message() {
-        match m? {
+        let m = match m {
+            Ok(m) => m,
+            // One message that does not decode (a corrupt payload, a big-endian CDR
+            // message) is skipped and counted: a user wants the rest of the log. Errors
+            // of the container itself end the read.
+            Err(e @ fusemap_io::Error::Format { location: fusemap_io::Location::Message { .. }, .. }) => {
+                undecodable.malformed(e.to_string());
+                continue;
+            }
+            Err(e) => return Err(e.into()),
+        };
+        match m {
             LogMessage::Scan(s) => log.scans.entry(s.topic.clone()).or_default().push(s),
             LogMessage::Odometry(o) => log.odom.entry(o.topic.clone()).or_default().push(o),
-            LogMessage::Tf(t) if t.is_static => log.tf_static.extend(t.transforms),
-            LogMessage::Tf(t) => log.tf_dynamic.extend(t.transforms),
+            LogMessage::Tf(t) => tf.push(t),
             LogMessage::Imu(i) => *log.imu.entry(i.topic).or_default() += 1,
         }
     }
     log.stats = reader.stats().clone();
+    for e in undecodable.malformed_examples {
+        log.stats.malformed(e);
+    }
+    log.stats.malformed += undecodable.malformed - undecodable.malformed.min(10);
     if opened.format != fusemap_io::log::LogFormat::Carmen {
         // ROS containers are played back in log-time order (what `rosbag play` and
         // `ros2 bag play` do), whatever order their chunks hold the records in. CARMEN
@@ -75,6 +99,14 @@ pub fn load(path: &Path) -> Result<LoadedLog> {
         }
         for v in log.odom.values_mut() {
             v.sort_by_key(|m| m.receive_stamp);
+        }
+        tf.sort_by_key(|m| m.receive_stamp);
+    }
+    for t in tf {
+        if t.is_static {
+            log.tf_static.extend(t.transforms);
+        } else {
+            log.tf_dynamic.extend(t.transforms);
         }
     }
     log.decode_s = t0.elapsed().as_secs_f64();
@@ -92,6 +124,11 @@ pub fn choose_scan_topic(log: &LoadedLog, cfg: &LogConfig, notes: &mut Vec<Strin
         }
     }
     match log.scans.keys().collect::<Vec<_>>().as_slice() {
+        [] if log.stats.malformed > 0 => bail!(
+            "the log holds no usable laser scans; {} records could not be decoded, the first: {}",
+            log.stats.malformed,
+            log.stats.malformed_examples.first().map_or("", |s| s.as_str())
+        ),
         [] => bail!("the log holds no laser scans"),
         [only] => {
             notes.push(format!("scan topic `{}` not in the log; using its only scan topic `{only}`", cfg.scan_topic));
@@ -123,10 +160,10 @@ pub struct TrackCounts {
     pub samples: u64,
     /// Samples kept.
     pub used: u64,
-    /// Same stamp as the previous sample.
+    /// Same stamp as an earlier sample (the first one is kept).
     pub duplicates: u64,
-    /// Older than the previous sample.
-    pub out_of_order: u64,
+    /// Arrived after a sample with a later stamp: put back in stamp order and used.
+    pub reordered: u64,
     /// NaN or infinite poses.
     pub not_finite: u64,
 }
@@ -159,13 +196,19 @@ pub fn build_track(
     };
     let mut buffer = PoseBuffer::new(cfg.max_pose_gap_s)
         .bridging_gaps(cfg.gap_bridge_motion_m, cfg.gap_bridge_motion_deg.to_radians());
-    let mut push = |stamp: Stamp, pose: Pose2, counts: &mut TrackCounts| {
-        counts.samples += 1;
-        match buffer.push(stamp, pose) {
-            PushOutcome::Added => counts.used += 1,
-            PushOutcome::Duplicate => counts.duplicates += 1,
-            PushOutcome::OutOfOrder => counts.out_of_order += 1,
-            PushOutcome::NotFinite => counts.not_finite += 1,
+    // The samples in stamp order (stable: equal stamps keep their log order).
+    let mut fill = |samples: Vec<(Stamp, Pose2)>, counts: &mut TrackCounts| {
+        counts.samples += samples.len() as u64;
+        counts.reordered += count_reordered(samples.iter().map(|s| s.0));
+        let mut samples = samples;
+        samples.sort_by_key(|s| s.0);
+        for (stamp, pose) in samples {
+            match buffer.push(stamp, pose) {
+                PushOutcome::Added => counts.used += 1,
+                PushOutcome::Duplicate => counts.duplicates += 1,
+                PushOutcome::NotFinite => counts.not_finite += 1,
+                PushOutcome::OutOfOrder => unreachable!("the samples are sorted by stamp"),
+            }
         }
     };
     let name = match source {
@@ -179,16 +222,15 @@ pub fn build_track(
             let Some(topic) = odom_topic else {
                 bail!("log.pose_source = \"odometry\" but the log has no odometry topic `{}`", cfg.odom_topic)
             };
-            for o in &log.odom[&topic] {
-                push(o.stamp, o.pose, counts);
-            }
+            fill(log.odom[&topic].iter().map(|o| (o.stamp, o.pose)).collect(), counts);
             format!("odometry `{topic}`")
         }
         PoseSource::Tf => {
-            for t in log.tf_dynamic.iter().filter(|t| t.child == cfg.base_frame) {
+            let samples = log.tf_dynamic.iter().filter(|t| t.child == cfg.base_frame).map(|t| {
                 let m = Mount3::from_translation_quaternion(t.translation, t.rotation);
-                push(t.stamp, Pose2::new(m.x, m.y, m.yaw), counts);
-            }
+                (t.stamp, Pose2::new(m.x, m.y, m.yaw))
+            });
+            fill(samples.collect(), counts);
             format!("TF `… → {}`", cfg.base_frame)
         }
         PoseSource::Auto => unreachable!("resolved above"),
@@ -197,6 +239,30 @@ pub fn build_track(
         bail!("the pose source ({name}) holds no usable pose");
     }
     Ok((source, Track::Buffer(buffer), name))
+}
+
+/// How many of `stamps` (in log order) come after a later stamp.
+pub fn count_reordered(stamps: impl IntoIterator<Item = Stamp>) -> u64 {
+    let mut latest: Option<Stamp> = None;
+    let mut n = 0;
+    for s in stamps {
+        match latest {
+            Some(l) if s < l => n += 1,
+            _ => latest = Some(s),
+        }
+    }
+    n
+}
+
+/// The scans in the order they are inserted: stamp order (stable) for a pose track, log
+/// order for poses on the scan lines (which do not depend on the stamps; some corrected
+/// CARMEN logs have broken or all-zero stamps).
+pub fn insertion_order<'a>(scans: &'a [ScanMessage], track: &Track) -> Vec<&'a ScanMessage> {
+    let mut v: Vec<&ScanMessage> = scans.iter().collect();
+    if matches!(track, Track::Buffer(_)) {
+        v.sort_by_key(|s| s.scan.stamp);
+    }
+    v
 }
 
 /// The transform `base_from_frame` through the static TF tree (either direction per edge).
@@ -318,12 +384,11 @@ pub struct Skipped {
     pub no_pose_within_tolerance: u64,
     /// No pose on the scan line.
     pub no_pose_on_line: u64,
-    /// Stamp earlier than the previous scan's.
-    pub stamp_went_backwards: u64,
 }
 
 impl Skipped {
-    fn count(&mut self, why: NoPose) {
+    /// Counts a scan that got no pose, by the reason.
+    pub fn count(&mut self, why: NoPose) {
         match why {
             NoPose::Empty | NoPose::BeforeStart(_) => self.before_first_pose += 1,
             NoPose::AfterEnd(_) => self.after_last_pose += 1,
@@ -339,7 +404,6 @@ impl Skipped {
             + self.in_pose_gap
             + self.no_pose_within_tolerance
             + self.no_pose_on_line
-            + self.stamp_went_backwards
     }
 }
 
@@ -364,6 +428,9 @@ pub struct LogReport {
     pub scans_skipped: Skipped,
     /// Scans de-skewed beam by beam.
     pub scans_deskewed: u64,
+    /// Scans inserted out of log order, after a later-stamped one (pose tracks map in
+    /// stamp order).
+    pub scans_reordered: u64,
     /// The pose track's counters.
     pub pose_track: TrackCounts,
     /// Timing of the scan stream.
@@ -382,17 +449,23 @@ pub struct LogReport {
     pub map_s: f64,
 }
 
-/// The sync mode from the config, with the nearest tolerance resolved.
-pub fn sync_mode(cfg: &LogConfig, scan_timing: &StreamTiming) -> SyncMode {
+/// The sync mode from the config, with the nearest tolerance resolved (half the median
+/// period of `scans`, taken in stamp order as the scans are mapped).
+pub fn sync_mode(cfg: &LogConfig, scans: &[ScanMessage]) -> SyncMode {
     match cfg.sync {
         SyncConfig::Interpolate => SyncMode::Interpolate,
         SyncConfig::Nearest => {
             let tol = if cfg.nearest_tolerance_s > 0.0 {
                 cfg.nearest_tolerance_s
-            } else if scan_timing.median_period_s > 0.0 {
-                scan_timing.median_period_s / 2.0
             } else {
-                0.05
+                let mut h: Vec<Stamp> = scans.iter().map(|s| s.scan.stamp).collect();
+                h.sort_unstable();
+                let median_period_s = StreamTiming::analyze(&h, &[], TimingLimits::default()).median_period_s;
+                if median_period_s > 0.0 {
+                    median_period_s / 2.0
+                } else {
+                    0.05
+                }
             };
             SyncMode::Nearest { tolerance_s: tol }
         }
@@ -420,7 +493,8 @@ pub fn run(plan: &Plan, config_given: bool, path: &Path, out: &Path, inputs: &[P
         }
     }
     let cfg = plan.log.clone();
-    let log = load(path).with_context(|| format!("reading {}", path.display()))?;
+    // fusemap-io errors already name the file (and the line or message): no context.
+    let log = load(path)?;
     let mut notes = Vec::new();
     let topic = choose_scan_topic(&log, &cfg, &mut notes)?;
     let scans = &log.scans[&topic];
@@ -448,7 +522,7 @@ pub fn run(plan: &Plan, config_given: bool, path: &Path, out: &Path, inputs: &[P
         }
         Track::ScanLine => None,
     };
-    let mode = sync_mode(&cfg, &scan_timing);
+    let mode = sync_mode(&cfg, scans);
 
     // The laser's mount: from the log's TF / scan lines or the config.
     let config_mount = plan.lidars[0].mount;
@@ -476,10 +550,13 @@ pub fn run(plan: &Plan, config_given: bool, path: &Path, out: &Path, inputs: &[P
         angle_increment: 0.0,
         ranges: Vec::new(),
     };
-    for msg in scans {
+    let scans_reordered = match track {
+        Track::Buffer(_) => count_reordered(scans.iter().map(|s| s.scan.stamp)),
+        Track::ScanLine => 0,
+    };
+    for msg in insertion_order(scans, &track) {
         pb.inc(1);
         let stamp = msg.scan.stamp;
-        let backwards = last.is_some_and(|l| stamp < l);
         // Angles at LaserScan's float32 precision whatever the format, so that the same
         // scan read from CARMEN text or from a ROS message gives the same rays.
         scan.angle_min = msg.scan.angle_min as f32 as f64;
@@ -497,10 +574,6 @@ pub fn run(plan: &Plan, config_given: bool, path: &Path, out: &Path, inputs: &[P
                 engine.insert_scan_limited(laser, &scan, msg.range_min, msg.range_max, |_| pose)?;
             }
             Track::Buffer(buf) => {
-                if backwards {
-                    skipped.stamp_went_backwards += 1;
-                    continue;
-                }
                 let pose = match buf.pose_at(stamp, mode) {
                     Ok(p) => p,
                     Err(why) => {
@@ -530,15 +603,15 @@ pub fn run(plan: &Plan, config_given: bool, path: &Path, out: &Path, inputs: &[P
     let map_s = t_map.elapsed().as_secs_f64();
 
     if scan_timing.regressions > 0 {
-        notes.push(format!("`{topic}` stamps go backwards {} times", scan_timing.regressions));
+        let order = if scans_reordered > 0 {
+            format!(": {scans_reordered} scans mapped in stamp order")
+        } else {
+            String::new()
+        };
+        notes.push(format!("`{topic}` stamps go backwards {} times{order}", scan_timing.regressions));
     }
     if skipped.total() > 0 {
-        notes.push(format!(
-            "{} of {} scans skipped ({} without a pose)",
-            skipped.total(),
-            scans.len(),
-            skipped.total() - skipped.stamp_went_backwards
-        ));
+        notes.push(format!("{} of {} scans skipped without a pose", skipped.total(), scans.len()));
     }
     if log.stats.malformed > 0 {
         notes.push(format!(
@@ -560,6 +633,7 @@ pub fn run(plan: &Plan, config_given: bool, path: &Path, out: &Path, inputs: &[P
         scans_used: engine.stats().measurements,
         scans_skipped: skipped,
         scans_deskewed: deskewed,
+        scans_reordered,
         pose_track: track_counts,
         scan_timing,
         pose_timing,

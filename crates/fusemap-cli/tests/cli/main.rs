@@ -1,4 +1,8 @@
 //! Integration tests: the `fusemap` binary on real files. One test binary with a module
 //! per area, so it links once.
 
+mod bad_input;
+mod demo;
+mod doctor;
+mod formats;
 mod util;

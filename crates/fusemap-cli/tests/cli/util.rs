@@ -49,3 +49,67 @@ pub fn one_line_error(o: &Output) -> String {
 pub fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
+
+/// A file of the repository, by its path from the root.
+pub fn repo_file(relative: &str) -> PathBuf {
+    repo_root().join(relative)
+}
+
+/// Writes `contents` to `dir/name` and returns the path.
+pub fn write_file(dir: &Path, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, contents).unwrap_or_else(|e| panic!("cannot write {}: {e}", p.display()));
+    p
+}
+
+/// The names in `dir`, sorted.
+pub fn file_names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
+        .map(|e| e.expect("directory entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// A JSON file, parsed.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{} is not JSON: {e}", path.display()))
+}
+
+/// Asserts a run succeeded, showing its output otherwise.
+pub fn assert_success(o: &Output) {
+    assert!(o.status.success(), "fusemap failed ({}):\nstdout: {}\nstderr: {}", o.status, stdout(o), stderr(o));
+}
+
+/// The Python interpreter: `$FUSEMAP_PYTHON`, else `python3` (tests/fixtures/README.md).
+pub fn python() -> Command {
+    Command::new(std::env::var_os("FUSEMAP_PYTHON").unwrap_or_else(|| "python3".into()))
+}
+
+/// True when Python runs and imports every module of `modules`; otherwise prints a skip
+/// notice (a failure under `FUSEMAP_NO_SKIP=1`) and returns false.
+pub fn python_with(modules: &[&str]) -> bool {
+    let code: String = modules.iter().map(|m| format!("import {m}\n")).collect();
+    match python().args(["-c", &code]).output() {
+        Ok(o) if o.status.success() => true,
+        Ok(o) => {
+            let why = stderr(&o);
+            let last = why.lines().last().unwrap_or("").trim();
+            fusemap_io::testdata::skip(&format!("python cannot import {}: {last}", modules.join(", ")));
+            false
+        }
+        Err(e) => {
+            fusemap_io::testdata::skip(&format!("cannot run python ($FUSEMAP_PYTHON or python3): {e}"));
+            false
+        }
+    }
+}
+
+/// Runs a Python script with `args`, asserting it succeeds, and returns its stdout.
+pub fn run_python(script: &str, args: &[&std::ffi::OsStr]) -> String {
+    let o = python().arg("-c").arg(script).args(args).output().expect("cannot start python");
+    assert!(o.status.success(), "python failed:\nstdout: {}\nstderr: {}", stdout(&o), stderr(&o));
+    stdout(&o)
+}

@@ -1,0 +1,402 @@
+//! Bad input of every kind: config files, world files and logs. Each must end the run
+//! with exactly one `error: ` line on stderr (no panic, non-zero exit) that names the
+//! file and the field or line, and write no map. Malformed CARMEN records are the
+//! exception by design: they are skipped, counted and reported, and the run succeeds.
+
+use crate::util::{
+    assert_success, file_names, one_line_error, python_with, read_json, repo_file, run, run_python, stdout, temp_dir,
+    write_file,
+};
+use std::path::{Path, PathBuf};
+
+fn path_str(p: &Path) -> &str {
+    p.to_str().expect("temp paths are UTF-8")
+}
+
+/// Asserts `line` names each of `parts`.
+fn assert_names(line: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(line.contains(p), "the error does not name `{p}`: {line}");
+    }
+}
+
+/// Asserts no map was written into `out`.
+fn assert_no_map(out: &Path) {
+    if out.exists() {
+        let names = file_names(out);
+        assert!(!names.iter().any(|n| n.starts_with("map.")), "a map was written: {names:?}");
+    }
+}
+
+/// The 1-based line of `text` where `needle` starts.
+fn line_of(text: &str, needle: &str) -> usize {
+    let at = text.find(needle).unwrap_or_else(|| panic!("`{needle}` not in the text"));
+    text[..at].matches('\n').count() + 1
+}
+
+// ---------------------------------------------------------------------------------------
+// Config files (`--config`), through `fusemap demo`.
+
+/// Writes `text` as a config file, runs `fusemap demo --config` with it and returns the
+/// file's path and the error line (which must name the file).
+fn config_error(name: &str, text: &str) -> (String, String) {
+    let dir = temp_dir(&format!("config-{name}"));
+    let config = write_file(&dir, "robot.toml", text);
+    let out = dir.join("out");
+    let line = one_line_error(&run(&["demo", "--config", path_str(&config), "--out", path_str(&out)]));
+    let config = path_str(&config).to_string();
+    assert!(line.contains(&config), "the error does not name the config file: {line}");
+    assert_no_map(&out);
+    std::fs::remove_dir_all(&dir).unwrap();
+    (config, line)
+}
+
+#[test]
+fn config_unknown_key_names_it_and_its_line() {
+    let (p, line) = config_error("unknown-key", "[map]\nresolutoin = 0.05\n");
+    assert_names(&line, &[&format!("{p}:2:"), "resolutoin"]);
+}
+
+#[test]
+fn config_wrong_type() {
+    let (p, line) = config_error("wrong-type", "[map]\nresolution = 0.05\nprior = \"half\"\n");
+    assert_names(&line, &[&format!("{p}:3:"), "invalid type", "string"]);
+}
+
+#[test]
+fn config_p_occ_below_the_prior() {
+    let (p, line) = config_error("p-occ", "[map]\nprior = 0.5\n\n[[lidar]]\np_occ = 0.3\n");
+    assert_names(&line, &[&format!("{p}:5:"), "lidar[0].p_occ", "prior"]);
+}
+
+#[test]
+fn config_p_free_above_the_prior() {
+    let (p, line) = config_error("p-free", "[[lidar]]\np_occ = 0.9\np_free = 0.6\n");
+    assert_names(&line, &[&format!("{p}:3:"), "lidar[0].p_free", "prior"]);
+}
+
+#[test]
+fn config_min_range_not_below_max_range() {
+    let (p, line) = config_error("ranges", "[[lidar]]\nmin_range = 5.0\nmax_range = 5.0\n");
+    assert_names(&line, &[&format!("{p}:3:"), "lidar[0].max_range", "min_range"]);
+}
+
+#[test]
+fn config_resolution_zero_or_negative() {
+    for (tag, v) in [("zero", "0"), ("negative", "-0.05")] {
+        let (p, line) = config_error(&format!("resolution-{tag}"), &format!("[map]\nresolution = {v}\n"));
+        assert_names(&line, &[&format!("{p}:2:"), "map.resolution"]);
+    }
+}
+
+#[test]
+fn config_nan_probability() {
+    let (p, line) = config_error("nan-prior", "[map]\nprior = nan\n");
+    assert_names(&line, &[&format!("{p}:2:"), "map.prior", "finite"]);
+    let (p, line) = config_error("nan-p-occ", "[[lidar]]\np_occ = nan\n");
+    assert_names(&line, &[&format!("{p}:2:"), "lidar[0].p_occ", "finite"]);
+}
+
+#[test]
+fn config_clamp_min_not_below_the_prior() {
+    // The rule spans three keys; the error names the table and spells the rule out.
+    let (p, line) = config_error("clamp", "[map]\nprior = 0.5\nclamp_min = 0.6\n");
+    assert_names(&line, &[&format!("{p}:1:"), "`map`", "clamp_min < prior < clamp_max", "0.6 / 0.5"]);
+}
+
+#[test]
+fn config_tilted_mount() {
+    let (p, line) = config_error("tilt", "[[lidar]]\nname = \"laser\"\n\n[lidar.mount]\npitch = 0.5\n");
+    assert_names(&line, &[&p, "lidar[0].mount", "tilted"]);
+}
+
+#[test]
+fn config_toml_syntax_error_names_the_line() {
+    let (p, line) = config_error("syntax", "[map]\nresolution = 0.05\nprior = = 0.5\n");
+    assert_names(&line, &[&format!("{p}:3:")]);
+}
+
+#[test]
+fn config_missing_file_names_the_path() {
+    let dir = temp_dir("config-missing");
+    let config = dir.join("no-such-config.toml");
+    let out = dir.join("out");
+    for args in [
+        vec!["demo", "--config", path_str(&config), "--out", path_str(&out)],
+        vec!["map", "--config", path_str(&config), "--out", path_str(&out), "--world", "unused.toml"],
+    ] {
+        let line = one_line_error(&run(&args));
+        assert_names(&line, &[path_str(&config), "No such file"]);
+    }
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// ---------------------------------------------------------------------------------------
+// World files (`fusemap map --world`).
+
+fn corridor_text() -> String {
+    std::fs::read_to_string(repo_file("worlds/corridor.toml")).unwrap()
+}
+
+/// Writes `text` as a world file, runs `fusemap map --world` and returns the file's path
+/// and the error line (which must name the file).
+fn world_error(name: &str, text: &str) -> (String, String) {
+    let dir = temp_dir(&format!("world-{name}"));
+    let world = write_file(&dir, "world.toml", text);
+    let out = dir.join("out");
+    let line = one_line_error(&run(&["map", "--world", path_str(&world), "--out", path_str(&out)]));
+    let world = path_str(&world).to_string();
+    assert!(line.contains(&world), "the error does not name the world file: {line}");
+    assert_no_map(&out);
+    std::fs::remove_dir_all(&dir).unwrap();
+    (world, line)
+}
+
+#[test]
+fn world_syntax_error_names_the_line() {
+    let text = corridor_text().replace("beams = 181", "beams = = 181");
+    let (p, line) = world_error("syntax", &text);
+    assert_names(&line, &[&format!("{p}:{}:", line_of(&text, "beams = = 181"))]);
+}
+
+#[test]
+fn world_unknown_key() {
+    let text = corridor_text().replace("rate_hz = 10.0", "rate_hz = 10.0\ncolour = \"red\"");
+    let (p, line) = world_error("unknown-key", &text);
+    assert_names(&line, &[&format!("{p}:{}:", line_of(&text, "colour")), "colour"]);
+}
+
+#[test]
+fn world_zero_length_wall_names_it() {
+    // The end wall (the third, wall[2]) from (4, 2) to (4, 2).
+    let text = corridor_text().replace("from = [4.0, -2.0]\nto = [4.0, 2.0]", "from = [4.0, 2.0]\nto = [4.0, 2.0]");
+    assert_ne!(text, corridor_text());
+    let (p, line) = world_error("zero-wall", &text);
+    assert_names(&line, &[&p, "wall[2]", "zero length"]);
+}
+
+#[test]
+fn world_without_poses() {
+    let corridor = corridor_text();
+    let at = corridor.find("[trajectory]").unwrap();
+    let text = format!("{}[trajectory]\nposes = []\n", &corridor[..at]);
+    let (p, line) = world_error("no-poses", &text);
+    assert_names(&line, &[&format!("{p}:{}:", line_of(&text, "poses = []")), "trajectory.poses"]);
+    // No [trajectory] at all.
+    let (p, line) = world_error("no-trajectory", &corridor[..at]);
+    assert_names(&line, &[&p, "trajectory"]);
+}
+
+#[test]
+fn world_nan_coordinate() {
+    let text = corridor_text().replace("from = [4.0, -2.0]", "from = [nan, -2.0]");
+    let (p, line) = world_error("nan", &text);
+    assert_names(&line, &[&format!("{p}:{}:", line_of(&text, "from = [nan")), "wall[2].from", "finite"]);
+}
+
+#[test]
+fn world_missing_file_names_the_path() {
+    let dir = temp_dir("world-missing");
+    let world = dir.join("no-such-world.toml");
+    let out = dir.join("out");
+    let line = one_line_error(&run(&["map", "--world", path_str(&world), "--out", path_str(&out)]));
+    assert_names(&line, &[path_str(&world), "No such file"]);
+    assert_no_map(&out);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// ---------------------------------------------------------------------------------------
+// Logs (`fusemap map LOG` and `fusemap doctor LOG`).
+
+/// Runs `fusemap map --out DIR LOG` and `fusemap doctor LOG`; both must fail with one
+/// line naming the log and each of `parts`.
+fn log_errors(log: &Path, parts: &[&str]) {
+    let out = log.parent().unwrap().join("out");
+    let map = one_line_error(&run(&["map", "--out", path_str(&out), path_str(log)]));
+    let doctor = one_line_error(&run(&["doctor", path_str(log)]));
+    for line in [&map, &doctor] {
+        assert_eq!(line.matches(path_str(log)).count(), 1, "the error should name the log once: {line}");
+        assert_names(line, parts);
+    }
+    assert_no_map(&out);
+}
+
+#[test]
+fn log_empty_file() {
+    let dir = temp_dir("log-empty");
+    let log = write_file(&dir, "empty.log", b"");
+    log_errors(&log, &["empty"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn log_garbage_bytes() {
+    let dir = temp_dir("log-garbage");
+    // 4 KiB of xorshift noise: no format's magic, not text.
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let bytes: Vec<u8> = (0..4096)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 56) as u8
+        })
+        .collect();
+    let log = write_file(&dir, "noise.bin", bytes);
+    log_errors(&log, &["not a log fusemap reads"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn log_missing_file() {
+    let dir = temp_dir("log-missing");
+    log_errors(&dir.join("no-such.log"), &["No such file"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The first `n` bytes of a shared dataset, copied into `dir` as `name`; `None` (after
+/// the skip notice) when the datasets are absent.
+fn dataset_head(relative: &str, n: usize, dir: &Path, name: &str) -> Option<PathBuf> {
+    let Some(src) = fusemap_io::testdata::dataset(relative) else {
+        let _ = std::fs::remove_dir_all(dir);
+        return None;
+    };
+    let bytes = std::fs::read(&src).unwrap();
+    assert!(bytes.len() > n, "{relative} is shorter than {n} bytes");
+    Some(write_file(dir, name, &bytes[..n]))
+}
+
+#[test]
+fn log_truncated_ros1_bag() {
+    let dir = temp_dir("log-bag-cut");
+    let Some(log) = dataset_head("rosbag1-slam-benchmark/mit-csail.orig.bag", 100_000, &dir, "cut.bag") else {
+        return;
+    };
+    log_errors(&log, &["truncated"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn log_truncated_gzip_carmen() {
+    let dir = temp_dir("log-gz-cut");
+    let Some(log) = dataset_head("intel/intel-corrected.log.gz", 50_000, &dir, "cut.log.gz") else {
+        return;
+    };
+    log_errors(&log, &["gzip stream ends early after line"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn log_directory_that_is_not_a_rosbag2() {
+    let dir = temp_dir("log-dir");
+    let bag = dir.join("not-a-bag");
+    std::fs::create_dir(&bag).unwrap();
+    write_file(&bag, "something.mcap", b"not really");
+    log_errors(&bag, &["not a rosbag2", "metadata.yaml"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A CARMEN log of 20 good FLASER lines (a robot driving along a 4 m corridor, every
+/// beam at 2 m) with one line of too few fields (line 6) and one with a NaN pose (line
+/// 11): both are skipped and counted, the rest is mapped.
+#[test]
+fn log_malformed_carmen_lines_are_skipped_and_counted() {
+    let dir = temp_dir("log-carmen-malformed");
+    let ranges = vec!["2.0"; 180].join(" ");
+    let mut lines: Vec<String> = (0..20)
+        .map(|i| {
+            let (x, t) = (0.05 * i as f64, 1.0 + 0.1 * i as f64);
+            format!("FLASER 180 {ranges} {x:.2} 0 0 {x:.2} 0 0 {t:.3} host {t:.3}")
+        })
+        .collect();
+    lines.insert(5, "FLASER 180 1 2 3 0 0 0 0 0 0 1 h 1".into());
+    lines.insert(10, format!("FLASER 180 {ranges} nan 0 0 0 0 0 2.05 host 2.05"));
+    let log = write_file(&dir, "corridor.log", lines.join("\n") + "\n");
+    let p = path_str(&log);
+
+    let out = dir.join("out");
+    let o = run(&["map", "--out", path_str(&out), p]);
+    assert_success(&o);
+    let s = read_json(&out.join("summary.json"));
+    assert_eq!(s["source_kind"], "carmen");
+    assert_eq!(s["scans"], 20, "every good line is mapped");
+    assert_eq!(s["log"]["malformed_records"], 2, "{}", s["log"]);
+    let notes = s["notes"].as_array().unwrap();
+    let note = notes
+        .iter()
+        .filter_map(|n| n.as_str())
+        .find(|n| n.contains("malformed"))
+        .unwrap_or_else(|| panic!("no note on malformed records: {notes:?}"));
+    assert_names(note, &["2 malformed records skipped", &format!("{p}:6:"), &format!("{p}:11:"), "nan"]);
+    assert!(stdout(&o).contains("2 malformed records skipped"), "{}", stdout(&o));
+    assert!(out.join("map.npz").exists());
+
+    // The doctor reads the same log and reports the skipped records too.
+    let o = run(&["doctor", p]);
+    assert_success(&o);
+    assert!(stdout(&o).contains("2 malformed records skipped"), "{}", stdout(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Writes a bare MCAP (with the third-party `mcap` writer) holding one
+/// `sensor_msgs/msg/LaserScan` on `/scan` whose CDR encapsulation header is 00 00
+/// (big-endian).
+const BIG_ENDIAN_MCAP: &str = r#"
+import sys
+from mcap.writer import Writer
+with open(sys.argv[1], "wb") as f:
+    w = Writer(f)
+    w.start(profile="ros2", library="fusemap cli test")
+    schema = w.register_schema(name="sensor_msgs/msg/LaserScan", encoding="ros2msg", data=b"")
+    channel = w.register_channel(topic="/scan", message_encoding="cdr", schema_id=schema)
+    # Encapsulation 00 00 (big-endian CDR), options 00 00, then a body.
+    payload = bytes([0x00, 0x00, 0x00, 0x00]) + bytes(64)
+    w.add_message(channel_id=channel, log_time=1_000_000_000, publish_time=1_000_000_000, data=payload)
+    w.finish()
+"#;
+
+/// The ROS 2 reader refuses a big-endian payload with an error at the message; the log
+/// pipeline skips and counts such messages, and a log left with no scan fails with one
+/// line naming the first undecodable message. The doctor reports it as a finding.
+#[test]
+fn log_mcap_with_big_endian_cdr() {
+    if !python_with(&["mcap"]) {
+        return;
+    }
+    let dir = temp_dir("log-mcap-big-endian");
+    let log = dir.join("big-endian.mcap");
+    run_python(BIG_ENDIAN_MCAP, &[log.as_os_str()]);
+    let out = dir.join("out");
+    let line = one_line_error(&run(&["map", "--out", path_str(&out), path_str(&log)]));
+    assert_names(&line, &["no usable laser scans", "message 1 on `/scan`", "sensor_msgs/msg/LaserScan", "big-endian"]);
+    assert_no_map(&out);
+    let o = run(&["doctor", path_str(&log)]);
+    assert_success(&o);
+    assert_names(&stdout(&o), &["1 malformed records skipped", "big-endian"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// ---------------------------------------------------------------------------------------
+// What to map.
+
+#[test]
+fn map_needs_a_log_or_a_world() {
+    let dir = temp_dir("map-nothing");
+    let out = dir.join("out");
+    let line = one_line_error(&run(&["map", "--out", path_str(&out)]));
+    assert_names(&line, &["nothing to map", "LOG", "--world"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn map_refuses_a_log_and_a_world() {
+    let dir = temp_dir("map-both");
+    let out = dir.join("out");
+    let world = repo_file("worlds/corridor.toml");
+    let log = write_file(&dir, "run.log", b"FLASER 3 1.0 1.0 1.0 0 0 0 0 0 0 1.0 host 1.0\n");
+    let line = one_line_error(&run(&["map", "--world", path_str(&world), "--out", path_str(&out), path_str(&log)]));
+    assert_names(&line, &["either --world", "not both"]);
+    assert_no_map(&out);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

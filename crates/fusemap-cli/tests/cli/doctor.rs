@@ -1,0 +1,42 @@
+//! `fusemap doctor`: its whole report on real logs, as snapshots
+//! (`snapshots/cli__doctor__*.snap`; review a change with `cargo insta review`, or rerun
+//! with `INSTA_UPDATE=always` and read the diff).
+//!
+//! The figures were checked against an independent reading when the snapshots were made
+//! (`rosbags` for the bags: message counts, rates, jitter, regressions in log-time order,
+//! pauses, the share of scans interpolation can pose; a Python scan of the CARMEN text).
+
+use crate::formats::intel_fixtures;
+use crate::util::{run, stderr, stdout};
+use std::path::Path;
+
+/// `fusemap doctor LOG`'s stdout, after checking it succeeded.
+fn doctor(log: &Path) -> String {
+    let o = run(&["doctor", log.to_str().unwrap()]);
+    assert!(o.status.success(), "fusemap doctor {} failed:\n{}", log.display(), stderr(&o));
+    stdout(&o)
+}
+
+/// The SLAM-benchmark Intel bag (ROS 1, bz2 chunks): odometry pauses while the robot
+/// stands, and some of them too long to bridge.
+#[test]
+fn doctor_intel_orig_bag() {
+    let Some(bag) = fusemap_io::testdata::dataset("rosbag1-slam-benchmark/intel.orig.bag") else { return };
+    insta::assert_snapshot!(doctor(&bag));
+}
+
+/// The bare MCAP written by `make_ros_fixtures.py` from the first 300 scans of the
+/// corrected Intel log: keyframe scans, re-anchored odometry with repeated stamps.
+#[test]
+fn doctor_ros2_mcap_fixture() {
+    let Some(fixtures) = intel_fixtures() else { return };
+    insta::assert_snapshot!(doctor(&fixtures.join("bare.mcap")));
+}
+
+/// The raw MIT CSAIL CARMEN log: poses on the scan lines, logger time counted from the
+/// start of the log while the scans carry Unix time.
+#[test]
+fn doctor_mit_csail_clf() {
+    let Some(clf) = fusemap_io::testdata::dataset("mit-csail-raw/mit-csail.clf") else { return };
+    insta::assert_snapshot!(doctor(&clf));
+}
