@@ -5,4 +5,5 @@ mod bad_input;
 mod demo;
 mod doctor;
 mod formats;
+mod real_logs;
 mod util;
