@@ -64,16 +64,18 @@ impl OccupancyTile {
     /// Returns whether it did.
     #[inline(always)]
     fn update_once(&mut self, offset: usize, delta: f32, table: &LogOddsTable) -> bool {
+        // Branch-free: whether a cell was already updated in this observation follows no
+        // pattern a branch predictor could learn, so the update is always computed and
+        // the old value kept by a select.
         let word = &mut self.updated[offset >> 6];
         let bit = 1u64 << (offset & 63);
-        if *word & bit != 0 {
-            return false;
-        }
+        let fresh = *word & bit == 0;
         *word |= bit;
         let v = self.log_odds[offset];
         let base = if v.is_nan() { table.prior } else { v };
-        self.log_odds[offset] = table.update(base, delta);
-        true
+        let updated = table.update(base, delta);
+        self.log_odds[offset] = if fresh { updated } else { v };
+        fresh
     }
 }
 

@@ -44,6 +44,7 @@ pub struct CellRay {
     t_delta_y: f64,
     remaining_x: u64,
     remaining_y: u64,
+    remaining: u64,
     finished: bool,
 }
 
@@ -58,6 +59,10 @@ impl CellRay {
         let dy = end.1 - start.1;
         let (step_x, t_max_x, t_delta_x) = axis(start.0, x0, dx);
         let (step_y, t_max_y, t_delta_y) = axis(start.1, y0, dy);
+        let (remaining_x, remaining_y) = (ix1.abs_diff(ix0), iy1.abs_diff(iy0));
+        // An axis with no step left never wins the comparison in `step`.
+        let t_max_x = if remaining_x == 0 { f64::INFINITY } else { t_max_x };
+        let t_max_y = if remaining_y == 0 { f64::INFINITY } else { t_max_y };
         Self {
             x: ix0,
             y: iy0,
@@ -67,8 +72,9 @@ impl CellRay {
             t_max_y,
             t_delta_x,
             t_delta_y,
-            remaining_x: ix1.abs_diff(ix0),
-            remaining_y: iy1.abs_diff(iy0),
+            remaining_x,
+            remaining_y,
+            remaining: remaining_x + remaining_y,
             finished: false,
         }
     }
@@ -78,7 +84,7 @@ impl CellRay {
         if self.finished {
             0
         } else {
-            self.remaining_x + self.remaining_y + 1
+            self.remaining + 1
         }
     }
 
@@ -98,23 +104,22 @@ impl CellRay {
     /// inside a tile can update its own offset instead of recomputing it from the cell.
     #[inline(always)]
     pub fn step(&mut self) -> Step {
-        let go_x = if self.remaining_y == 0 {
-            if self.remaining_x == 0 {
-                return Step::Done;
-            }
-            true
-        } else {
-            self.remaining_x != 0 && self.t_max_x < self.t_max_y
-        };
-        if go_x {
+        if self.remaining == 0 {
+            return Step::Done;
+        }
+        self.remaining -= 1;
+        // Ties (the segment passes exactly through a cell corner) take the y step. An
+        // exhausted axis has `t_max = ∞`, so the step counts, not the rounding of the
+        // crossing parameters, decide where the walk ends.
+        if self.t_max_x < self.t_max_y {
             self.x += self.step_x;
-            self.t_max_x += self.t_delta_x;
             self.remaining_x -= 1;
+            self.t_max_x = if self.remaining_x == 0 { f64::INFINITY } else { self.t_max_x + self.t_delta_x };
             Step::X
         } else {
             self.y += self.step_y;
-            self.t_max_y += self.t_delta_y;
             self.remaining_y -= 1;
+            self.t_max_y = if self.remaining_y == 0 { f64::INFINITY } else { self.t_max_y + self.t_delta_y };
             Step::Y
         }
     }
