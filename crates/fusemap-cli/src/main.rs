@@ -60,6 +60,10 @@ enum Command {
         /// its grid and range limits, for side-by-side comparisons.
         #[arg(long, conflicts_with = "workload")]
         scanfile: Option<PathBuf>,
+        /// With --scanfile: insert only the first N scans (the baselines time slow systems
+        /// on the first 250 scans of workload c).
+        #[arg(long, requires = "scanfile")]
+        max_scans: Option<usize>,
         /// One JSON object per line per workload instead of a table.
         #[arg(long)]
         json: bool,
@@ -74,7 +78,9 @@ fn main() {
             commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out)
         }
         Command::Doctor { config, log } => commands::doctor::run(config.as_deref(), &log),
-        Command::Bench { workload, scanfile, json } => commands::bench::run(workload, scanfile.as_deref(), json),
+        Command::Bench { workload, scanfile, max_scans, json } => {
+            commands::bench::run(workload, scanfile.as_deref(), max_scans, json)
+        }
     };
     if let Err(e) = result {
         eprintln!("error: {}", format_chain(&e));

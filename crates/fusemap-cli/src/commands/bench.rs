@@ -83,9 +83,13 @@ pub fn run_one(name: char) -> Result<BenchRow> {
 /// Maps the scans of a `SCAN2D01` scan file (the baselines' input) in this process, on
 /// the file's grid alignment and range limits, so that fusemap and the baselines insert
 /// exactly the same beams.
-pub fn run_scanfile(path: &std::path::Path) -> Result<BenchRow> {
+pub fn run_scanfile(path: &std::path::Path, max_scans: Option<usize>) -> Result<BenchRow> {
     let t0 = Instant::now();
-    let f = fusemap_io::scanfile::read_scanfile(path)?;
+    let mut f = fusemap_io::scanfile::read_scanfile(path)?;
+    if let Some(n) = max_scans {
+        f.poses.truncate(n);
+        f.ranges.truncate(n * f.beams);
+    }
     let simulate_s = t0.elapsed().as_secs_f64();
     let geometry = GridGeometry::new(f.resolution, fusemap_core::geometry::Point2::new(f.origin[0], f.origin[1]))?;
     let mut engine = Engine::new(OccupancyGrid::new(geometry, OccupancyParams::default()));
@@ -144,9 +148,14 @@ pub fn peak_rss_bytes() -> u64 {
 }
 
 /// `fusemap bench`.
-pub fn run(which: Option<char>, scanfile: Option<&std::path::Path>, json: bool) -> Result<()> {
+pub fn run(
+    which: Option<char>,
+    scanfile: Option<&std::path::Path>,
+    max_scans: Option<usize>,
+    json: bool,
+) -> Result<()> {
     let rows = match (which, scanfile) {
-        (_, Some(path)) => vec![run_scanfile(path)?],
+        (_, Some(path)) => vec![run_scanfile(path, max_scans)?],
         (Some(w), None) => vec![run_one(w)?],
         (None, None) => {
             let exe = std::env::current_exe().context("cannot find the fusemap executable to run workloads")?;
