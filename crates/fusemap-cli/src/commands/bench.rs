@@ -46,6 +46,30 @@ pub struct BenchRow {
     pub tiles: u64,
 }
 
+impl BenchRow {
+    /// The figures of a finished run of `engine` over `beams` beams.
+    fn new(workload: String, description: String, engine: &Engine, beams: u64, simulate_s: f64, insert_s: f64) -> Self {
+        let st = engine.stats().insert;
+        let scans = engine.stats().measurements;
+        Self {
+            workload,
+            description,
+            scans,
+            beams,
+            rays: st.rays,
+            cell_visits: st.cell_visits,
+            cell_visits_per_ray: st.cell_visits as f64 / st.rays.max(1) as f64,
+            simulate_s,
+            insert_s,
+            scans_per_s: scans as f64 / insert_s,
+            beams_per_s: beams as f64 / insert_s,
+            cell_visits_per_s: st.cell_visits as f64 / insert_s,
+            peak_rss_bytes: peak_rss_bytes(),
+            tiles: engine.grid().tile_count() as u64,
+        }
+    }
+}
+
 /// Runs workload `name` in this process.
 pub fn run_one(name: char) -> Result<BenchRow> {
     let t0 = Instant::now();
@@ -59,25 +83,8 @@ pub fn run_one(name: char) -> Result<BenchRow> {
         engine.insert_scan(laser, scan, *pose)?;
     }
     let insert_s = t1.elapsed().as_secs_f64();
-    let st = engine.stats().insert;
-    let scans = w.run.scans.len() as u64;
     let beams: u64 = w.run.scans.iter().map(|s| s.ranges.len() as u64).sum();
-    Ok(BenchRow {
-        workload: name.to_string(),
-        description: w.description.to_string(),
-        scans,
-        beams,
-        rays: st.rays,
-        cell_visits: st.cell_visits,
-        cell_visits_per_ray: st.cell_visits as f64 / st.rays.max(1) as f64,
-        simulate_s,
-        insert_s,
-        scans_per_s: scans as f64 / insert_s,
-        beams_per_s: beams as f64 / insert_s,
-        cell_visits_per_s: st.cell_visits as f64 / insert_s,
-        peak_rss_bytes: peak_rss_bytes(),
-        tiles: engine.grid().tile_count() as u64,
-    })
+    Ok(BenchRow::new(name.to_string(), w.description.to_string(), &engine, beams, simulate_s, insert_s))
 }
 
 /// Maps the scans of a `SCAN2D01` scan file (the baselines' input) in this process, on
@@ -109,28 +116,10 @@ pub fn run_scanfile(path: &std::path::Path, max_scans: Option<usize>) -> Result<
         engine.insert_scan(laser, &scan, *pose)?;
     }
     let insert_s = t1.elapsed().as_secs_f64();
-    let st = engine.stats().insert;
-    let scans = f.poses.len() as u64;
-    let beams = f.ranges.len() as u64;
-    Ok(BenchRow {
-        workload: format!(
-            "scanfile:{}",
-            path.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())
-        ),
-        description: format!("{} scans x {} beams from {}", scans, f.beams, path.display()),
-        scans,
-        beams,
-        rays: st.rays,
-        cell_visits: st.cell_visits,
-        cell_visits_per_ray: st.cell_visits as f64 / st.rays.max(1) as f64,
-        simulate_s,
-        insert_s,
-        scans_per_s: scans as f64 / insert_s,
-        beams_per_s: beams as f64 / insert_s,
-        cell_visits_per_s: st.cell_visits as f64 / insert_s,
-        peak_rss_bytes: peak_rss_bytes(),
-        tiles: engine.grid().tile_count() as u64,
-    })
+    let workload =
+        format!("scanfile:{}", path.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned()));
+    let description = format!("{} scans x {} beams from {}", f.poses.len(), f.beams, path.display());
+    Ok(BenchRow::new(workload, description, &engine, f.ranges.len() as u64, simulate_s, insert_s))
 }
 
 /// Peak resident set size of this process (`VmHWM` in `/proc/self/status`), 0 where

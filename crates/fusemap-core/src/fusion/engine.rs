@@ -136,17 +136,8 @@ impl Engine {
         scan: &LaserScan,
         pose_of_beam: impl FnMut(usize) -> Pose2,
     ) -> Result<InsertStats, EngineError> {
-        if self.lidars.get(sensor.0 as usize).is_none() {
-            return Err(EngineError::UnknownSensor(sensor));
-        }
-        self.check_order(sensor, scan.stamp)?;
-        let slot = &mut self.lidars[sensor.0 as usize];
-        slot.model.scan_to_range_data_with(sensor, scan, pose_of_beam, &mut self.scratch, &mut slot.stats.returns);
-        slot.stats.scans += 1;
-        let s = self.grid.insert(&self.scratch);
-        self.stats.measurements += 1;
-        self.stats.insert.add(&s);
-        Ok(s)
+        // NaN limits are "not stated": the model's own limits apply.
+        self.insert_scan_limited(sensor, scan, f32::NAN, f32::NAN, pose_of_beam)
     }
 
     /// Inserts a scan with the sensor's own stated range limits (see
@@ -167,10 +158,7 @@ impl Engine {
         let model = slot.model.limited_to(range_min, range_max);
         model.scan_to_range_data_with(sensor, scan, pose_of_beam, &mut self.scratch, &mut slot.stats.returns);
         slot.stats.scans += 1;
-        let s = self.grid.insert(&self.scratch);
-        self.stats.measurements += 1;
-        self.stats.insert.add(&s);
-        Ok(s)
+        Ok(apply(&mut self.grid, &mut self.stats, &self.scratch))
     }
 
     /// The model registered for `sensor`.
@@ -181,11 +169,16 @@ impl Engine {
     /// Inserts range data a sensor model outside the engine produced.
     pub fn insert_range_data(&mut self, data: &RangeData) -> Result<InsertStats, EngineError> {
         self.check_order(data.sensor, data.stamp)?;
-        let s = self.grid.insert(data);
-        self.stats.measurements += 1;
-        self.stats.insert.add(&s);
-        Ok(s)
+        Ok(apply(&mut self.grid, &mut self.stats, data))
     }
+}
+
+/// Inserts one observation into the grid and counts it.
+fn apply(grid: &mut OccupancyGrid, stats: &mut EngineStats, data: &RangeData) -> InsertStats {
+    let s = grid.insert(data);
+    stats.measurements += 1;
+    stats.insert.add(&s);
+    s
 }
 
 #[cfg(test)]
