@@ -12,6 +12,7 @@ pub mod log;
 pub mod map_server;
 pub mod npz;
 pub mod picture;
+pub mod read_ahead;
 pub mod scanfile;
 pub mod world_file;
 
