@@ -277,8 +277,10 @@ pub fn report(cfg: &LogConfig, path: &Path) -> Result<String> {
                 let skipped = if tr.configured == SyncMode::Interpolate { &tr.interpolate } else { &tr.nearest };
                 let missing = skipped.total();
                 if missing > 0 {
-                    let head =
-                        format!("{:.1} % of scans on {} ({missing} of {})", 100.0 - share(skipped), s.topic, s.scans);
+                    let pct = 100.0 - share(skipped);
+                    // One decimal, or two when that would print a share that is not 0 as 0.0.
+                    let pct = if pct < 0.1 { format!("{pct:.2}") } else { format!("{pct:.1}") };
+                    let head = format!("{pct} % of scans on {} ({missing} of {})", s.topic, s.scans);
                     if let SyncMode::Nearest { tolerance_s } = tr.configured {
                         findings.push(format!(
                             "{head} have no pose within {:.0} ms: raise the tolerance or use interpolation",
