@@ -15,7 +15,7 @@ pub enum LogFormat {
     Ros1Bag,
     /// A bare MCAP file.
     Mcap,
-    /// A rosbag2 directory (MCAP or SQLite storage).
+    /// A rosbag2 directory (MCAP or SQLite storage), or one of its `.db3` files.
     Rosbag2,
 }
 
@@ -52,6 +52,9 @@ pub fn detect(path: &Path) -> Result<LogFormat> {
         Ok(LogFormat::Ros1Bag)
     } else if super::ros2::sniff_mcap(&head) {
         Ok(LogFormat::Mcap)
+    } else if head.starts_with(super::ros2::SQLITE_MAGIC) {
+        // A rosbag2 `.db3` storage file given on its own.
+        Ok(LogFormat::Rosbag2)
     } else if super::carmen::sniff(&head) {
         Ok(LogFormat::Carmen)
     } else if head.is_empty() {
@@ -74,4 +77,29 @@ pub fn open_log(path: &Path) -> Result<OpenedLog> {
         LogFormat::Mcap | LogFormat::Rosbag2 => super::ros2::open_ros2(path)?,
     };
     Ok(OpenedLog { format, reader })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn detect_bytes(name: &str, bytes: &[u8]) -> Result<LogFormat> {
+        let dir = std::env::temp_dir().join(format!("fusemap-detect-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        let r = detect(&p);
+        std::fs::remove_file(&p).unwrap();
+        r
+    }
+
+    #[test]
+    fn formats_are_recognised_by_content_not_name() {
+        assert_eq!(detect_bytes("a.txt", b"#ROSBAG V2.0\n").unwrap(), LogFormat::Ros1Bag);
+        assert_eq!(detect_bytes("a.bag", b"\x89MCAP0\r\n").unwrap(), LogFormat::Mcap);
+        assert_eq!(detect_bytes("a.mcap", b"SQLite format 3\0rest").unwrap(), LogFormat::Rosbag2);
+        assert_eq!(detect_bytes("a.bin", b"ODOM 0 0 0 0 0 0 0 pippo 0\n").unwrap(), LogFormat::Carmen);
+        assert!(detect_bytes("a.log", b"").unwrap_err().to_string().contains("empty"));
+        assert!(detect_bytes("a.log", &[0xde, 0xad, 0xbe, 0xef]).unwrap_err().to_string().contains("not a log"));
+    }
 }
