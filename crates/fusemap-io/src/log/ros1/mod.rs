@@ -42,6 +42,7 @@
 
 mod cursor;
 mod messages;
+mod prefetch;
 mod record;
 #[cfg(test)]
 mod tests;
@@ -81,6 +82,10 @@ pub struct BagReader<R = BufReader<File>> {
     data_buf: Vec<u8>,
     decoder: Decoder,
     finished: bool,
+    /// Compressed chunk records met so far.
+    compressed_chunks: u64,
+    /// The helper decompressing every second compressed chunk ([`BagReader::open`]).
+    prefetch: Option<prefetch::Prefetch>,
 }
 
 /// The decompressed data of the chunk being read and where the next record in it is.
@@ -144,7 +149,9 @@ impl BagReader<BufReader<File>> {
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
-        Self::from_reader(BufReader::with_capacity(1 << 16, file), path)
+        let mut reader = Self::from_reader(BufReader::with_capacity(1 << 16, file), path)?;
+        reader.prefetch = prefetch::Prefetch::spawn(path);
+        Ok(reader)
     }
 }
 
@@ -168,6 +175,8 @@ impl<R: Read> BagReader<R> {
                 stats: ReadStats::default(),
             },
             finished: false,
+            compressed_chunks: 0,
+            prefetch: None,
         };
         reader.read_preamble()?;
         Ok(reader)
@@ -304,7 +313,18 @@ impl<R: Read> BagReader<R> {
                         chunk.clear();
                         return Err(self.truncated_data(&head, got as u64));
                     }
-                    record::decompress(compression, &self.data_buf, size, chunk)
+                    self.compressed_chunks += 1;
+                    let ready = match &mut self.prefetch {
+                        Some(p) if self.compressed_chunks % 2 == 0 => p.take(head.offset),
+                        _ => None,
+                    };
+                    match ready {
+                        Some(data) if data.len() == size as usize => {
+                            *chunk = data;
+                            Ok(())
+                        }
+                        _ => record::decompress(compression, &self.data_buf, size, chunk),
+                    }
                 } else {
                     Err(record::unsupported_compression(compression))
                 }

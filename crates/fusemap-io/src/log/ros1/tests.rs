@@ -942,3 +942,91 @@ fn other_benchmark_bags_match_their_provenance() {
         assert_eq!(s.beams, BTreeMap::from([(beams, scan_count)]), "{file}");
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// The second-core chunk decompression of `open`.
+
+/// Everything `BagReader::open` yields for `bytes` written to a file: messages before
+/// the first error, and the error's text with the file named `test.bag`.
+fn read_file(name: &str, bytes: &[u8]) -> (Vec<LogMessage>, Option<String>) {
+    let dir = std::env::temp_dir().join(format!("fusemap-ros1-prefetch-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    let mut out = (Vec::new(), None);
+    match BagReader::open(&path) {
+        Err(e) => out.1 = Some(e.to_string().replace(&path.display().to_string(), "test.bag")),
+        Ok(mut reader) => {
+            while let Some(m) = reader.next_message() {
+                match m {
+                    Ok(m) => out.0.push(m),
+                    Err(e) => {
+                        out.1 = Some(e.to_string().replace(&path.display().to_string(), "test.bag"));
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    std::fs::remove_file(&path).unwrap();
+    out
+}
+
+fn many_chunks() -> Vec<u8> {
+    let odom = |i: u32| msg(ODOM, (i, 0), odom_payload((i, 0), f64::from(i), 0.0));
+    let mut chunks = vec![(Compression::Bz2, vec![Inner::Conn(ODOM), odom(0)])];
+    for k in 1..9u32 {
+        let c = [Compression::Bz2, Compression::Lz4, Compression::None][(k % 3) as usize];
+        chunks.push((c, (0..5).map(|j| odom(10 * k + j)).collect()));
+    }
+    bag(chunks)
+}
+
+#[test]
+fn open_with_a_second_core_reads_exactly_what_a_stream_reads() {
+    let bytes = many_chunks();
+    let (stream, error, _) = read_bytes(&bytes);
+    assert!(error.is_none(), "{error:?}");
+    let (file, error) = read_file("many.bag", &bytes);
+    assert!(error.is_none(), "{error:?}");
+    assert_eq!(file, stream);
+    assert_eq!(file.len(), 41);
+}
+
+#[test]
+fn open_with_a_second_core_fails_like_a_stream() {
+    // Cut and corrupt the file at many places: `open` must give the same messages and the
+    // same error text as reading the bytes as a stream (the helper only ever saves work).
+    let bytes = many_chunks();
+    let mut rng = Rng(0x5eed);
+    for _ in 0..40 {
+        let at = (rng.next() as usize) % bytes.len();
+        let mut cut = bytes[..at].to_vec();
+        let (stream, stream_err, _) = read_bytes(&cut);
+        let (file, file_err) = read_file("cut.bag", &cut);
+        // Debug text, not `==`: a flipped byte can make a NaN, which equals nothing.
+        assert_eq!(format!("{file:?}"), format!("{stream:?}"), "cut at {at}");
+        assert_eq!(file_err, stream_err.map(|e| e.to_string()), "cut at {at}");
+        cut = bytes.clone();
+        cut[at] ^= 0x5a;
+        let (stream, stream_err, _) = read_bytes(&cut);
+        let (file, file_err) = read_file("flip.bag", &cut);
+        assert_eq!(format!("{file:?}"), format!("{stream:?}"), "flip at {at}");
+        assert_eq!(file_err, stream_err.map(|e| e.to_string()), "flip at {at}");
+    }
+}
+
+#[test]
+fn open_reads_the_intel_bag_exactly_as_a_stream() {
+    let Some(path) = crate::testdata::dataset("rosbag1-slam-benchmark/intel.orig.bag") else { return };
+    let bytes = std::fs::read(&path).unwrap();
+    let (stream, error, _) = read_bytes(&bytes);
+    assert!(error.is_none());
+    let mut reader = BagReader::open(&path).unwrap();
+    let mut n = 0;
+    while let Some(m) = reader.next_message() {
+        assert_eq!(m.unwrap(), stream[n], "message {n}");
+        n += 1;
+    }
+    assert_eq!(n, stream.len());
+}
