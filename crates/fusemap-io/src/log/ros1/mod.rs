@@ -315,7 +315,7 @@ impl<R: Read> BagReader<R> {
                     }
                     self.compressed_chunks += 1;
                     let ready = match &mut self.prefetch {
-                        Some(p) if self.compressed_chunks % 2 == 0 => p.take(head.offset),
+                        Some(p) if self.compressed_chunks.is_multiple_of(2) => p.take(head.offset),
                         _ => None,
                     };
                     match ready {

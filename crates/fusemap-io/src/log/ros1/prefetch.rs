@@ -87,7 +87,7 @@ fn walk(input: &mut BufReader<File>, mut deliver: impl FnMut(u64, Vec<u8>) -> bo
         let ours = match (is_chunk, compression) {
             (true, Some(c)) if c == b"bz2" || c == b"lz4" => {
                 compressed += 1;
-                compressed % 2 == 0
+                compressed.is_multiple_of(2)
             }
             _ => false,
         };
