@@ -6,4 +6,5 @@ mod demo;
 mod doctor;
 mod formats;
 mod real_logs;
+mod sync;
 mod util;
