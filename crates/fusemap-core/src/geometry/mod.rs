@@ -3,7 +3,7 @@
 //! Names say which frame a value lives in and which way a transform maps:
 //! `world_from_base * point_in_base == point_in_world` (the convention of rerun and Drake).
 //! The grid is 2D, so the pipeline works in SE(2); a sensor's full 3D mounting pose is
-//! reduced to the planar transform once, in [`mount`].
+//! reduced to the planar transform once, by [`Mount3::to_planar`].
 
 mod mount;
 mod pose2;
