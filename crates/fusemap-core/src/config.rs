@@ -436,10 +436,7 @@ mod tests {
         c.log.scan_topic = " ".into();
         assert_eq!(field_of(c), "log.scan_topic");
         let mut c = Config::default();
-        c.log.max_pose_gap_s = 0.0;
-        assert_eq!(field_of(c), "log.max_pose_gap_s");
-        let mut c = Config::default();
-        c.log.scan_topic = " ".into();
-        assert_eq!(field_of(c), "log.scan_topic");
+        c.log.gap_bridge_motion_m = -1.0;
+        assert_eq!(field_of(c), "log.gap_bridge_motion_m");
     }
 }

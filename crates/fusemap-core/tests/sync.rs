@@ -5,7 +5,7 @@
 //! function; odometry samples it exactly. Walls are drawn from scans posed three ways and
 //! their thickness is measured as the mean distance of occupied cells from the true walls.
 
-use fusemap_core::geometry::{PlanarMount, Point2, Pose2};
+use fusemap_core::geometry::{PlanarMount, Pose2};
 use fusemap_core::grid::{CellIndex, GridGeometry, OccupancyGrid, OccupancyParams, Ternary};
 use fusemap_core::sensor::{LaserScan, LidarModel, LidarParams};
 use fusemap_core::sim::{box_world, simulate_moving_scan, simulate_scan, BoxWorld, ScannerSpec};
@@ -36,20 +36,12 @@ fn wall_spread(g: &OccupancyGrid, w: &BoxWorld) -> (f64, usize) {
             let c = CellIndex::new(x, y);
             if g.ternary(c) == Ternary::Occupied {
                 let p = g.geometry().cell_center(c);
-                let d =
-                    w.world.segments.iter().map(|s| point_segment_distance(p, s.a, s.b)).fold(f64::INFINITY, f64::min);
-                sum += d / res;
+                sum += w.world.distance_to_walls(p) / res;
                 n += 1;
             }
         }
     }
     (sum / n as f64, n)
-}
-
-fn point_segment_distance(p: Point2, a: Point2, b: Point2) -> f64 {
-    let (dx, dy) = (b.x - a.x, b.y - a.y);
-    let t = (((p.x - a.x) * dx + (p.y - a.y) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
-    p.distance(Point2::new(a.x + t * dx, a.y + t * dy))
 }
 
 fn engine() -> (Engine, SensorId) {

@@ -87,19 +87,12 @@ fn wall_spread(out: &Path, w: &BoxWorld) -> (f64, usize) {
         for col in 0..wd {
             if occ[row * wd + col] > 0.65 {
                 let p = Point2::new(origin[0] + (col as f64 + 0.5) * res, origin[1] + (row as f64 + 0.5) * res);
-                let d = w.world.segments.iter().map(|s| distance(p, s.a, s.b)).fold(f64::INFINITY, f64::min);
-                sum += d / res;
+                sum += w.world.distance_to_walls(p) / res;
                 n += 1;
             }
         }
     }
     (sum / n as f64, n)
-}
-
-fn distance(p: Point2, a: Point2, b: Point2) -> f64 {
-    let (dx, dy) = (b.x - a.x, b.y - a.y);
-    let t = (((p.x - a.x) * dx + (p.y - a.y) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
-    p.distance(Point2::new(a.x + t * dx, a.y + t * dy))
 }
 
 #[test]

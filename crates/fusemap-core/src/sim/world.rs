@@ -36,6 +36,16 @@ impl Segment {
     }
 }
 
+impl Segment {
+    /// Euclidean distance from `p` to the nearest point of the segment.
+    pub fn distance_to(&self, p: Point2) -> f64 {
+        let (dx, dy) = (self.b.x - self.a.x, self.b.y - self.a.y);
+        let len2 = dx * dx + dy * dy;
+        let t = if len2 > 0.0 { (((p.x - self.a.x) * dx + (p.y - self.a.y) * dy) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        p.distance(Point2::new(self.a.x + t * dx, self.a.y + t * dy))
+    }
+}
+
 /// A world of wall segments.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct World {
@@ -44,6 +54,12 @@ pub struct World {
 }
 
 impl World {
+    /// Distance from `p` to the nearest wall (infinite for a world without walls): the
+    /// ground truth that simulated runs measure their maps against.
+    pub fn distance_to_walls(&self, p: Point2) -> f64 {
+        self.segments.iter().map(|s| s.distance_to(p)).fold(f64::INFINITY, f64::min)
+    }
+
     /// Distance to the nearest wall along the ray, `None` when no wall is hit.
     pub fn cast(&self, origin: Point2, angle: f64) -> Option<f64> {
         let (s, c) = angle.sin_cos();
@@ -135,6 +151,17 @@ mod tests {
         assert!((w.cast(o, FRAC_PI_4).unwrap() - 2.0 * 2f64.sqrt()).abs() < 1e-12);
         // Looking back down the corridor, the side walls end at x = -20.
         assert!(w.cast(o, std::f64::consts::PI).is_none());
+    }
+
+    #[test]
+    fn distances_to_walls() {
+        let w = corridor();
+        assert!((w.distance_to_walls(Point2::new(1.0, 0.5)) - 1.5).abs() < 1e-12);
+        assert!((w.distance_to_walls(Point2::new(5.0, 3.0)) - 2f64.sqrt()).abs() < 1e-12);
+        assert!((w.distance_to_walls(Point2::new(3.5, 0.0)) - 0.5).abs() < 1e-12);
+        let dot = Segment::new(1.0, 1.0, 1.0, 1.0);
+        assert!((dot.distance_to(Point2::new(4.0, 5.0)) - 5.0).abs() < 1e-12);
+        assert_eq!(World::default().distance_to_walls(Point2::default()), f64::INFINITY);
     }
 
     #[test]
