@@ -191,13 +191,7 @@ mod tests {
     use std::io::Write;
 
     fn temp_dir(tag: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!(
-            "fusemap-atomic-{tag}-{}-{}",
-            std::process::id(),
-            TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
-        ));
-        std::fs::create_dir_all(&d).unwrap();
-        d
+        crate::testdata::temp_dir(&format!("atomic-{tag}"))
     }
 
     fn entries(d: &Path) -> Vec<String> {

@@ -475,14 +475,7 @@ mod tests {
     use fusemap_core::grid::{logodds::logit, CellIndex, OccupancyParams};
 
     fn temp_dir(tag: &str) -> PathBuf {
-        static N: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-        let d = std::env::temp_dir().join(format!(
-            "fusemap-mapserver-{tag}-{}-{}",
-            std::process::id(),
-            N.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
-        ));
-        std::fs::create_dir_all(&d).unwrap();
-        d
+        crate::testdata::temp_dir(&format!("mapserver-{tag}"))
     }
 
     /// 3 columns × 2 rows. Row 0 (lowest y): occupied, free, unknown (never seen).
