@@ -37,6 +37,12 @@ pub fn parse_config_str(text: &str, path: &Path) -> Result<Config> {
     if let Some(n) = array_len(text, "map.origin").filter(|&n| n != 2) {
         return Err(field_error(path, text, "map.origin", format!("expected [x, y], got {n} numbers")));
     }
+    for i in 0..config.sensor.len() {
+        let field = format!("sensor[{i}].datum");
+        if let Some(n) = array_len(text, &field).filter(|&n| n != 3) {
+            return Err(field_error(path, text, &field, format!("expected [latitude, longitude, altitude], got {n} numbers")));
+        }
+    }
     config.validate().map_err(|e| field_error(path, text, &e.field, e.message))?;
     Ok(config)
 }
@@ -175,28 +181,36 @@ mod tests {
     #[test]
     fn values_are_read() {
         let c = parse(
-            "[map]\nresolution = 0.1\norigin = [-5, -5.0]\n\n[[lidar]]\nname = \"front\"\np_occ = 0.8\n\
-             max_range_policy = \"clear\"\n[lidar.mount]\nx = 0.2\n\n[[lidar]]\nname = \"rear\"\n",
+            "[map]\nresolution = 0.1\norigin = [-5, -5.0]\n\n[[sensor]]\nkind = \"lidar\"\nname = \"front\"\np_occ = 0.8\n\
+             max_range_policy = \"clear\"\n[sensor.base_from_sensor]\nx = 0.2\n\n[[sensor]]\nkind = \"lidar\"\n\
+             name = \"rear\"\n\n[[sensor]]\nkind = \"gnss\"\ndatum = [48.1, 11.5, 520.0]\n",
         )
         .unwrap();
         assert_eq!(c.map.resolution, 0.1);
         assert_eq!(c.map.origin, Some([-5.0, -5.0]));
-        assert_eq!(c.lidar.len(), 2);
-        assert_eq!(c.lidar[0].p_occ, 0.8);
-        assert_eq!(c.lidar[0].mount.x, 0.2);
-        assert_eq!(c.lidar[1].name, "rear");
-        assert_eq!(c.lidar[1].p_occ, 0.9);
+        assert_eq!(c.sensor.len(), 3);
+        assert_eq!(c.sensor[0].p_occ, Some(0.8));
+        assert_eq!(c.sensor[0].base_from_sensor.map(|m| m.x), Some(0.2));
+        assert_eq!(c.sensor[1].name.as_deref(), Some("rear"));
+        assert_eq!(c.sensor[1].p_occ, None);
+        assert_eq!(c.sensor[2].datum, Some([48.1, 11.5, 520.0]));
+        let plan = c.validate().unwrap();
+        assert_eq!(plan.lidars.len(), 2);
+        assert_eq!(plan.lidars[1].model.params().p_occ, 0.9);
     }
 
     #[test]
     fn unknown_key_names_key_and_line() {
-        let e = parse("[map]\nresolution = 0.05\n\n[[lidar]]\np_ocupied = 0.9\n").unwrap_err();
+        let e = parse("[map]\nresolution = 0.05\n\n[[sensor]]\nkind = \"lidar\"\np_ocupied = 0.9\n").unwrap_err();
         let text = e.to_string();
         let (loc, msg) = location(e);
-        assert_eq!(loc, Location::Line(5), "{text}");
+        assert_eq!(loc, Location::Line(6), "{text}");
         assert!(msg.contains("p_ocupied"), "{msg}");
         assert!(!msg.contains('\n'), "{msg}");
-        assert!(text.starts_with("robot.toml:5: "), "{text}");
+        assert!(text.starts_with("robot.toml:6: "), "{text}");
+        // The tables of the old layout are refused, not ignored.
+        let e = parse("[[lidar]]\nname = \"laser\"\n").unwrap_err();
+        assert!(e.to_string().contains("lidar"), "{e}");
         let e = parse("colour = 1\n").unwrap_err();
         assert_eq!(location(e).0, Location::Line(1));
     }
@@ -207,9 +221,9 @@ mod tests {
         let (loc, msg) = location(e);
         assert_eq!(loc, Location::Line(3), "{msg}");
         assert!(!msg.contains('\n'), "{msg}");
-        let e = parse("[[lidar]]\nmax_range_policy = \"sometimes\"\n").unwrap_err();
+        let e = parse("[[sensor]]\nkind = \"lidar\"\nmax_range_policy = \"sometimes\"\n").unwrap_err();
         let (loc, msg) = location(e);
-        assert_eq!(loc, Location::Line(2), "{msg}");
+        assert_eq!(loc, Location::Line(3), "{msg}");
         assert!(msg.contains("sometimes"), "{msg}");
     }
 
@@ -227,26 +241,32 @@ mod tests {
 
     #[test]
     fn validation_names_field_and_line() {
-        let e = parse("[map]\nprior = 0.5\n\n[[lidar]]\nname = \"laser\"\np_occ = 0.3\n").unwrap_err();
+        let e = parse("[map]\nprior = 0.5\n\n[[sensor]]\nkind = \"lidar\"\np_occ = 0.3\n").unwrap_err();
         let text = e.to_string();
         let (loc, msg) = location(e);
-        assert_eq!(loc, Location::LineField(6, "lidar[0].p_occ".into()));
+        assert_eq!(loc, Location::LineField(6, "sensor[0].p_occ".into()));
         assert!(msg.contains("0.3"), "{msg}");
-        assert!(text.contains("lidar[0].p_occ"), "{text}");
+        assert!(text.contains("sensor[0].p_occ"), "{text}");
         // NaN is valid TOML but not a valid probability.
         let e = parse("[map]\nprior = nan\n").unwrap_err();
         assert_eq!(location(e).0, Location::LineField(2, "map.prior".into()));
         // A field left at its default has no line: the prior makes the default p_free wrong.
-        let e = parse("[map]\nprior = 0.3\nclamp_min = 0.1\n").unwrap_err();
-        assert_eq!(location(e).0, Location::Field("lidar[0].p_free".into()));
+        let e = parse("[map]\nprior = 0.3\nclamp_min = 0.1\n\n[[sensor]]\nkind = \"lidar\"\n").unwrap_err();
+        assert_eq!(location(e).0, Location::Field("sensor[0].p_free".into()));
         // A whole table.
         let e = parse("[map]\nclamp_max = 0.4\n").unwrap_err();
         assert_eq!(location(e).0, Location::LineField(1, "map".into()));
         let e = parse("[map]\norigin = [1.0, 2.0, 0.5]\n").unwrap_err();
         assert_eq!(location(e).0, Location::LineField(2, "map.origin".into()));
         assert!(parse("[map]\norigin = [1.0]\n").is_err());
-        let e = parse("[[lidar]]\nname = \"a\"\n[[lidar]]\nname = \"a\"\n").unwrap_err();
-        assert_eq!(location(e).0, Location::LineField(4, "lidar[1].name".into()));
+        let e = parse("[[sensor]]\nkind = \"imu\"\nname = \"a\"\n[[sensor]]\nkind = \"lidar\"\nname = \"a\"\n").unwrap_err();
+        assert_eq!(location(e).0, Location::LineField(6, "sensor[1].name".into()));
+        let e = parse("[[sensor]]\nkind = \"imu\"\np_occ = 0.7\n").unwrap_err();
+        assert_eq!(location(e).0, Location::LineField(3, "sensor[0].p_occ".into()));
+        let e = parse("[[sensor]]\nkind = \"gnss\"\ndatum = [48.1, 11.5]\n").unwrap_err();
+        assert_eq!(location(e).0, Location::Line(3));
+        let e = parse("[[sensor]]\nkind = \"gnss\"\ndatum = [48.1, 11.5, 500, 1]\n").unwrap_err();
+        assert_eq!(location(e).0, Location::LineField(3, "sensor[0].datum".into()));
     }
 
     #[test]
@@ -268,7 +288,14 @@ mod tests {
     fn example_file_is_the_default() {
         let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/example.toml");
         let c = load_config(&p).unwrap();
-        assert_eq!(c, Config::default());
+        let d = Config::default();
+        assert_eq!((c.map, &c.log), (d.map, &d.log));
+        // Its one sensor table is the default lidar, written out.
+        assert_eq!(c.sensor.len(), 1);
+        let (plan, default) = (c.validate().unwrap(), d.validate().unwrap());
+        assert_eq!(plan.lidars[0].name, default.lidars[0].name);
+        assert_eq!(plan.lidars[0].model.params(), default.lidars[0].model.params());
+        assert_eq!(plan.lidars[0].topic, None);
         // Every line that sets a value carries its own comment block above it: no bare keys.
         let text = std::fs::read_to_string(&p).unwrap();
         let lines: Vec<&str> = text.lines().collect();
@@ -282,12 +309,12 @@ mod tests {
 
     #[test]
     fn field_paths() {
-        let text = "[map]\nprior = 0.5\n\n[[lidar]]\nname = \"a\"\n[lidar.mount]\nyaw = 1\n[[lidar]]\nname = \"b\"\n";
+        let text = "[map]\nprior = 0.5\n\n[[sensor]]\nname = \"a\"\n[sensor.base_from_sensor]\nyaw = 1\n[[sensor]]\nname = \"b\"\n";
         assert_eq!(field_line(text, "map.prior"), Some(2));
-        assert_eq!(field_line(text, "lidar[0].name"), Some(5));
-        assert_eq!(field_line(text, "lidar[0].mount.yaw"), Some(7));
-        assert_eq!(field_line(text, "lidar[1].name"), Some(9));
-        assert_eq!(field_line(text, "lidar[2].name"), None);
+        assert_eq!(field_line(text, "sensor[0].name"), Some(5));
+        assert_eq!(field_line(text, "sensor[0].base_from_sensor.yaw"), Some(7));
+        assert_eq!(field_line(text, "sensor[1].name"), Some(9));
+        assert_eq!(field_line(text, "sensor[2].name"), None);
         assert_eq!(field_line(text, "map.resolution"), None);
         assert_eq!(field_line(text, "map[0]"), None);
         assert_eq!(split_indices("a[1][2]"), Some(("a", vec![1, 2])));

@@ -1,28 +1,16 @@
 //! `fusemap demo` and `fusemap map`: build a map and write its outputs.
 
-use crate::output;
-use crate::summary::{CellsUpdated, MapInfo, Summary};
+use crate::output::{self, finish};
+use crate::progress;
+use crate::summary::Summary;
 use anyhow::{bail, Result};
 use fusemap_core::config::{Config, Plan};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::grid::OccupancyGrid;
-use fusemap_core::metrics::map_entropy;
-use fusemap_core::sensor::ReturnCounts;
 use fusemap_core::sim::{ScannerSpec, SimulatedRun, World};
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// A progress bar on stderr; indicatif draws nothing when stderr is not a terminal.
-pub fn progress(len: u64, what: &str) -> ProgressBar {
-    let pb = ProgressBar::new(len);
-    if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {per_sec} eta {eta}") {
-        pb.set_style(style.progress_chars("=> "));
-    }
-    pb.set_message(what.to_string());
-    pb
-}
 
 /// An engine with the plan's grid and lidars.
 pub fn engine_for(plan: &Plan) -> Engine {
@@ -31,51 +19,6 @@ pub fn engine_for(plan: &Plan) -> Engine {
         engine.add_lidar(l.name.clone(), l.model);
     }
     engine
-}
-
-/// Builds the summary of a finished engine and writes every output.
-pub fn finish(
-    engine: &Engine,
-    files: &output::OutputFiles,
-    source_kind: &str,
-    source: &str,
-    started: Instant,
-    notes: Vec<String>,
-    log: Option<serde_json::Value>,
-) -> Result<Summary> {
-    let grid = engine.grid();
-    let raster = grid.known_raster();
-    let st = engine.stats();
-    let mut returns = ReturnCounts::default();
-    let mut scans = 0;
-    for s in engine.sensor_stats() {
-        returns.add(&s.returns);
-        scans += s.scans;
-    }
-    let mut summary = Summary {
-        fusemap_version: env!("CARGO_PKG_VERSION"),
-        source_kind: source_kind.to_string(),
-        source: source.to_string(),
-        scans,
-        beams: returns.total(),
-        returns,
-        rays_walked: st.insert.rays,
-        rays_rejected: st.insert.rays_rejected,
-        cell_visits: st.insert.cell_visits,
-        cells_updated: CellsUpdated::from(&st.insert),
-        map: MapInfo::new(raster.as_ref(), grid.geometry().resolution(), grid.tile_count()),
-        entropy: raster.as_ref().map(map_entropy),
-        wall_time_s: 0.0,
-        notes,
-        log,
-    };
-    if raster.is_none() {
-        summary.notes.push("no cell was observed: only summary.json was written".into());
-    }
-    summary.wall_time_s = started.elapsed().as_secs_f64();
-    output::write(files, raster.as_ref(), &summary)?;
-    summary.wall_time_s = started.elapsed().as_secs_f64();
-    Ok(summary)
 }
 
 /// Maps a simulated run of `world` with `scanner` along `poses`.
@@ -92,7 +35,7 @@ pub fn run_simulated(
     let files = output::prepare(out, inputs)?;
     let mut engine = engine_for(plan);
     let ids: Vec<_> = (0..plan.lidars.len() as u16).map(fusemap_core::measurement::SensorId).collect();
-    let pb = progress(poses.len() as u64, "mapping");
+    let pb = progress::bar(poses.len() as u64, "mapping");
     for (i, pose) in poses.iter().enumerate() {
         for (k, id) in ids.iter().enumerate() {
             let mount = plan.lidars[k].model.mount();
@@ -103,7 +46,7 @@ pub fn run_simulated(
         pb.inc(1);
     }
     pb.finish_and_clear();
-    finish(&engine, &files, "world", source, started, Vec::new(), None)
+    finish(&engine, &files, "world", source, started, Vec::new(), None, None)
 }
 
 /// `fusemap demo --out DIR`: the design document's corridor with the default config.
@@ -145,7 +88,7 @@ pub fn map(config: Option<&Path>, world: Option<&Path>, log: Option<&Path>, out:
         }
         (None, Some(l)) => {
             inputs.push(l.to_path_buf());
-            crate::commands::log_map::run(&plan, config.is_some(), l, out, &inputs)?
+            run_log(&plan, l, out, &inputs)?
         }
         (Some(_), Some(_)) => bail!("give either --world FILE or a LOG, not both"),
         (None, None) => {
@@ -155,4 +98,23 @@ pub fn map(config: Option<&Path>, world: Option<&Path>, log: Option<&Path>, out:
     summary.print();
     println!("outputs       {}", out.display());
     Ok(())
+}
+
+/// Maps a robot log through the pipeline and writes the outputs.
+fn run_log(plan: &Plan, path: &Path, out: &Path, inputs: &[PathBuf]) -> Result<Summary> {
+    let started = Instant::now();
+    let files = output::prepare(out, inputs)?;
+    // fusemap-io errors already name the file (and the line or message): no context.
+    let run = fusemap_pipeline::map_log(plan, path, &mut progress::reporter())?;
+    let value = serde_json::to_value(&run.report)?;
+    finish(
+        &run.engine,
+        &files,
+        &run.format.to_string(),
+        &path.display().to_string(),
+        started,
+        run.notes,
+        Some(value),
+        Some(&run.trajectory),
+    )
 }

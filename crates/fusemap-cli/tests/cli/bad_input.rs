@@ -65,20 +65,20 @@ fn config_wrong_type() {
 
 #[test]
 fn config_p_occ_below_the_prior() {
-    let (p, line) = config_error("p-occ", "[map]\nprior = 0.5\n\n[[lidar]]\np_occ = 0.3\n");
-    assert_names(&line, &[&format!("{p}:5:"), "lidar[0].p_occ", "prior"]);
+    let (p, line) = config_error("p-occ", "[map]\nprior = 0.5\n\n[[sensor]]\nkind = \"lidar\"\np_occ = 0.3\n");
+    assert_names(&line, &[&format!("{p}:6:"), "sensor[0].p_occ", "prior"]);
 }
 
 #[test]
 fn config_p_free_above_the_prior() {
-    let (p, line) = config_error("p-free", "[[lidar]]\np_occ = 0.9\np_free = 0.6\n");
-    assert_names(&line, &[&format!("{p}:3:"), "lidar[0].p_free", "prior"]);
+    let (p, line) = config_error("p-free", "[[sensor]]\nkind = \"lidar\"\np_occ = 0.9\np_free = 0.6\n");
+    assert_names(&line, &[&format!("{p}:4:"), "sensor[0].p_free", "prior"]);
 }
 
 #[test]
 fn config_min_range_not_below_max_range() {
-    let (p, line) = config_error("ranges", "[[lidar]]\nmin_range = 5.0\nmax_range = 5.0\n");
-    assert_names(&line, &[&format!("{p}:3:"), "lidar[0].max_range", "min_range"]);
+    let (p, line) = config_error("ranges", "[[sensor]]\nkind = \"lidar\"\nmin_range = 5.0\nmax_range = 5.0\n");
+    assert_names(&line, &[&format!("{p}:4:"), "sensor[0].max_range", "min_range"]);
 }
 
 #[test]
@@ -93,8 +93,8 @@ fn config_resolution_zero_or_negative() {
 fn config_nan_probability() {
     let (p, line) = config_error("nan-prior", "[map]\nprior = nan\n");
     assert_names(&line, &[&format!("{p}:2:"), "map.prior", "finite"]);
-    let (p, line) = config_error("nan-p-occ", "[[lidar]]\np_occ = nan\n");
-    assert_names(&line, &[&format!("{p}:2:"), "lidar[0].p_occ", "finite"]);
+    let (p, line) = config_error("nan-p-occ", "[[sensor]]\nkind = \"lidar\"\np_occ = nan\n");
+    assert_names(&line, &[&format!("{p}:3:"), "sensor[0].p_occ", "finite"]);
 }
 
 #[test]
@@ -106,8 +106,8 @@ fn config_clamp_min_not_below_the_prior() {
 
 #[test]
 fn config_tilted_mount() {
-    let (p, line) = config_error("tilt", "[[lidar]]\nname = \"laser\"\n\n[lidar.mount]\npitch = 0.5\n");
-    assert_names(&line, &[&p, "lidar[0].mount", "tilted"]);
+    let (p, line) = config_error("tilt", "[[sensor]]\nkind = \"lidar\"\nname = \"laser\"\n\n[sensor.base_from_sensor]\npitch = 0.5\n");
+    assert_names(&line, &[&p, "sensor[0].base_from_sensor", "tilted"]);
 }
 
 #[test]

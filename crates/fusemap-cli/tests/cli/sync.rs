@@ -106,7 +106,7 @@ fn nearest_neighbour_sync_thickens_walls_through_the_cli() {
             &dir,
             &format!("{sync}.toml"),
             format!(
-                "[[lidar]]\nmax_range = 20.0\n\n[log]\npose_source = \"odometry\"\nsync = \"{sync}\"\nnearest_tolerance_s = 0.05\n"
+                "[[sensor]]\nkind = \"lidar\"\nmax_range = 20.0\n\n[log]\npose_source = \"odometry\"\nsync = \"{sync}\"\nnearest_tolerance_s = 0.05\n"
             ),
         );
         let out = dir.join(sync);
@@ -146,7 +146,7 @@ fn de_skew_thins_walls_through_the_cli() {
         let cfg = write_file(
             &dir,
             &format!("deskew-{deskew}.toml"),
-            format!("[[lidar]]\nmax_range = 20.0\n\n[log]\ndeskew = {deskew}\n"),
+            format!("[[sensor]]\nkind = \"lidar\"\nmax_range = 20.0\n\n[log]\ndeskew = {deskew}\n"),
         );
         let out = dir.join(format!("deskew-{deskew}"));
         let o =

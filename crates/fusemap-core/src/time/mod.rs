@@ -4,7 +4,9 @@
 mod pose_buffer;
 mod stamp;
 mod timing;
+mod track;
 
 pub use pose_buffer::{NoPose, PoseBuffer, PushOutcome, SyncMode};
 pub use stamp::Stamp;
 pub use timing::{DelayStats, StreamTiming, TimingLimits};
+pub use track::{Covariance3, InFrame, PoseTrack};

@@ -6,9 +6,14 @@
 //! misspelt `p_ocupied` is an error and not a silently ignored line. Every validation
 //! error names the field, in the path form the TOML file uses (`lidar[0].p_occ`).
 
-use crate::geometry::{Mount3, PlanarMount, Point2};
+mod sensor;
+
+pub use sensor::{
+    auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind,
+};
+
+use crate::geometry::Point2;
 use crate::grid::{GridGeometry, OccupancyParams};
-use crate::sensor::{LidarModel, LidarParams, MaxRangePolicy};
 use serde::{Deserialize, Serialize};
 
 /// The whole configuration.
@@ -18,9 +23,9 @@ pub struct Config {
     /// The map.
     #[serde(default)]
     pub map: MapConfig,
-    /// The lidars (one table per sensor: `[[lidar]]`).
-    #[serde(default = "default_lidars")]
-    pub lidar: Vec<LidarConfig>,
+    /// The sensors, one `[[sensor]]` table each.
+    #[serde(default)]
+    pub sensor: Vec<SensorConfig>,
     /// How robot logs are read: topics, pose source, time synchronisation.
     #[serde(default)]
     pub log: LogConfig,
@@ -28,7 +33,7 @@ pub struct Config {
 
 impl Default for Config {
     fn default() -> Self {
-        Self { map: MapConfig::default(), lidar: default_lidars(), log: LogConfig::default() }
+        Self { map: MapConfig::default(), sensor: Vec::new(), log: LogConfig::default() }
     }
 }
 
@@ -36,8 +41,9 @@ impl Default for Config {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PoseSource {
-    /// The pose written on the scan line if the log has one (CARMEN), else the odometry
-    /// topic, else TF to the base frame.
+    /// The pose written on the scan line if the log has one (CARMEN), else the estimator
+    /// when the log has an IMU, GNSS or poses, else the odometry topic, else TF to the base
+    /// frame.
     #[default]
     Auto,
     /// The pose on each scan line (CARMEN corrected logs).
@@ -46,6 +52,10 @@ pub enum PoseSource {
     Odometry,
     /// Dynamic TF transforms to the base frame, interpolated at each scan's stamp.
     Tf,
+    /// The pose estimator: wheel odometry, IMU, GNSS and absolute poses fused by an
+    /// extended Kalman filter and smoothed over the whole log (`auto` picks it when the log
+    /// carries an IMU, GNSS or poses).
+    Estimator,
 }
 
 /// How the pose at a scan's stamp is found.
@@ -76,11 +86,6 @@ pub enum ExtrinsicsSource {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LogConfig {
-    /// The LaserScan topic (ROS logs). If absent from the log and the log has exactly one
-    /// scan topic, that one is used.
-    pub scan_topic: String,
-    /// The odometry topic (ROS logs).
-    pub odom_topic: String,
     /// The robot's base frame.
     pub base_frame: String,
     /// Where scan poses come from.
@@ -106,13 +111,15 @@ pub struct LogConfig {
     pub extrinsics_tolerance_deg: f64,
     /// A header stamp further than this from its receive time is reported, seconds.
     pub far_delay_s: f64,
+    /// How far (seconds of header stamp) the time-ordered merge of the log's streams waits
+    /// for a late message before releasing a later one: messages that arrive later than
+    /// this behind their stream are counted and dropped. Bounds the memory of a run.
+    pub reorder_window_s: f64,
 }
 
 impl Default for LogConfig {
     fn default() -> Self {
         Self {
-            scan_topic: "/scan".into(),
-            odom_topic: "/odom".into(),
             base_frame: "base_link".into(),
             pose_source: PoseSource::Auto,
             sync: SyncConfig::Interpolate,
@@ -125,12 +132,9 @@ impl Default for LogConfig {
             extrinsics_tolerance_m: 0.02,
             extrinsics_tolerance_deg: 1.0,
             far_delay_s: 1.0,
+            reorder_window_s: 2.0,
         }
     }
-}
-
-fn default_lidars() -> Vec<LidarConfig> {
-    vec![LidarConfig::default()]
 }
 
 /// The map's geometry and probabilities.
@@ -169,44 +173,6 @@ impl Default for MapConfig {
     }
 }
 
-/// One lidar: its inverse model and its mount.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct LidarConfig {
-    /// Name (the frame id of its messages).
-    pub name: String,
-    /// Occupancy probability of a beam's end cell.
-    pub p_occ: f64,
-    /// Occupancy probability of a crossed cell.
-    pub p_free: f64,
-    /// Shortest valid range, metres.
-    pub min_range: f64,
-    /// Longest valid range, metres (exclusive).
-    pub max_range: f64,
-    /// `skip` or `clear`.
-    pub max_range_policy: MaxRangePolicy,
-    /// Largest tilt of the scan plane from horizontal accepted, degrees.
-    pub max_tilt_deg: f64,
-    /// `base_from_sensor`.
-    pub mount: Mount3,
-}
-
-impl Default for LidarConfig {
-    fn default() -> Self {
-        let p = LidarParams::default();
-        Self {
-            name: "laser".into(),
-            p_occ: p.p_occ,
-            p_free: p.p_free,
-            min_range: p.min_range,
-            max_range: p.max_range,
-            max_range_policy: p.max_range_policy,
-            max_tilt_deg: 2.0,
-            mount: Mount3::default(),
-        }
-    }
-}
-
 /// A configuration error, naming the field.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("{field}: {message}")]
@@ -238,19 +204,6 @@ fn probability(field: &str, v: f64) -> Result<f64, ConfigError> {
     }
 }
 
-/// One validated lidar.
-#[derive(Clone, Debug)]
-pub struct PlannedLidar {
-    /// Name (frame id).
-    pub name: String,
-    /// The inverse model with the planar mount.
-    pub model: LidarModel,
-    /// The mount as configured (3D).
-    pub mount: Mount3,
-    /// Largest accepted scan-plane tilt, radians.
-    pub max_tilt: f64,
-}
-
 /// A validated configuration, ready to build a map and sensor models.
 #[derive(Clone, Debug)]
 pub struct Plan {
@@ -258,8 +211,15 @@ pub struct Plan {
     pub geometry: GridGeometry,
     /// The grid's probabilities.
     pub occupancy: OccupancyParams,
-    /// Each lidar: name, model and the 3D mount it was reduced from.
+    /// Each enabled lidar: name, model, the 3D mount it was reduced from, its topic.
+    /// Without any `[[sensor]]` of kind lidar, one default lidar whose topic is found in
+    /// the log; with every listed lidar disabled, none (a log run then refuses).
     pub lidars: Vec<PlannedLidar>,
+    /// The enabled sensors that are not lidars, as configured (kinds not listed are
+    /// auto-detected by the log pipeline with [`auto_sensor`]).
+    pub sensors: Vec<PlannedSensor>,
+    /// Kinds listed only with `enabled = false`: not auto-detected either.
+    pub disabled_kinds: Vec<SensorKind>,
     /// How logs are read.
     pub log: LogConfig,
 }
@@ -300,48 +260,10 @@ impl Config {
             free_threshold: free_t,
         };
 
-        if self.lidar.is_empty() {
-            return Err(err("lidar", "at least one [[lidar]] table is needed"));
-        }
-        let mut lidars = Vec::new();
-        for (i, l) in self.lidar.iter().enumerate() {
-            let f = |name: &str| format!("lidar[{i}].{name}");
-            if l.name.trim().is_empty() {
-                return Err(err(f("name"), "must not be empty"));
-            }
-            if self.lidar[..i].iter().any(|o| o.name == l.name) {
-                return Err(err(f("name"), format!("`{}` is used by two lidars", l.name)));
-            }
-            let p_occ = probability(&f("p_occ"), l.p_occ)?;
-            let p_free = probability(&f("p_free"), l.p_free)?;
-            if p_occ <= prior {
-                return Err(err(f("p_occ"), format!("must be above the prior {prior}, got {p_occ}")));
-            }
-            if p_free >= prior {
-                return Err(err(f("p_free"), format!("must be below the prior {prior}, got {p_free}")));
-            }
-            let min_r = finite(&f("min_range"), l.min_range)?;
-            let max_r = finite(&f("max_range"), l.max_range)?;
-            if min_r < 0.0 {
-                return Err(err(f("min_range"), format!("must be >= 0, got {min_r}")));
-            }
-            if min_r >= max_r {
-                return Err(err(f("max_range"), format!("must be above min_range ({min_r}), got {max_r}")));
-            }
-            let tilt = finite(&f("max_tilt_deg"), l.max_tilt_deg)?;
-            if !(0.0..=90.0).contains(&tilt) {
-                return Err(err(f("max_tilt_deg"), format!("must be within [0, 90] degrees, got {tilt}")));
-            }
-            let mount: PlanarMount =
-                l.mount.to_planar(tilt.to_radians()).map_err(|e| err(f("mount"), e.to_string()))?;
-            let params =
-                LidarParams { p_occ, p_free, min_range: min_r, max_range: max_r, max_range_policy: l.max_range_policy };
-            lidars.push(PlannedLidar {
-                name: l.name.clone(),
-                model: LidarModel::new(params, mount),
-                mount: l.mount,
-                max_tilt: tilt.to_radians(),
-            });
+        let (mut lidars, sensors) = sensor::plan_sensors(&self.sensor, prior)?;
+        let lidar_listed = self.sensor.iter().any(|s| s.kind == SensorKind::Lidar);
+        if lidars.is_empty() && !lidar_listed {
+            lidars.push(sensor::default_lidar());
         }
         let g = &self.log;
         finite("log.nearest_tolerance_s", g.nearest_tolerance_s)?;
@@ -365,20 +287,47 @@ impl Config {
                 return Err(err(name, format!("must be > 0, got {v}")));
             }
         }
-        for (name, v) in
-            [("log.scan_topic", &g.scan_topic), ("log.odom_topic", &g.odom_topic), ("log.base_frame", &g.base_frame)]
-        {
-            if v.trim().is_empty() {
-                return Err(err(name, "must not be empty"));
-            }
+        if !(finite("log.reorder_window_s", g.reorder_window_s)? >= 0.0) {
+            return Err(err("log.reorder_window_s", format!("must be >= 0, got {}", g.reorder_window_s)));
         }
-        Ok(Plan { geometry, occupancy, lidars, log: g.clone() })
+        if g.base_frame.trim().is_empty() {
+            return Err(err("log.base_frame", "must not be empty"));
+        }
+        let disabled_kinds = SensorKind::ALL
+            .into_iter()
+            .filter(|k| {
+                let mut listed = self.sensor.iter().filter(|s| s.kind == *k);
+                listed.clone().next().is_some() && listed.all(|s| !s.enabled)
+            })
+            .collect();
+        Ok(Plan { geometry, occupancy, lidars, sensors, disabled_kinds, log: g.clone() })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Mount3;
+
+    #[test]
+    fn unlisted_kinds_are_auto_and_disabled_lidars_are_not_mapped() {
+        let p = Config::default().validate().unwrap();
+        assert_eq!(p.lidars.len(), 1);
+        assert!(!p.lidars[0].explicit && p.lidars[0].topic.is_none());
+        assert!(p.sensors.is_empty());
+        let mut c = Config::default();
+        c.sensor = vec![
+            SensorConfig { enabled: false, ..SensorConfig::new(SensorKind::Lidar) },
+            SensorConfig { topic: Some("/wheels".into()), ..SensorConfig::new(SensorKind::WheelOdometry) },
+        ];
+        let p = c.validate().unwrap();
+        assert!(p.lidars.is_empty());
+        assert_eq!(p.sensors.len(), 1);
+        assert_eq!(p.sensors[0].topic.as_deref(), Some("/wheels"));
+        assert_eq!(p.sensors[0].name, "wheel_odometry");
+        assert!(auto_sensor(SensorKind::Imu).is_some_and(|s| !s.explicit));
+        assert!(auto_sensor(SensorKind::Lidar).is_none());
+    }
 
     #[test]
     fn defaults_are_the_documents() {
@@ -406,35 +355,43 @@ mod tests {
         c.map.prior = 1.0;
         assert_eq!(field_of(c), "map.prior");
         let mut c = Config::default();
-        c.lidar[0].p_occ = 0.45;
-        assert_eq!(field_of(c), "lidar[0].p_occ");
-        let mut c = Config::default();
-        c.lidar[0].p_free = 0.5;
-        assert_eq!(field_of(c), "lidar[0].p_free");
-        let mut c = Config::default();
-        c.lidar[0].max_range = 0.05;
-        assert_eq!(field_of(c), "lidar[0].max_range");
-        let mut c = Config::default();
-        c.lidar[0].min_range = f64::NAN;
-        assert_eq!(field_of(c), "lidar[0].min_range");
+        c.sensor.push(SensorConfig { p_occ: Some(0.45), ..SensorConfig::new(SensorKind::Lidar) });
+        assert_eq!(field_of(c), "sensor[0].p_occ");
+        let lidar = |f: fn(&mut SensorConfig)| {
+            let mut c = Config::default();
+            let mut s = SensorConfig::new(SensorKind::Lidar);
+            f(&mut s);
+            c.sensor.push(s);
+            field_of(c)
+        };
+        assert_eq!(lidar(|s| s.p_free = Some(0.5)), "sensor[0].p_free");
+        assert_eq!(lidar(|s| s.max_range = Some(0.05)), "sensor[0].max_range");
+        assert_eq!(lidar(|s| s.min_range = Some(f64::NAN)), "sensor[0].min_range");
+        assert_eq!(
+            lidar(|s| s.base_from_sensor = Some(Mount3 { pitch: 0.5, ..Default::default() })),
+            "sensor[0].base_from_sensor"
+        );
+        assert_eq!(lidar(|s| s.gyro_noise_rad_s = Some(0.1)), "sensor[0].gyro_noise_rad_s");
+        assert_eq!(lidar(|s| s.time_offset_s = f64::INFINITY), "sensor[0].time_offset_s");
         let mut c = Config::default();
         c.map.clamp_max = 0.4;
         assert_eq!(field_of(c), "map");
         let mut c = Config::default();
-        c.lidar[0].mount.pitch = 0.5;
-        assert_eq!(field_of(c), "lidar[0].mount");
-        let mut c = Config::default();
         c.map.free_threshold = 0.7;
         assert_eq!(field_of(c), "map.free_threshold");
         let mut c = Config::default();
-        c.lidar.push(LidarConfig::default());
-        assert_eq!(field_of(c), "lidar[1].name");
+        c.sensor = vec![SensorConfig::new(SensorKind::Lidar), SensorConfig::new(SensorKind::Lidar)];
+        c.sensor[1].name = Some("laser".into());
+        assert_eq!(field_of(c), "sensor[1].name");
+        let mut c = Config::default();
+        c.sensor = vec![SensorConfig { datum: Some([91.0, 0.0, 0.0]), ..SensorConfig::new(SensorKind::Gnss) }];
+        assert_eq!(field_of(c), "sensor[0].datum");
         let mut c = Config::default();
         c.log.max_pose_gap_s = 0.0;
         assert_eq!(field_of(c), "log.max_pose_gap_s");
         let mut c = Config::default();
-        c.log.scan_topic = " ".into();
-        assert_eq!(field_of(c), "log.scan_topic");
+        c.log.base_frame = " ".into();
+        assert_eq!(field_of(c), "log.base_frame");
         let mut c = Config::default();
         c.log.gap_bridge_motion_m = -1.0;
         assert_eq!(field_of(c), "log.gap_bridge_motion_m");

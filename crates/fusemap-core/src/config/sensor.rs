@@ -1,0 +1,514 @@
+//! One `[[sensor]]` table per sensor: what it is, where its messages are, where it sits on
+//! the robot, how its clock is off, and the noise to assume where its messages carry none.
+//!
+//! Every kind shares `kind`, `name`, `topic`, `frame`, `enabled`, `time_offset_s` and
+//! `base_from_sensor`; the other keys belong to one kind each, and a key given for the
+//! wrong kind is an error naming it (a `p_occ` on an IMU is a mistake, not a no-op).
+//!
+//! Kinds not listed at all are looked for in the log under their usual topics (`/scan` or
+//! the log's only scan topic, `/odom`, `/imu`, `/fix`), so a log with no config still maps;
+//! a kind that is listed is used exactly as written (its topic must be in the log), and
+//! `enabled = false` switches a kind off, auto-detection included.
+
+use crate::geometry::{Mount3, PlanarMount};
+use crate::sensor::{LidarModel, LidarParams, MaxRangePolicy};
+use serde::{Deserialize, Serialize};
+
+use super::{err, finite, probability, ConfigError};
+
+/// What a sensor is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorKind {
+    /// A 2D lidar (`sensor_msgs/LaserScan`, CARMEN laser lines): mapped.
+    Lidar,
+    /// Wheel odometry (`nav_msgs/Odometry`, CARMEN `ODOM`): predicts the pose.
+    WheelOdometry,
+    /// An IMU (`sensor_msgs/Imu`): its gyro corrects the heading rate.
+    Imu,
+    /// A GNSS/RTK receiver (`sensor_msgs/NavSatFix`): absolute position fixes.
+    Gnss,
+    /// Absolute poses (`geometry_msgs/PoseWithCovarianceStamped`), e.g. from a localiser.
+    Pose,
+}
+
+impl SensorKind {
+    /// Every kind, in table order.
+    pub const ALL: [SensorKind; 5] =
+        [SensorKind::Lidar, SensorKind::WheelOdometry, SensorKind::Imu, SensorKind::Gnss, SensorKind::Pose];
+
+    /// The config spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SensorKind::Lidar => "lidar",
+            SensorKind::WheelOdometry => "wheel_odometry",
+            SensorKind::Imu => "imu",
+            SensorKind::Gnss => "gnss",
+            SensorKind::Pose => "pose",
+        }
+    }
+
+    /// The name a sensor of this kind gets when the config gives none (`laser` for a
+    /// lidar, as CARMEN and ROS drivers call it).
+    pub fn default_name(self) -> &'static str {
+        match self {
+            SensorKind::Lidar => "laser",
+            k => k.as_str(),
+        }
+    }
+
+    /// The topic looked for when the config names none.
+    pub fn default_topic(self) -> &'static str {
+        match self {
+            SensorKind::Lidar => "/scan",
+            SensorKind::WheelOdometry => "/odom",
+            SensorKind::Imu => "/imu",
+            SensorKind::Gnss => "/fix",
+            SensorKind::Pose => "/pose",
+        }
+    }
+}
+
+/// One `[[sensor]]` table as written.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorConfig {
+    /// `lidar`, `wheel_odometry`, `imu`, `gnss` or `pose`.
+    pub kind: SensorKind,
+    /// A name for reports; default: the kind, numbered when repeated.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// The topic (ROS) or message type (CARMEN); default: the kind's usual topic, or the
+    /// log's only topic of that kind.
+    #[serde(default)]
+    pub topic: Option<String>,
+    /// The sensor's frame id; default: the `header.frame_id` of its messages.
+    #[serde(default)]
+    pub frame: Option<String>,
+    /// `false` ignores the sensor (and stops its kind being auto-detected).
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    /// Seconds added to every stamp of this sensor (a known clock offset; the knob a time
+    /// calibration turns).
+    #[serde(default)]
+    pub time_offset_s: f64,
+    /// The mount `base_from_sensor`. Given, it is checked against the log's TF; left out,
+    /// the log's TF is used, else identity.
+    #[serde(default)]
+    pub base_from_sensor: Option<Mount3>,
+
+    /// Lidar: occupancy probability of a beam's end cell.
+    #[serde(default)]
+    pub p_occ: Option<f64>,
+    /// Lidar: occupancy probability of a crossed cell.
+    #[serde(default)]
+    pub p_free: Option<f64>,
+    /// Lidar: shortest valid range, metres.
+    #[serde(default)]
+    pub min_range: Option<f64>,
+    /// Lidar: longest valid range, metres (exclusive).
+    #[serde(default)]
+    pub max_range: Option<f64>,
+    /// Lidar: `skip` or `clear`.
+    #[serde(default)]
+    pub max_range_policy: Option<MaxRangePolicy>,
+    /// Lidar: largest tilt of the scan plane accepted, degrees.
+    #[serde(default)]
+    pub max_tilt_deg: Option<f64>,
+
+    /// Wheel odometry: translation σ per metre travelled (Thrun's α₃), m/m.
+    #[serde(default)]
+    pub translation_noise_per_m: Option<f64>,
+    /// Wheel odometry: translation σ per radian turned (α₄), m/rad.
+    #[serde(default)]
+    pub translation_noise_per_rad: Option<f64>,
+    /// Wheel odometry: rotation σ per radian turned (α₁), rad/rad.
+    #[serde(default)]
+    pub rotation_noise_per_rad: Option<f64>,
+    /// Wheel odometry: rotation σ per metre travelled (α₂), rad/m.
+    #[serde(default)]
+    pub rotation_noise_per_m: Option<f64>,
+
+    /// IMU: gyro rate σ, rad/s, where the message has no covariance.
+    #[serde(default)]
+    pub gyro_noise_rad_s: Option<f64>,
+    /// IMU: use the message's orientation yaw when it provides one (REP 145).
+    #[serde(default)]
+    pub use_orientation: Option<bool>,
+
+    /// GNSS: the local map frame's origin `[latitude°, longitude°, altitude m]`; default:
+    /// the first good fix.
+    #[serde(default)]
+    pub datum: Option<[f64; 3]>,
+    /// GNSS: smallest σ accepted for an RTK (`STATUS_GBAS_FIX`) fix, metres.
+    #[serde(default)]
+    pub sigma_floor_rtk_m: Option<f64>,
+    /// GNSS: smallest σ accepted for an SBAS fix, metres.
+    #[serde(default)]
+    pub sigma_floor_sbas_m: Option<f64>,
+    /// GNSS: smallest σ accepted for a plain fix, metres.
+    #[serde(default)]
+    pub sigma_floor_fix_m: Option<f64>,
+    /// GNSS: σ used when the message says its covariance is unknown, metres.
+    #[serde(default)]
+    pub sigma_unknown_m: Option<f64>,
+
+    /// Pose: position σ where the message's covariance is zero or unusable, metres.
+    #[serde(default)]
+    pub position_noise_m: Option<f64>,
+    /// Pose: yaw σ where the message's covariance is zero or unusable, degrees.
+    #[serde(default)]
+    pub yaw_noise_deg: Option<f64>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl SensorConfig {
+    /// A table of `kind` with every key at its default.
+    pub fn new(kind: SensorKind) -> Self {
+        Self {
+            kind,
+            name: None,
+            topic: None,
+            frame: None,
+            enabled: true,
+            time_offset_s: 0.0,
+            base_from_sensor: None,
+            p_occ: None,
+            p_free: None,
+            min_range: None,
+            max_range: None,
+            max_range_policy: None,
+            max_tilt_deg: None,
+            translation_noise_per_m: None,
+            translation_noise_per_rad: None,
+            rotation_noise_per_rad: None,
+            rotation_noise_per_m: None,
+            gyro_noise_rad_s: None,
+            use_orientation: None,
+            datum: None,
+            sigma_floor_rtk_m: None,
+            sigma_floor_sbas_m: None,
+            sigma_floor_fix_m: None,
+            sigma_unknown_m: None,
+            position_noise_m: None,
+            yaw_noise_deg: None,
+        }
+    }
+
+    /// The keys given that belong to another kind, by name.
+    fn foreign_keys(&self) -> Vec<&'static str> {
+        let mut v = Vec::new();
+        let mut check = |given: bool, key: &'static str, kind: SensorKind| {
+            if given && self.kind != kind {
+                v.push(key);
+            }
+        };
+        check(self.p_occ.is_some(), "p_occ", SensorKind::Lidar);
+        check(self.p_free.is_some(), "p_free", SensorKind::Lidar);
+        check(self.min_range.is_some(), "min_range", SensorKind::Lidar);
+        check(self.max_range.is_some(), "max_range", SensorKind::Lidar);
+        check(self.max_range_policy.is_some(), "max_range_policy", SensorKind::Lidar);
+        check(self.max_tilt_deg.is_some(), "max_tilt_deg", SensorKind::Lidar);
+        let odo = SensorKind::WheelOdometry;
+        check(self.translation_noise_per_m.is_some(), "translation_noise_per_m", odo);
+        check(self.translation_noise_per_rad.is_some(), "translation_noise_per_rad", odo);
+        check(self.rotation_noise_per_rad.is_some(), "rotation_noise_per_rad", odo);
+        check(self.rotation_noise_per_m.is_some(), "rotation_noise_per_m", odo);
+        check(self.gyro_noise_rad_s.is_some(), "gyro_noise_rad_s", SensorKind::Imu);
+        check(self.use_orientation.is_some(), "use_orientation", SensorKind::Imu);
+        let g = SensorKind::Gnss;
+        check(self.datum.is_some(), "datum", g);
+        check(self.sigma_floor_rtk_m.is_some(), "sigma_floor_rtk_m", g);
+        check(self.sigma_floor_sbas_m.is_some(), "sigma_floor_sbas_m", g);
+        check(self.sigma_floor_fix_m.is_some(), "sigma_floor_fix_m", g);
+        check(self.sigma_unknown_m.is_some(), "sigma_unknown_m", g);
+        check(self.position_noise_m.is_some(), "position_noise_m", SensorKind::Pose);
+        check(self.yaw_noise_deg.is_some(), "yaw_noise_deg", SensorKind::Pose);
+        v
+    }
+}
+
+/// Noise figures of a wheel odometry (Thrun et al., *Probabilistic Robotics*, §5.4: the
+/// odometry motion model, its σ growing with distance and rotation).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct OdometryNoise {
+    /// Translation σ per metre, m/m.
+    pub translation_per_m: f64,
+    /// Translation σ per radian, m/rad.
+    pub translation_per_rad: f64,
+    /// Rotation σ per radian, rad/rad.
+    pub rotation_per_rad: f64,
+    /// Rotation σ per metre, rad/m.
+    pub rotation_per_m: f64,
+}
+
+impl OdometryNoise {
+    /// The covariance (x, y, θ in the frame of the increment's start) of an increment of
+    /// `distance` metres and `rotation` radians: σ_t = α₃·d + α₄·|Δθ|,
+    /// σ_θ = α₁·|Δθ| + α₂·d, with a floor so a standing robot's increment is not certain.
+    pub fn increment_covariance(&self, distance: f64, rotation: f64) -> [[f64; 3]; 3] {
+        let st = self.translation_per_m * distance.abs() + self.translation_per_rad * rotation.abs() + 1e-4;
+        let sr = self.rotation_per_rad * rotation.abs() + self.rotation_per_m * distance.abs() + 1e-4;
+        [[st * st, 0.0, 0.0], [0.0, st * st, 0.0], [0.0, 0.0, sr * sr]]
+    }
+}
+
+/// GNSS σ floors by fix status.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct GnssNoise {
+    /// Floor for RTK fixes (`STATUS_GBAS_FIX`), m.
+    pub floor_rtk_m: f64,
+    /// Floor for SBAS fixes, m.
+    pub floor_sbas_m: f64,
+    /// Floor for plain fixes, m.
+    pub floor_fix_m: f64,
+    /// σ when the covariance is unknown, m.
+    pub unknown_m: f64,
+}
+
+/// What a sensor adds to a run, validated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedSensor {
+    /// Its kind.
+    pub kind: SensorKind,
+    /// Its name.
+    pub name: String,
+    /// The configured topic; `None`: look for the kind's usual one.
+    pub topic: Option<String>,
+    /// The configured frame id.
+    pub frame: Option<String>,
+    /// Seconds added to its stamps.
+    pub time_offset_s: f64,
+    /// The configured mount.
+    pub base_from_sensor: Option<Mount3>,
+    /// Odometry noise (kind `wheel_odometry`).
+    pub odometry: OdometryNoise,
+    /// Gyro σ, rad/s (kind `imu`).
+    pub gyro_noise_rad_s: f64,
+    /// Whether to use IMU orientation (kind `imu`).
+    pub use_orientation: bool,
+    /// The GNSS datum, if configured.
+    pub datum: Option<[f64; 3]>,
+    /// GNSS σ floors.
+    pub gnss: GnssNoise,
+    /// Pose σ fallbacks: position m, yaw rad.
+    pub pose_noise: (f64, f64),
+    /// `true` when the table was written in the config, `false` when auto-detected.
+    pub explicit: bool,
+}
+
+/// A lidar of the plan.
+#[derive(Clone, Debug)]
+pub struct PlannedLidar {
+    /// Its name.
+    pub name: String,
+    /// The inverse model with the mount reduced to the plane.
+    pub model: LidarModel,
+    /// The full 3D mount (identity when none was configured).
+    pub mount: Mount3,
+    /// Whether the mount was written in the config (then checked against the log's TF).
+    pub mount_given: bool,
+    /// Largest accepted tilt, radians.
+    pub max_tilt: f64,
+    /// The configured topic; `None`: auto.
+    pub topic: Option<String>,
+    /// The configured frame id.
+    pub frame: Option<String>,
+    /// Seconds added to its stamps.
+    pub time_offset_s: f64,
+    /// `true` when written in the config.
+    pub explicit: bool,
+}
+
+fn positive(field: &str, v: f64) -> Result<f64, ConfigError> {
+    if finite(field, v)? < 0.0 {
+        return Err(err(field, format!("must be >= 0, got {v}")));
+    }
+    Ok(v)
+}
+
+/// Validates the `[[sensor]]` tables into lidars and the other sensors. `prior` is the
+/// map's prior (lidar probabilities must straddle it).
+pub(super) fn plan_sensors(
+    tables: &[SensorConfig],
+    prior: f64,
+) -> Result<(Vec<PlannedLidar>, Vec<PlannedSensor>), ConfigError> {
+    let mut lidars = Vec::new();
+    let mut others = Vec::new();
+    let mut names: Vec<String> = Vec::new();
+    for (i, s) in tables.iter().enumerate() {
+        let f = |name: &str| format!("sensor[{i}].{name}");
+        if let Some(k) = s.foreign_keys().first() {
+            return Err(err(f(k), format!("not a key of a `{}` sensor", s.kind.as_str())));
+        }
+        let same_kind = tables[..i].iter().filter(|o| o.kind == s.kind).count();
+        let name = match &s.name {
+            Some(n) if n.trim().is_empty() => return Err(err(f("name"), "must not be empty")),
+            Some(n) => n.clone(),
+            None if same_kind == 0 => s.kind.default_name().to_string(),
+            None => format!("{}{}", s.kind.default_name(), same_kind + 1),
+        };
+        if names.contains(&name) {
+            return Err(err(f("name"), format!("`{name}` is used by two sensors")));
+        }
+        names.push(name.clone());
+        if let Some(t) = &s.topic {
+            if t.trim().is_empty() {
+                return Err(err(f("topic"), "must not be empty (leave it out to look for the usual topic)"));
+            }
+        }
+        let offset = finite(&f("time_offset_s"), s.time_offset_s)?;
+        if offset.abs() > 3600.0 {
+            return Err(err(f("time_offset_s"), format!("must be within ±3600 s, got {offset}")));
+        }
+        if !s.enabled {
+            continue;
+        }
+        if s.kind == SensorKind::Lidar {
+            lidars.push(plan_lidar(i, s, name, prior)?);
+            continue;
+        }
+        let d = OdometryNoise { translation_per_m: 0.05, translation_per_rad: 0.01, rotation_per_rad: 0.05, rotation_per_m: 0.02 };
+        let odometry = OdometryNoise {
+            translation_per_m: positive(&f("translation_noise_per_m"), s.translation_noise_per_m.unwrap_or(d.translation_per_m))?,
+            translation_per_rad: positive(
+                &f("translation_noise_per_rad"),
+                s.translation_noise_per_rad.unwrap_or(d.translation_per_rad),
+            )?,
+            rotation_per_rad: positive(&f("rotation_noise_per_rad"), s.rotation_noise_per_rad.unwrap_or(d.rotation_per_rad))?,
+            rotation_per_m: positive(&f("rotation_noise_per_m"), s.rotation_noise_per_m.unwrap_or(d.rotation_per_m))?,
+        };
+        let gyro = s.gyro_noise_rad_s.unwrap_or(0.005);
+        if !(finite(&f("gyro_noise_rad_s"), gyro)? > 0.0) {
+            return Err(err(f("gyro_noise_rad_s"), format!("must be > 0, got {gyro}")));
+        }
+        if let Some([lat, lon, alt]) = s.datum {
+            for v in [lat, lon, alt] {
+                finite(&f("datum"), v)?;
+            }
+            if lat.abs() > 90.0 || lon.abs() > 180.0 {
+                return Err(err(f("datum"), format!("latitude must be within ±90° and longitude ±180°, got {lat}, {lon}")));
+            }
+        }
+        let gnss = GnssNoise {
+            floor_rtk_m: s.sigma_floor_rtk_m.unwrap_or(0.02),
+            floor_sbas_m: s.sigma_floor_sbas_m.unwrap_or(0.5),
+            floor_fix_m: s.sigma_floor_fix_m.unwrap_or(1.0),
+            unknown_m: s.sigma_unknown_m.unwrap_or(3.0),
+        };
+        for (k, v) in [
+            ("sigma_floor_rtk_m", gnss.floor_rtk_m),
+            ("sigma_floor_sbas_m", gnss.floor_sbas_m),
+            ("sigma_floor_fix_m", gnss.floor_fix_m),
+            ("sigma_unknown_m", gnss.unknown_m),
+        ] {
+            if !(finite(&f(k), v)? > 0.0) {
+                return Err(err(f(k), format!("must be > 0 metres, got {v}")));
+            }
+        }
+        let pos = s.position_noise_m.unwrap_or(0.1);
+        let yaw = s.yaw_noise_deg.unwrap_or(2.0);
+        for (k, v) in [("position_noise_m", pos), ("yaw_noise_deg", yaw)] {
+            if !(finite(&f(k), v)? > 0.0) {
+                return Err(err(f(k), format!("must be > 0, got {v}")));
+            }
+        }
+        if let Some(m) = &s.base_from_sensor {
+            for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", m.yaw)] {
+                finite(&f(&format!("base_from_sensor.{k}")), v)?;
+            }
+        }
+        others.push(PlannedSensor {
+            kind: s.kind,
+            name,
+            topic: s.topic.clone(),
+            frame: s.frame.clone(),
+            time_offset_s: offset,
+            base_from_sensor: s.base_from_sensor,
+            odometry,
+            gyro_noise_rad_s: gyro,
+            use_orientation: s.use_orientation.unwrap_or(true),
+            datum: s.datum,
+            gnss,
+            pose_noise: (pos, yaw.to_radians()),
+            explicit: true,
+        });
+    }
+    Ok((lidars, others))
+}
+
+fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<PlannedLidar, ConfigError> {
+    let f = |name: &str| format!("sensor[{i}].{name}");
+    let d = LidarParams::default();
+    let p_occ = probability(&f("p_occ"), s.p_occ.unwrap_or(d.p_occ))?;
+    let p_free = probability(&f("p_free"), s.p_free.unwrap_or(d.p_free))?;
+    if p_occ <= prior {
+        return Err(err(f("p_occ"), format!("must be above the prior {prior}, got {p_occ}")));
+    }
+    if p_free >= prior {
+        return Err(err(f("p_free"), format!("must be below the prior {prior}, got {p_free}")));
+    }
+    let min_r = finite(&f("min_range"), s.min_range.unwrap_or(d.min_range))?;
+    let max_r = finite(&f("max_range"), s.max_range.unwrap_or(d.max_range))?;
+    if min_r < 0.0 {
+        return Err(err(f("min_range"), format!("must be >= 0, got {min_r}")));
+    }
+    if min_r >= max_r {
+        return Err(err(f("max_range"), format!("must be above min_range ({min_r}), got {max_r}")));
+    }
+    let tilt = finite(&f("max_tilt_deg"), s.max_tilt_deg.unwrap_or(2.0))?;
+    if !(0.0..=90.0).contains(&tilt) {
+        return Err(err(f("max_tilt_deg"), format!("must be within [0, 90] degrees, got {tilt}")));
+    }
+    let mount3 = s.base_from_sensor.unwrap_or_default();
+    let mount: PlanarMount =
+        mount3.to_planar(tilt.to_radians()).map_err(|e| err(f("base_from_sensor"), e.to_string()))?;
+    let params = LidarParams {
+        p_occ,
+        p_free,
+        min_range: min_r,
+        max_range: max_r,
+        max_range_policy: s.max_range_policy.unwrap_or(d.max_range_policy),
+    };
+    Ok(PlannedLidar {
+        name,
+        model: LidarModel::new(params, mount),
+        mount: mount3,
+        mount_given: s.base_from_sensor.is_some(),
+        max_tilt: tilt.to_radians(),
+        topic: s.topic.clone(),
+        frame: s.frame.clone(),
+        time_offset_s: s.time_offset_s,
+        explicit: true,
+    })
+}
+
+/// The sensor a kind gets when the config lists none of it: looked for under its usual
+/// topic, with default noise figures.
+/// `None` for [`SensorKind::Lidar`], whose default is [`PlannedLidar`]'s.
+pub fn auto_sensor(kind: SensorKind) -> Option<PlannedSensor> {
+    let (_, mut v) = plan_sensors(&[SensorConfig::new(kind)], 0.5).ok()?;
+    let mut s = v.pop()?;
+    s.explicit = false;
+    Some(s)
+}
+
+/// The lidar mapped when the config lists none: the document's inverse model (§3.2),
+/// identity mount, its topic found in the log.
+pub(super) fn default_lidar() -> PlannedLidar {
+    let d = LidarParams::default();
+    PlannedLidar {
+        name: SensorKind::Lidar.default_name().into(),
+        model: LidarModel::new(d, PlanarMount::default()),
+        mount: Mount3::default(),
+        mount_given: false,
+        max_tilt: 2f64.to_radians(),
+        topic: None,
+        frame: None,
+        time_offset_s: 0.0,
+        explicit: false,
+    }
+}

@@ -1,0 +1,330 @@
+//! The log doctor: what is wrong with a log's timing, before blaming the map (the design
+//! document's §4.3 habits, built in): per topic, message count, rate and jitter, time
+//! span, header-stamp delay against the log's receive time, stamp regressions and gaps;
+//! for the scan topic, the share of scans that get a pose under each sync mode; then
+//! findings in plain words.
+//!
+//! The figures of a topic's row, over its header stamps:
+//!
+//! * `rate` = (messages − 1) / `span`, `span` = latest − earliest stamp;
+//! * `period jitter` = standard deviation of the periods between successive distinct
+//!   stamps in time order;
+//! * `delay` = receive time − header stamp (smallest, mean, largest), where the format
+//!   records a receive time (ROS log time, CARMEN `logger_ts`);
+//! * `backwards` = stamps earlier than the one before them in the order the log holds
+//!   them (log-time order for ROS containers, file order for CARMEN);
+//! * `duplicates` = stamps equal to an earlier one;
+//! * `gaps` = pauses between successive stamps in time order longer than
+//!   `log.max_pose_gap_s`.
+//!
+//! Everything but `backwards` is taken in time order, as the mapper takes a pose track
+//! and the scans it poses from one: a message that arrives late does not open a pause.
+//! The doctor uses the mapper's own functions (the first pass, the sensor binding, the
+//! pose track), so what it says is what `fusemap map` will do.
+
+use crate::recording::Inventory;
+use crate::report::Skipped;
+use crate::run::{limits, sync_mode};
+use crate::track::Track;
+use crate::PipelineError;
+use fusemap_core::config::{LogConfig, Plan, PoseSource, SyncConfig};
+use fusemap_core::geometry::quaternion_yaw;
+use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The timing of one topic: `backwards` and the delays in log order, the rest in time order.
+fn timing(header: &[Stamp], receive: &[Option<Stamp>], limits: TimingLimits) -> StreamTiming {
+    let in_log_order = StreamTiming::analyze(header, receive, limits);
+    let mut sorted = header.to_vec();
+    sorted.sort_unstable();
+    let in_time_order = StreamTiming::analyze(&sorted, &[], limits);
+    StreamTiming { regressions: in_log_order.regressions, delay: in_log_order.delay, ..in_time_order }
+}
+
+/// "once", "3 times".
+fn times(n: u64) -> String {
+    if n == 1 {
+        "once".into()
+    } else {
+        format!("{n} times")
+    }
+}
+
+/// What a topic is to the mapper.
+#[derive(Clone, Copy, PartialEq)]
+enum Role {
+    /// The scans that are mapped, posed from a pose track.
+    ScansOnTrack,
+    /// The pose track.
+    PoseTrack,
+    /// Anything else.
+    Other,
+}
+
+/// How the scan topic gets its poses.
+struct Sync {
+    topic: String,
+    scans: u64,
+    source: String,
+    /// For a pose track: its topic, its counters, the configured mode and the shares.
+    track: Option<TrackSync>,
+}
+
+struct TrackSync {
+    topic: Option<String>,
+    configured: SyncMode,
+    interpolate: Skipped,
+    nearest: Skipped,
+    nearest_tolerance_s: f64,
+}
+
+/// The doctor's report as text (deterministic, for snapshot tests).
+pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
+    let log = Inventory::read(path)?;
+    let cfg = &plan.log;
+    let limits = limits(cfg);
+    let mut out = String::new();
+    let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+    writeln!(out, "log: {name} ({})", log.format)?;
+    writeln!(out)?;
+
+    let mut rows: Vec<(String, &str, StreamTiming)> = Vec::new();
+    for (topic, scans) in &log.scans {
+        rows.push((topic.clone(), "scan", timing(&scans.stamps, &scans.receive, limits)));
+    }
+    for (topic, odom) in &log.odom {
+        let h: Vec<Stamp> = odom.iter().map(|o| o.stamp).collect();
+        let r: Vec<Option<Stamp>> = odom.iter().map(|o| o.receive_stamp).collect();
+        rows.push((topic.clone(), "odometry", timing(&h, &r, limits)));
+    }
+    for (topic, imu) in &log.imu {
+        let h: Vec<Stamp> = imu.iter().map(|o| o.stamp).collect();
+        let r: Vec<Option<Stamp>> = imu.iter().map(|o| o.receive_stamp).collect();
+        rows.push((topic.clone(), "imu", timing(&h, &r, limits)));
+    }
+    if !log.tf_dynamic.is_empty() {
+        let h: Vec<Stamp> = log.tf_dynamic.iter().map(|t| t.stamp).collect();
+        rows.push(("/tf".into(), "tf", timing(&h, &[], limits)));
+    }
+
+    writeln!(
+        out,
+        "| topic | kind | messages | rate Hz | period jitter ms | span s | delay min ms | delay mean ms | delay max ms | backwards | duplicates | gaps > {:.2} s |",
+        limits.gap_s
+    )?;
+    writeln!(out, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    for (topic, kind, t) in &rows {
+        let ms = |s: f64| format!("{:.1}", s * 1e3);
+        let (dmin, dmean, dmax) =
+            t.delay.map_or(("-".into(), "-".into(), "-".into()), |d| (ms(d.min_s), ms(d.mean_s), ms(d.max_s)));
+        writeln!(
+            out,
+            "| {topic} | {kind} | {} | {:.2} | {:.1} | {:.1} | {dmin} | {dmean} | {dmax} | {} | {} | {} |",
+            t.count,
+            t.rate_hz,
+            t.jitter_s * 1e3,
+            t.span_s,
+            t.regressions,
+            t.duplicates,
+            t.gaps
+        )?;
+    }
+    if !log.tf_static.is_empty() {
+        writeln!(out)?;
+        for t in &log.tf_static {
+            writeln!(
+                out,
+                "static transform {} -> {}: translation ({:.3}, {:.3}, {:.3}), yaw {:.2}°",
+                t.parent,
+                t.child,
+                t.translation[0],
+                t.translation[1],
+                t.translation[2],
+                quaternion_yaw(t.rotation).to_degrees()
+            )?;
+        }
+    }
+    for (t, n) in &log.stats.skipped_by_type {
+        writeln!(out, "skipped {n} records of type {t}")?;
+    }
+
+    // How the scans would be posed, as `fusemap map` does it.
+    let mut notes = Vec::new();
+    let mut findings: Vec<String> = Vec::new();
+    let mut sync = None;
+    match crate::run::prepare(plan, &log) {
+        Ok((bound, chosen, _)) => {
+            notes.extend(bound.notes.iter().cloned());
+            let topic = bound.lidars[0].topic.clone();
+            let stamps = &log.scans[&topic].stamps;
+            let offset = crate::offset_ns(bound.lidars[0].lidar.time_offset_s);
+            match &chosen.track {
+                Track::Timed(track) => {
+                    let configured = sync_mode(cfg, stamps);
+                    let nearest_cfg = LogConfig { sync: SyncConfig::Nearest, ..cfg.clone() };
+                    let nearest = sync_mode(&nearest_cfg, stamps);
+                    let tally = |mode: SyncMode| {
+                        let mut skipped = Skipped::default();
+                        for s in stamps {
+                            if let Err(why) = track.pose_at(Stamp(s.0.saturating_add(offset)), mode) {
+                                skipped.count(why);
+                            }
+                        }
+                        skipped
+                    };
+                    let topic_of_track = match chosen.source {
+                        PoseSource::Odometry => {
+                            bound.first(fusemap_core::config::SensorKind::WheelOdometry).map(|b| b.topic.clone())
+                        }
+                        PoseSource::Tf => Some("/tf".to_string()),
+                        _ => None,
+                    };
+                    sync = Some(Sync {
+                        topic: topic.clone(),
+                        scans: stamps.len() as u64,
+                        source: chosen.name.clone(),
+                        track: Some(TrackSync {
+                            topic: topic_of_track,
+                            configured,
+                            interpolate: tally(SyncMode::Interpolate),
+                            nearest: tally(nearest),
+                            nearest_tolerance_s: match nearest {
+                                SyncMode::Nearest { tolerance_s } => tolerance_s,
+                                SyncMode::Interpolate => 0.0,
+                            },
+                        }),
+                    });
+                }
+                Track::ScanLine => {
+                    sync = Some(Sync { topic: topic.clone(), scans: stamps.len() as u64, source: chosen.name.clone(), track: None })
+                }
+            }
+            notes.extend(chosen.notes.iter().cloned());
+        }
+        Err(e) => findings.push(format!("cannot be mapped: {e}")),
+    }
+
+    if log.stats.malformed > 0 {
+        // The same words as `fusemap map`'s note: the reader skipped these records.
+        findings.push(format!(
+            "{} malformed records skipped; first: {}",
+            log.stats.malformed,
+            log.stats.malformed_examples.join("; ")
+        ));
+    }
+    let track = sync.as_ref().and_then(|s| s.track.as_ref());
+    for (topic, kind, t) in &rows {
+        let role = match (&sync, track) {
+            (Some(s), Some(_)) if *topic == s.topic => Role::ScansOnTrack,
+            (_, Some(tr)) if tr.topic.as_deref() == Some(topic.as_str()) => Role::PoseTrack,
+            _ => Role::Other,
+        };
+        if t.regressions > 0 {
+            let consequence = match role {
+                Role::ScansOnTrack => ": the scans are mapped in stamp order",
+                Role::PoseTrack => ": the pose track takes its samples in stamp order",
+                Role::Other => "",
+            };
+            findings.push(format!("{topic} stamps go backwards {}{consequence}", times(t.regressions)));
+        }
+        if t.duplicates > 0 {
+            let consequence =
+                if role == Role::PoseTrack { ": the pose track uses the first sample of each stamp" } else { "" };
+            findings.push(format!("{topic} repeats a stamp {}{consequence}", times(t.duplicates)));
+        }
+        if let Some(d) = t.delay {
+            let spread = d.max_s - d.min_s;
+            if d.far > 0 && d.far == d.count && spread <= limits.far_delay_s {
+                // Every delay is far and they spread less than the limit: all have one sign.
+                let (near, far) = (d.min_s.abs().min(d.max_s.abs()), d.min_s.abs().max(d.max_s.abs()));
+                findings.push(format!(
+                    "{topic}: every header stamp is {near:.3} to {far:.3} s {} the log's receive time: the stamps \
+                     and the log count time from different origins (a CARMEN logger counts from the start of the \
+                     log), which is no clock fault, but the delay cannot be judged",
+                    if d.mean_s < 0.0 { "later than" } else { "earlier than" },
+                ));
+            } else if d.far > 0 {
+                findings.push(format!(
+                    "{topic}: {} header stamps are more than {:.1} s from the log's receive time (largest {:.3} s): check the sensor's clock",
+                    d.far, limits.far_delay_s, d.max_s.abs().max(d.min_s.abs())
+                ));
+            }
+        }
+        if *kind != "scan" && t.gaps > 0 {
+            let consequence = if role == Role::PoseTrack {
+                format!(
+                    ": a scan inside one gets a pose only if the robot moved at most {} m and {}° across it",
+                    cfg.gap_bridge_motion_m, cfg.gap_bridge_motion_deg
+                )
+            } else {
+                String::new()
+            };
+            findings.push(format!(
+                "{topic} pauses longer than {:.2} s {} (longest {:.2} s){consequence}",
+                limits.gap_s,
+                times(t.gaps),
+                t.max_gap_s
+            ));
+        }
+    }
+
+    if let Some(s) = &sync {
+        writeln!(out)?;
+        match &s.track {
+            None => {
+                writeln!(out, "scans on {} are posed by the {}: no time synchronisation needed", s.topic, s.source)?
+            }
+            Some(tr) => {
+                let share = |k: &Skipped| 100.0 * (s.scans - k.total()) as f64 / s.scans.max(1) as f64;
+                writeln!(out, "scans on {} with a pose from {}:", s.topic, s.source)?;
+                writeln!(out, "  interpolate: {:.1} %", share(&tr.interpolate))?;
+                writeln!(out, "  nearest within {:.0} ms: {:.1} %", tr.nearest_tolerance_s * 1e3, share(&tr.nearest))?;
+                let skipped = if tr.configured == SyncMode::Interpolate { &tr.interpolate } else { &tr.nearest };
+                let missing = skipped.total();
+                if missing > 0 {
+                    let pct = 100.0 - share(skipped);
+                    // One decimal, or two when that would print a share that is not 0 as 0.0.
+                    let pct = if pct < 0.1 { format!("{pct:.2}") } else { format!("{pct:.1}") };
+                    let head = format!("{pct} % of scans on {} ({missing} of {})", s.topic, s.scans);
+                    if let SyncMode::Nearest { tolerance_s } = tr.configured {
+                        findings.push(format!(
+                            "{head} have no pose within {:.0} ms: raise the tolerance or use interpolation",
+                            tolerance_s * 1e3
+                        ));
+                    } else {
+                        let mut why = Vec::new();
+                        if skipped.before_first_pose > 0 {
+                            why.push(format!("{} before the first pose", skipped.before_first_pose));
+                        }
+                        if skipped.after_last_pose > 0 {
+                            why.push(format!("{} after the last pose", skipped.after_last_pose));
+                        }
+                        if skipped.in_pose_gap > 0 {
+                            why.push(format!(
+                                "{} in pauses of the pose track longer than {:.2} s across which the robot moved \
+                                 more than {} m or {}°",
+                                skipped.in_pose_gap,
+                                cfg.max_pose_gap_s,
+                                cfg.gap_bridge_motion_m,
+                                cfg.gap_bridge_motion_deg
+                            ));
+                        }
+                        findings.push(format!("{head} get no pose and are skipped: {}", why.join(", ")));
+                    }
+                }
+            }
+        }
+    }
+
+    findings.extend(notes);
+    writeln!(out)?;
+    writeln!(out, "findings:")?;
+    if findings.is_empty() {
+        writeln!(out, "- no clock faults found")?;
+    }
+    for f in findings {
+        writeln!(out, "- {f}")?;
+    }
+    Ok(out)
+}

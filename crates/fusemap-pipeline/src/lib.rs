@@ -1,0 +1,54 @@
+//! # fusemap-pipeline
+//!
+//! The log → map pipeline as a library: a recording read as a time-ordered stream of every
+//! sensor (never loaded whole), its sensors bound to topics, the pose track chosen and
+//! built (odometry, TF, poses on CARMEN scan lines, or the estimator fusing odometry, IMU,
+//! GNSS and absolute poses), every lidar mapped through the engine, and a report of what
+//! happened. One call, [`map_log`], runs a whole mapping pass in memory: the `fusemap` CLI,
+//! a Python binding or a calibration search all use it the same way. Writing outputs is
+//! left to the caller.
+//!
+//! | concept | module |
+//! |---|---|
+//! | the time-ordered merge of sensor streams | [`merge`] |
+//! | the two passes over a recording | [`recording`] |
+//! | configured sensors bound to the log's topics | [`sensors`] |
+//! | choosing and building the pose track | [`track`] |
+//! | the estimator's inputs from log messages | [`estimation`] |
+//! | sensor mounts from TF or config | [`extrinsics`] |
+//! | the mapping pass | [`run`] |
+//! | the run report | [`report`] |
+//! | the log doctor's figures | [`doctor`] |
+
+#![warn(missing_docs)]
+
+pub mod doctor;
+pub mod estimation;
+pub mod extrinsics;
+pub mod merge;
+pub mod recording;
+pub mod report;
+pub mod run;
+pub mod sensors;
+pub mod track;
+
+pub use run::{map_inventory, map_log, MapRun, Progress};
+
+pub(crate) use run::offset_ns;
+
+/// Why a run could not be done.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// Reading the log failed (the error names the file and the place in it).
+    #[error(transparent)]
+    Read(#[from] fusemap_io::Error),
+    /// The engine refused a measurement.
+    #[error(transparent)]
+    Engine(#[from] fusemap_core::fusion::EngineError),
+    /// The log and the configuration do not allow a run, with the reason.
+    #[error("{0}")]
+    Refused(String),
+    /// Writing a text report failed.
+    #[error("cannot format the report")]
+    Format(#[from] std::fmt::Error),
+}

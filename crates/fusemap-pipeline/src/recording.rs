@@ -1,0 +1,192 @@
+//! A recording read in two passes, never whole.
+//!
+//! The first pass ([`Inventory::read`]) goes through every message once and keeps only
+//! what is small: the pose sensors' samples (odometry, IMU, GNSS, poses, transforms), which
+//! the estimator and its smoother need over the whole log, and for each scan topic its
+//! stamps and frame ids (for the timing report and the choice of topics) — not the scans.
+//! The second pass ([`for_each_scan`]) streams the range sensors' messages of the chosen
+//! topics to the mapper through the time-ordered merge. Peak memory is the pose streams
+//! plus one merge window of scans, whatever the number of scans.
+
+use fusemap_core::geometry::Pose2;
+use fusemap_core::time::Stamp;
+use fusemap_io::log::{ImuMessage, LogFormat, LogMessage, OdomMessage, ReadStats, ScanMessage, Transform};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What the first pass learnt about one scan topic.
+#[derive(Clone, Debug, Default)]
+pub struct ScanTopic {
+    /// Header stamps in log order.
+    pub stamps: Vec<Stamp>,
+    /// Receive stamps in log order, where the format has them.
+    pub receive: Vec<Option<Stamp>>,
+    /// Frame ids seen, with their counts.
+    pub frames: BTreeMap<String, u64>,
+    /// Scans that carry a pose on their line (CARMEN).
+    pub with_pose: u64,
+    /// The first (robot pose, laser pose) pair of a line that carries both (CARMEN
+    /// `ROBOTLASER1`), from which the mount follows.
+    pub first_laser_pose: Option<(Pose2, Pose2)>,
+}
+
+impl ScanTopic {
+    /// The most common non-empty frame id.
+    pub fn frame(&self) -> Option<&str> {
+        self.frames.iter().filter(|(f, _)| !f.is_empty()).max_by_key(|(_, n)| **n).map(|(f, _)| f.as_str())
+    }
+}
+
+/// The first pass over a recording: every pose sensor's messages, and an inventory of the
+/// range sensors.
+pub struct Inventory {
+    /// The file.
+    pub path: PathBuf,
+    /// Its format.
+    pub format: LogFormat,
+    /// Scan topics.
+    pub scans: BTreeMap<String, ScanTopic>,
+    /// Odometry by topic, in log order.
+    pub odom: BTreeMap<String, Vec<OdomMessage>>,
+    /// IMU messages by topic, in log order.
+    pub imu: BTreeMap<String, Vec<ImuMessage>>,
+    /// Static transforms (`/tf_static`), in log order.
+    pub tf_static: Vec<Transform>,
+    /// Dynamic transforms (`/tf`), in log order.
+    pub tf_dynamic: Vec<Transform>,
+    /// What the reader skipped, plus the messages that did not decode.
+    pub stats: ReadStats,
+    /// Seconds spent in this pass.
+    pub read_s: f64,
+}
+
+/// Reads the next message, turning an undecodable message into a counted skip. Errors of
+/// the container itself end the read.
+fn next(
+    reader: &mut dyn fusemap_io::log::LogReader,
+    undecodable: &mut ReadStats,
+) -> Option<fusemap_io::Result<LogMessage>> {
+    loop {
+        match reader.next_message()? {
+            Ok(m) => return Some(Ok(m)),
+            // One message that does not decode (a corrupt payload, a big-endian CDR
+            // message) is skipped and counted: a user wants the rest of the log.
+            Err(e) if is_skippable(&e) => undecodable.malformed(e.to_string()),
+            Err(e) => return Some(Err(e)),
+        }
+    }
+}
+
+/// Whether a read error concerns one message only, so the rest of the log can be read.
+fn is_skippable(e: &fusemap_io::Error) -> bool {
+    matches!(e, fusemap_io::Error::Format { location: fusemap_io::Location::Message { .. }, .. })
+}
+
+/// Merges the reader's own counters with the undecodable messages.
+fn merged_stats(reader: &ReadStats, undecodable: ReadStats) -> ReadStats {
+    let mut stats = reader.clone();
+    for e in undecodable.malformed_examples {
+        stats.malformed(e);
+    }
+    stats.malformed += undecodable.malformed - undecodable.malformed.min(10);
+    stats
+}
+
+impl Inventory {
+    /// The first pass over `path`.
+    pub fn read(path: &Path) -> fusemap_io::Result<Inventory> {
+        let t0 = Instant::now();
+        let opened = fusemap_io::log::open_log(path)?;
+        let mut reader = opened.reader;
+        let mut inv = Inventory {
+            path: path.to_path_buf(),
+            format: opened.format,
+            scans: BTreeMap::new(),
+            odom: BTreeMap::new(),
+            imu: BTreeMap::new(),
+            tf_static: Vec::new(),
+            tf_dynamic: Vec::new(),
+            stats: ReadStats::default(),
+            read_s: 0.0,
+        };
+        let mut undecodable = ReadStats::default();
+        let mut tf = Vec::new();
+        while let Some(m) = next(reader.as_mut(), &mut undecodable) {
+            match m? {
+                LogMessage::Scan(s) => {
+                    let t = inv.scans.entry(s.topic.clone()).or_default();
+                    t.stamps.push(s.scan.stamp);
+                    t.receive.push(s.receive_stamp);
+                    *t.frames.entry(s.frame_id).or_default() += 1;
+                    if s.pose.is_some() {
+                        t.with_pose += 1;
+                    }
+                    if t.first_laser_pose.is_none() {
+                        if let (Some(r), Some(l)) = (s.pose, s.laser_pose) {
+                            t.first_laser_pose = Some((r, l));
+                        }
+                    }
+                }
+                LogMessage::Odometry(o) => inv.odom.entry(o.topic.clone()).or_default().push(o),
+                LogMessage::Imu(i) => inv.imu.entry(i.topic.clone()).or_default().push(i),
+                LogMessage::Tf(t) => tf.push(t),
+            }
+        }
+        inv.stats = merged_stats(reader.stats(), undecodable);
+        if inv.format != LogFormat::Carmen {
+            // ROS containers are played back in log-time order (what `rosbag play` and
+            // `ros2 bag play` do), whatever order their chunks hold the records in.
+            for v in inv.odom.values_mut() {
+                v.sort_by_key(|m| m.receive_stamp);
+            }
+            for v in inv.imu.values_mut() {
+                v.sort_by_key(|m| m.receive_stamp);
+            }
+            tf.sort_by_key(|m| m.receive_stamp);
+            for t in inv.scans.values_mut() {
+                let mut pairs: Vec<(Option<Stamp>, Stamp)> =
+                    t.receive.iter().copied().zip(t.stamps.iter().copied()).collect();
+                pairs.sort_by_key(|p| p.0);
+                t.receive = pairs.iter().map(|p| p.0).collect();
+                t.stamps = pairs.iter().map(|p| p.1).collect();
+            }
+        }
+        for t in tf {
+            if t.is_static {
+                inv.tf_static.extend(t.transforms);
+            } else {
+                inv.tf_dynamic.extend(t.transforms);
+            }
+        }
+        inv.read_s = t0.elapsed().as_secs_f64();
+        Ok(inv)
+    }
+
+    /// Total scans in the log.
+    pub fn scan_count(&self) -> u64 {
+        self.scans.values().map(|t| t.stamps.len() as u64).sum()
+    }
+}
+
+/// The second pass: calls `f` with every scan of `topics`, in log order, and returns the
+/// seconds spent reading. Errors of the container end the pass; undecodable messages were
+/// already counted by the first pass and are skipped.
+pub fn for_each_scan(
+    path: &Path,
+    topics: &[String],
+    mut f: impl FnMut(ScanMessage) -> Result<(), crate::PipelineError>,
+) -> Result<f64, crate::PipelineError> {
+    let t0 = Instant::now();
+    let opened = fusemap_io::log::open_log(path)?;
+    let mut reader = opened.reader;
+    let mut ignored = ReadStats::default();
+    while let Some(m) = next(reader.as_mut(), &mut ignored) {
+        if let LogMessage::Scan(s) = m? {
+            if topics.contains(&s.topic) {
+                f(s)?;
+            }
+        }
+    }
+    Ok(t0.elapsed().as_secs_f64())
+}

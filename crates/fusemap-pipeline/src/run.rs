@@ -1,0 +1,392 @@
+//! One mapping pass over a recording: the whole log → map pipeline in one library call.
+//!
+//! Steps: the first pass reads the pose sensors and an inventory of the scans; the sensors
+//! are bound to topics; the pose track is chosen and built (the estimator and its smoother
+//! over the whole log, when the log has the sensors for it); each lidar's mount is
+//! resolved; then the second pass streams every lidar's scans through the time-ordered
+//! merge into the engine, each scan with the pose at its own stamp (or each beam's,
+//! de-skewed). Every scan that cannot be posed is skipped and counted with its reason;
+//! clock faults are reported, and the usable part of the log is still mapped.
+
+use crate::extrinsics::{lidar_mount_from_log, resolve, ExtrinsicsReport};
+use crate::merge::{OrderedMerge, Pushed};
+use crate::recording::{for_each_scan, Inventory};
+use crate::report::{LidarReport, LogReport, Skipped};
+use crate::sensors::{bind, Bound};
+use crate::track::{choose, count_reordered, ChosenTrack, Track};
+use crate::PipelineError;
+use fusemap_core::config::{LogConfig, Plan, SensorKind, SyncConfig};
+use fusemap_core::fusion::Engine;
+use fusemap_core::geometry::{PlanarMount, Pose2};
+use fusemap_core::grid::OccupancyGrid;
+use fusemap_core::measurement::SensorId;
+use fusemap_core::sensor::{LaserScan, LidarModel};
+use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
+use fusemap_io::log::{LogFormat, ScanMessage};
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+/// What a run tells its caller as it goes (the CLI draws a progress bar from it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Progress<'a> {
+    /// A phase starts, with the number of steps when known.
+    Phase {
+        /// What it does.
+        name: &'a str,
+        /// Steps in it.
+        total: u64,
+    },
+    /// Steps done since the last report.
+    Advance(u64),
+    /// The phase ended.
+    Done,
+}
+
+/// A finished mapping pass.
+pub struct MapRun {
+    /// The engine, holding the map and its counters.
+    pub engine: Engine,
+    /// The log's format.
+    pub format: LogFormat,
+    /// The run report.
+    pub report: LogReport,
+    /// The pose track used, `map_from_base` in time order (for `trajectory.tum`).
+    pub trajectory: Vec<(Stamp, Pose2)>,
+    /// Facts a user should know.
+    pub notes: Vec<String>,
+}
+
+/// Nanoseconds of a time offset in seconds (configs bound it to ±1 h).
+pub(crate) fn offset_ns(s: f64) -> i64 {
+    (s * 1e9).round() as i64
+}
+
+/// Maps the log at `path` with `plan`.
+pub fn map_log(plan: &Plan, path: &Path, progress: &mut dyn FnMut(Progress)) -> Result<MapRun, PipelineError> {
+    progress(Progress::Phase { name: "reading", total: 0 });
+    let inv = Inventory::read(path)?;
+    progress(Progress::Done);
+    map_inventory(plan, &inv, progress)
+}
+
+/// The topics of the first pass, by kind, with their message counts.
+pub fn topics_by_kind(inv: &Inventory) -> BTreeMap<SensorKind, BTreeMap<String, u64>> {
+    let mut m: BTreeMap<SensorKind, BTreeMap<String, u64>> = BTreeMap::new();
+    for (t, s) in &inv.scans {
+        m.entry(SensorKind::Lidar).or_default().insert(t.clone(), s.stamps.len() as u64);
+    }
+    for (t, v) in &inv.odom {
+        m.entry(SensorKind::WheelOdometry).or_default().insert(t.clone(), v.len() as u64);
+    }
+    for (t, v) in &inv.imu {
+        m.entry(SensorKind::Imu).or_default().insert(t.clone(), v.len() as u64);
+    }
+    m
+}
+
+/// The sync mode from the config, with the nearest tolerance resolved (half the median
+/// period of `stamps`, taken in stamp order as the scans are mapped).
+pub fn sync_mode(cfg: &LogConfig, stamps: &[Stamp]) -> SyncMode {
+    match cfg.sync {
+        SyncConfig::Interpolate => SyncMode::Interpolate,
+        SyncConfig::Nearest => {
+            let tol = if cfg.nearest_tolerance_s > 0.0 {
+                cfg.nearest_tolerance_s
+            } else {
+                let mut h = stamps.to_vec();
+                h.sort_unstable();
+                let median_period_s = StreamTiming::analyze(&h, &[], TimingLimits::default()).median_period_s;
+                if median_period_s > 0.0 {
+                    median_period_s / 2.0
+                } else {
+                    0.05
+                }
+            };
+            SyncMode::Nearest { tolerance_s: tol }
+        }
+    }
+}
+
+/// The timing limits of the config.
+pub fn limits(cfg: &LogConfig) -> TimingLimits {
+    TimingLimits { gap_s: cfg.max_pose_gap_s, far_delay_s: cfg.far_delay_s }
+}
+
+/// One lidar as the second pass uses it.
+struct Mapped {
+    id: SensorId,
+    offset_ns: i64,
+    stream: usize,
+    report: LidarReport,
+}
+
+/// Binds the sensors and builds the pose track: everything before the scans are read.
+pub fn prepare(plan: &Plan, inv: &Inventory) -> Result<(Bound, ChosenTrack, f64), PipelineError> {
+    if inv.scans.is_empty() && inv.stats.malformed > 0 {
+        return Err(PipelineError::Refused(format!(
+            "the log holds no usable laser scans; {} records could not be decoded, the first: {}",
+            inv.stats.malformed,
+            inv.stats.malformed_examples.first().map_or("", |s| s.as_str())
+        )));
+    }
+    let bound = bind(plan, &topics_by_kind(inv))?;
+    let t0 = Instant::now();
+    let chosen = choose(inv, &plan.log, &bound, || crate::estimation::estimator_track(plan, inv, &bound))?;
+    Ok((bound, chosen, t0.elapsed().as_secs_f64()))
+}
+
+/// Maps a recording whose first pass is done.
+pub fn map_inventory(plan: &Plan, inv: &Inventory, progress: &mut dyn FnMut(Progress)) -> Result<MapRun, PipelineError> {
+    let cfg = &plan.log;
+    let (bound, chosen, track_s) = prepare(plan, inv)?;
+    let mut notes = bound.notes.clone();
+    if bound.lidars.is_empty() {
+        return Err(PipelineError::Refused("no lidar to map: every [[sensor]] of kind lidar is disabled".into()));
+    }
+    let first_stamps = &inv.scans[&bound.lidars[0].topic].stamps;
+    let mode = sync_mode(cfg, first_stamps);
+    let window = match chosen.track {
+        Track::ScanLine => 0,
+        Track::Timed(_) => offset_ns(cfg.reorder_window_s),
+    };
+    let mut merge: OrderedMerge<ScanMessage> = OrderedMerge::new(window);
+    let mut engine = Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy));
+    let mut lidars = Vec::new();
+    for b in &bound.lidars {
+        let topic = &inv.scans[&b.topic];
+        let frame = b.lidar.frame.clone().or_else(|| topic.frame().map(str::to_string)).unwrap_or_default();
+        let log_mount = lidar_mount_from_log(&inv.tf_static, &inv.tf_dynamic, &cfg.base_frame, &frame, topic);
+        let config_mount = b.lidar.mount_given.then_some(b.lidar.mount);
+        let ext: ExtrinsicsReport = resolve(&frame, cfg, config_mount, log_mount, &mut notes)?;
+        let planar: PlanarMount = ext
+            .base_from_sensor
+            .to_planar(b.lidar.max_tilt)
+            .map_err(|e| PipelineError::Refused(format!("mount of lidar `{}` ({}): {e}", b.lidar.name, ext.source)))?;
+        let mut params = *b.lidar.model.params();
+        if !b.lidar.explicit {
+            // Defaults suited to a typical indoor 2D lidar rather than the document's 10 m corridor.
+            params.max_range = 40.0;
+        }
+        let id = engine.add_lidar(b.lidar.name.clone(), LidarModel::new(params, planar));
+        let mut other_frames = topic.frames.clone();
+        other_frames.remove(&frame);
+        other_frames.remove("");
+        if !other_frames.is_empty() {
+            notes.push(format!(
+                "`{}` carries several frame ids ({} besides `{frame}`): every scan is mapped with the mount of `{frame}`",
+                b.topic,
+                other_frames.keys().map(String::as_str).collect::<Vec<_>>().join(", ")
+            ));
+        }
+        let stream = merge.add_stream(b.topic.clone());
+        let timing = StreamTiming::analyze(&topic.stamps, &topic.receive, limits(cfg));
+        let scans_reordered = match chosen.track {
+            Track::Timed(_) => count_reordered(topic.stamps.iter().copied()),
+            Track::ScanLine => 0,
+        };
+        lidars.push(Mapped {
+            id,
+            offset_ns: offset_ns(b.lidar.time_offset_s),
+            stream,
+            report: LidarReport {
+                name: b.lidar.name.clone(),
+                topic: b.topic.clone(),
+                frame,
+                other_frames,
+                scans_read: topic.stamps.len() as u64,
+                scans_used: 0,
+                scans_skipped: Skipped::default(),
+                scans_deskewed: 0,
+                scans_reordered,
+                time_offset_s: b.lidar.time_offset_s,
+                timing,
+                extrinsics: ext,
+            },
+        });
+    }
+
+    // The second pass: every lidar's scans, merged in stamp order (file order for poses on
+    // the scan lines, which do not depend on the stamps: some corrected CARMEN logs have
+    // broken or all-zero stamps).
+    let topics: Vec<String> = bound.lidars.iter().map(|b| b.topic.clone()).collect();
+    let total: u64 = lidars.iter().map(|l| l.report.scans_read).sum();
+    progress(Progress::Phase { name: "mapping", total });
+    let mut inserter = Inserter {
+        engine: &mut engine,
+        track: &chosen.track,
+        mode,
+        deskew: cfg.deskew,
+        scan: LaserScan { stamp: Stamp::ZERO, angle_min: 0.0, angle_increment: 0.0, ranges: Vec::new() },
+        last: None,
+        line_trajectory: Vec::new(),
+    };
+    let t_map = Instant::now();
+    let mut seq = 0i64;
+    let read_s = for_each_scan(&inv.path, &topics, |msg| {
+        let Some(l) = lidars.iter_mut().find(|l| l.report.topic == msg.topic) else { return Ok(()) };
+        let key = match chosen.track {
+            Track::ScanLine => {
+                seq += 1;
+                seq
+            }
+            Track::Timed(_) => msg.scan.stamp.0.saturating_add(l.offset_ns),
+        };
+        if merge.push(l.stream, key, msg) == Pushed::Late {
+            l.report.scans_skipped.late += 1;
+            progress(Progress::Advance(1));
+        }
+        while let Some((s, key, msg)) = merge.pop_ready() {
+            let l = lidars.iter_mut().find(|l| l.stream == s).expect("every stream is a lidar's");
+            inserter.insert(l, Stamp(key), &msg)?;
+            progress(Progress::Advance(1));
+        }
+        Ok(())
+    })?;
+    while let Some((s, key, msg)) = merge.pop_final() {
+        let l = lidars.iter_mut().find(|l| l.stream == s).expect("every stream is a lidar's");
+        inserter.insert(l, Stamp(key), &msg)?;
+        progress(Progress::Advance(1));
+    }
+    progress(Progress::Done);
+    let map_s = t_map.elapsed().as_secs_f64();
+    let _ = read_s;
+    let trajectory = match &chosen.track {
+        Track::ScanLine => std::mem::take(&mut inserter.line_trajectory),
+        Track::Timed(t) => t.samples(),
+    };
+    drop(inserter);
+
+    let mut skipped = Skipped::default();
+    for l in &lidars {
+        let r = &l.report;
+        skipped.add(&r.scans_skipped);
+        if r.timing.regressions > 0 {
+            let order = if r.scans_reordered > 0 {
+                format!(": {} scans mapped in stamp order", r.scans_reordered)
+            } else {
+                String::new()
+            };
+            notes.push(format!("`{}` stamps go backwards {} times{order}", r.topic, r.timing.regressions));
+        }
+        if r.scans_skipped.late > 0 {
+            notes.push(format!(
+                "{} scans of `{}` arrived more than log.reorder_window_s = {} s behind the others and were dropped",
+                r.scans_skipped.late, r.topic, cfg.reorder_window_s
+            ));
+        }
+    }
+    let read: u64 = lidars.iter().map(|l| l.report.scans_read).sum();
+    if skipped.total() > 0 {
+        notes.push(format!("{} of {} scans skipped without a pose", skipped.total(), read));
+    }
+    if inv.stats.malformed > 0 {
+        notes.push(format!(
+            "{} malformed records skipped; first: {}",
+            inv.stats.malformed,
+            inv.stats.malformed_examples.join("; ")
+        ));
+    }
+    let pose_timing = (!chosen.stamps.is_empty())
+        .then(|| StreamTiming::analyze(&chosen.stamps, &chosen.receive, limits(cfg)));
+    let first = &lidars[0].report;
+    let report = LogReport {
+        format: inv.format.to_string(),
+        scan_topic: first.topic.clone(),
+        pose_source: chosen.name.clone(),
+        sync: match mode {
+            SyncMode::Interpolate => "interpolate".into(),
+            SyncMode::Nearest { tolerance_s } => format!("nearest (tolerance {tolerance_s:.3} s)"),
+        },
+        deskew: lidars.iter().any(|l| l.report.scans_deskewed > 0),
+        scans_read: read,
+        scans_used: lidars.iter().map(|l| l.report.scans_used).sum(),
+        scans_skipped: skipped,
+        scans_deskewed: lidars.iter().map(|l| l.report.scans_deskewed).sum(),
+        scans_reordered: lidars.iter().map(|l| l.report.scans_reordered).sum(),
+        sensors: bound
+            .lidars
+            .iter()
+            .map(|b| (b.lidar.name.clone(), format!("lidar {}", b.topic)))
+            .chain(bound.sensors.iter().map(|b| (b.sensor.name.clone(), format!("{} {}", b.sensor.kind.as_str(), b.topic))))
+            .collect(),
+        pose_track: chosen.counts.clone(),
+        scan_timing: first.timing,
+        pose_timing,
+        extrinsics: first.extrinsics.clone(),
+        estimator: chosen.estimator.clone(),
+        merge: merge.stats().to_vec(),
+        merge_peak_queued: merge.peak_queued(),
+        skipped_by_type: inv.stats.skipped_by_type.clone(),
+        malformed_records: inv.stats.malformed,
+        decode_s: inv.read_s,
+        track_s,
+        map_s,
+        lidars: lidars.into_iter().map(|l| l.report).collect(),
+    };
+    notes.extend(chosen.notes.iter().cloned());
+    Ok(MapRun { engine, format: inv.format, report, trajectory, notes })
+}
+
+/// Inserts released scans with their poses.
+struct Inserter<'a> {
+    engine: &'a mut Engine,
+    track: &'a Track,
+    mode: SyncMode,
+    deskew: bool,
+    scan: LaserScan,
+    last: Option<Stamp>,
+    line_trajectory: Vec<(Stamp, Pose2)>,
+}
+
+impl Inserter<'_> {
+    fn insert(&mut self, l: &mut Mapped, key: Stamp, msg: &ScanMessage) -> Result<(), PipelineError> {
+        // Angles at LaserScan's float32 precision whatever the format, so that the same
+        // scan read from CARMEN text or from a ROS message gives the same rays.
+        let scan = &mut self.scan;
+        scan.angle_min = msg.scan.angle_min as f32 as f64;
+        scan.angle_increment = msg.scan.angle_increment as f32 as f64;
+        scan.ranges.clone_from(&msg.scan.ranges);
+        let stamp = msg.scan.stamp;
+        match self.track {
+            Track::ScanLine => {
+                let Some(pose) = msg.pose.filter(|p| p.is_finite()) else {
+                    l.report.scans_skipped.no_pose_on_line += 1;
+                    return Ok(());
+                };
+                // Line poses do not depend on the stamp: applied in file order.
+                scan.stamp = self.last.map_or(stamp, |last| last.max(stamp));
+                self.engine.insert_scan_limited(l.id, scan, msg.range_min, msg.range_max, |_| pose)?;
+                self.line_trajectory.push((scan.stamp, pose));
+                self.last = Some(scan.stamp);
+            }
+            Track::Timed(track) => {
+                let t = key;
+                let pose = match track.pose_at(t, self.mode) {
+                    Ok(p) => p,
+                    Err(why) => {
+                        l.report.scans_skipped.count(why);
+                        return Ok(());
+                    }
+                };
+                scan.stamp = t;
+                let n = scan.ranges.len();
+                let ti = msg.time_increment as f64;
+                let can_deskew = self.deskew && self.mode == SyncMode::Interpolate && ti > 0.0 && n > 1;
+                let end = Stamp(t.0.saturating_add((ti * (n - 1) as f64 * 1e9) as i64));
+                if can_deskew && track.pose_at(end, SyncMode::Interpolate).is_ok() {
+                    l.report.scans_deskewed += 1;
+                    self.engine.insert_scan_limited(l.id, scan, msg.range_min, msg.range_max, |i| {
+                        let tb = Stamp(t.0.saturating_add((ti * i as f64 * 1e9) as i64));
+                        track.pose_at(tb, SyncMode::Interpolate).unwrap_or(pose)
+                    })?;
+                } else {
+                    self.engine.insert_scan_limited(l.id, scan, msg.range_min, msg.range_max, |_| pose)?;
+                }
+                self.last = Some(t);
+            }
+        }
+        l.report.scans_used += 1;
+        Ok(())
+    }
+}

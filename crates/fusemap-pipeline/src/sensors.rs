@@ -1,0 +1,147 @@
+//! Which of the log's topics feed which configured sensor.
+//!
+//! A sensor the config lists with a topic must find it in the log (a run that maps fewer
+//! sensors than configured refuses, naming the missing topic and the ones the log has).
+//! A kind the config does not list is looked for under its usual topic, then under the
+//! log's only topic of that kind (CARMEN logs: `FLASER`, `ROBOTLASER1`, `RAWLASER1` for
+//! the front laser, `ODOM`).
+
+use crate::PipelineError;
+use fusemap_core::config::{auto_sensor, Plan, PlannedLidar, PlannedSensor, SensorKind};
+use std::collections::BTreeMap;
+
+/// A lidar bound to its topic.
+#[derive(Clone, Debug)]
+pub struct BoundLidar {
+    /// The plan's lidar.
+    pub lidar: PlannedLidar,
+    /// The topic it reads.
+    pub topic: String,
+}
+
+/// A pose sensor bound to its topic.
+#[derive(Clone, Debug)]
+pub struct BoundSensor {
+    /// The plan's sensor.
+    pub sensor: PlannedSensor,
+    /// The topic it reads.
+    pub topic: String,
+}
+
+/// Every sensor of a run, bound to the log's topics.
+#[derive(Clone, Debug, Default)]
+pub struct Bound {
+    /// The lidars, all mapped.
+    pub lidars: Vec<BoundLidar>,
+    /// The other sensors.
+    pub sensors: Vec<BoundSensor>,
+    /// What a user should know about the binding.
+    pub notes: Vec<String>,
+}
+
+impl Bound {
+    /// The first bound sensor of `kind`.
+    pub fn first(&self, kind: SensorKind) -> Option<&BoundSensor> {
+        self.sensors.iter().find(|s| s.sensor.kind == kind)
+    }
+}
+
+/// Binds the plan's sensors to `topics` (topic name → message count, per kind).
+pub fn bind(plan: &Plan, topics: &BTreeMap<SensorKind, BTreeMap<String, u64>>) -> Result<Bound, PipelineError> {
+    let mut out = Bound::default();
+    let empty = BTreeMap::new();
+    let of = |k: SensorKind| topics.get(&k).unwrap_or(&empty);
+    let list = |k: SensorKind| {
+        let v: Vec<&str> = of(k).keys().map(String::as_str).collect();
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.join(", ")
+        }
+    };
+    for l in &plan.lidars {
+        let scans = of(SensorKind::Lidar);
+        let topic = match &l.topic {
+            Some(t) if scans.contains_key(t) => t.clone(),
+            Some(t) => {
+                return Err(PipelineError::Refused(format!(
+                    "lidar `{}`: topic `{t}` is not in the log (its scan topics: {})",
+                    l.name,
+                    list(SensorKind::Lidar)
+                )))
+            }
+            None => auto_topic(SensorKind::Lidar, scans).ok_or_else(|| match scans.len() {
+                0 => PipelineError::Refused("the log holds no laser scans".into()),
+                _ => PipelineError::Refused(format!(
+                    "the log has several scan topics ({}) and none is `/scan`: list the lidars as \
+                     [[sensor]] tables with kind = \"lidar\" and their topics",
+                    list(SensorKind::Lidar)
+                )),
+            })?,
+        };
+        if out.lidars.iter().any(|b| b.topic == topic) {
+            return Err(PipelineError::Refused(format!("two lidars read topic `{topic}`: give each its own topic")));
+        }
+        out.lidars.push(BoundLidar { lidar: l.clone(), topic });
+    }
+    let scan_topics = of(SensorKind::Lidar);
+    if plan.lidars.iter().all(|l| l.topic.is_none()) && scan_topics.len() > out.lidars.len() {
+        let unused: Vec<&str> =
+            scan_topics.keys().filter(|t| !out.lidars.iter().any(|b| &b.topic == *t)).map(String::as_str).collect();
+        out.notes.push(format!("scan topics not mapped (list them as [[sensor]] lidars to map them): {}", unused.join(", ")));
+    }
+    for kind in [SensorKind::WheelOdometry, SensorKind::Imu, SensorKind::Gnss, SensorKind::Pose] {
+        let listed = plan.sensors.iter().filter(|s| s.kind == kind);
+        let mut any = false;
+        for s in listed {
+            any = true;
+            let topic = match &s.topic {
+                Some(t) if of(kind).contains_key(t) => t.clone(),
+                Some(t) => {
+                    return Err(PipelineError::Refused(format!(
+                        "{} sensor `{}`: topic `{t}` is not in the log (its {} topics: {})",
+                        kind.as_str(),
+                        s.name,
+                        kind.as_str(),
+                        list(kind)
+                    )))
+                }
+                None => auto_topic(kind, of(kind)).ok_or_else(|| {
+                    PipelineError::Refused(format!(
+                        "{} sensor `{}`: no topic given and the log has no `{}` (its {} topics: {})",
+                        kind.as_str(),
+                        s.name,
+                        kind.default_topic(),
+                        kind.as_str(),
+                        list(kind)
+                    ))
+                })?,
+            };
+            out.sensors.push(BoundSensor { sensor: s.clone(), topic });
+        }
+        // A kind listed only as disabled is off, auto-detection included.
+        if any || plan.disabled_kinds.contains(&kind) {
+            continue;
+        }
+        if let (Some(topic), Some(sensor)) = (auto_topic(kind, of(kind)), auto_sensor(kind)) {
+            out.sensors.push(BoundSensor { sensor, topic });
+        }
+    }
+    Ok(out)
+}
+
+/// The usual topic of `kind`, else CARMEN's name for it, else the only topic.
+fn auto_topic(kind: SensorKind, topics: &BTreeMap<String, u64>) -> Option<String> {
+    if topics.contains_key(kind.default_topic()) {
+        return Some(kind.default_topic().to_string());
+    }
+    let carmen: &[&str] = match kind {
+        SensorKind::Lidar => &["FLASER", "ROBOTLASER1", "RAWLASER1"],
+        SensorKind::WheelOdometry => &["ODOM"],
+        _ => &[],
+    };
+    if let Some(t) = carmen.iter().find(|t| topics.contains_key(**t)) {
+        return Some(t.to_string());
+    }
+    (topics.len() == 1).then(|| topics.keys().next().cloned()).flatten()
+}

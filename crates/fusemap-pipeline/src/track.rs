@@ -1,0 +1,193 @@
+//! Choosing and building the pose track a run maps with.
+//!
+//! `pose_source = "auto"` takes, in order: poses written on the scan lines (CARMEN
+//! corrected logs), the estimator when the log carries an IMU, GNSS or absolute poses next
+//! to its odometry, the odometry alone, dynamic TF to the base frame. With odometry alone,
+//! `map = odom` (identity `map_from_odom`); the estimator gives `map_from_base` directly.
+//!
+//! With a pose track (odometry or TF), samples are taken in header-stamp order (the design
+//! document's "time-sorted odometry and scans", §4.1), not in the order the log holds them:
+//! a sample that arrives after a later-stamped one is still good data at its own stamp.
+
+use crate::recording::Inventory;
+use crate::sensors::Bound;
+use crate::PipelineError;
+use fusemap_core::config::{LogConfig, PoseSource, SensorKind};
+use fusemap_core::geometry::{Mount3, Pose2};
+use fusemap_core::time::{PoseBuffer, PoseTrack, PushOutcome, Stamp};
+use serde::Serialize;
+
+/// Counters of the pose track.
+#[derive(Debug, Default, Clone, Serialize)]
+pub struct TrackCounts {
+    /// Samples offered.
+    pub samples: u64,
+    /// Samples kept.
+    pub used: u64,
+    /// Same stamp as an earlier sample (the first one is kept).
+    pub duplicates: u64,
+    /// Arrived after a sample with a later stamp: put back in stamp order and used.
+    pub reordered: u64,
+    /// NaN or infinite poses (a zero quaternion among them).
+    pub not_finite: u64,
+}
+
+/// Where scans get their poses.
+pub enum Track {
+    /// From each scan line (CARMEN corrected logs).
+    ScanLine,
+    /// From a time-indexed track.
+    Timed(Box<dyn PoseTrack>),
+}
+
+/// The chosen track.
+pub struct ChosenTrack {
+    /// The source, resolved from `auto`.
+    pub source: PoseSource,
+    /// The track.
+    pub track: Track,
+    /// A name for reports (`odometry `/odom``).
+    pub name: String,
+    /// Its counters.
+    pub counts: TrackCounts,
+    /// The header stamps of the stream the track was built from (for the timing report).
+    pub stamps: Vec<Stamp>,
+    /// … and their receive stamps.
+    pub receive: Vec<Option<Stamp>>,
+    /// The estimator's report, when it made the track.
+    pub estimator: Option<serde_json::Value>,
+    /// Facts about the track a user should know.
+    pub notes: Vec<String>,
+}
+
+/// How many of `stamps` (in log order) come after a later stamp.
+pub fn count_reordered(stamps: impl IntoIterator<Item = Stamp>) -> u64 {
+    let mut latest: Option<Stamp> = None;
+    let mut n = 0;
+    for s in stamps {
+        match latest {
+            Some(l) if s < l => n += 1,
+            _ => latest = Some(s),
+        }
+    }
+    n
+}
+
+/// A buffer of `samples` put in stamp order (stable: equal stamps keep their log order, and
+/// the first one is used).
+pub fn buffer_of(cfg: &LogConfig, samples: Vec<(Stamp, Pose2)>, counts: &mut TrackCounts) -> PoseBuffer {
+    let mut buffer = PoseBuffer::new(cfg.max_pose_gap_s)
+        .bridging_gaps(cfg.gap_bridge_motion_m, cfg.gap_bridge_motion_deg.to_radians());
+    counts.samples += samples.len() as u64;
+    counts.reordered += count_reordered(samples.iter().map(|s| s.0));
+    let mut samples = samples;
+    samples.sort_by_key(|s| s.0);
+    for (stamp, pose) in samples {
+        match buffer.push(stamp, pose) {
+            PushOutcome::Added => counts.used += 1,
+            PushOutcome::Duplicate | PushOutcome::OutOfOrder => counts.duplicates += 1,
+            PushOutcome::NotFinite => counts.not_finite += 1,
+        }
+    }
+    buffer
+}
+
+/// Whether the log carries a sensor the estimator fuses beyond odometry.
+pub fn has_fusion_sensors(bound: &Bound) -> bool {
+    [SensorKind::Imu, SensorKind::Gnss, SensorKind::Pose].iter().any(|k| bound.first(*k).is_some())
+}
+
+/// Chooses and builds the pose track of a run. `estimate` builds the estimator's track
+/// when the source is the estimator.
+pub fn choose(
+    inv: &Inventory,
+    cfg: &LogConfig,
+    bound: &Bound,
+    estimate: impl FnOnce() -> Result<ChosenTrack, PipelineError>,
+) -> Result<ChosenTrack, PipelineError> {
+    let lines_have_poses = bound.lidars.iter().any(|l| inv.scans.get(&l.topic).is_some_and(|t| t.with_pose > 0));
+    let odom = bound.first(SensorKind::WheelOdometry);
+    let tf_samples: Vec<(Stamp, Pose2)> = inv
+        .tf_dynamic
+        .iter()
+        .filter(|t| t.child == cfg.base_frame)
+        .map(|t| {
+            let m = Mount3::from_translation_quaternion(t.translation, t.rotation);
+            (t.stamp, Pose2::new(m.x, m.y, m.yaw))
+        })
+        .collect();
+    let source = match cfg.pose_source {
+        PoseSource::Auto if lines_have_poses => PoseSource::ScanLine,
+        PoseSource::Auto if has_fusion_sensors(bound) => PoseSource::Estimator,
+        PoseSource::Auto if odom.is_some() => PoseSource::Odometry,
+        PoseSource::Auto if !tf_samples.is_empty() => PoseSource::Tf,
+        PoseSource::Auto => {
+            return Err(PipelineError::Refused(format!(
+                "the log has no poses: no pose on scan lines, no odometry topic, no TF to `{}`",
+                cfg.base_frame
+            )))
+        }
+        s => s,
+    };
+    let mut counts = TrackCounts::default();
+    match source {
+        PoseSource::ScanLine => {
+            if !lines_have_poses {
+                return Err(PipelineError::Refused("log.pose_source = \"scan_line\" but the scans carry no pose".into()));
+            }
+            Ok(ChosenTrack {
+                source,
+                track: Track::ScanLine,
+                name: "pose on each scan line".into(),
+                counts,
+                stamps: Vec::new(),
+                receive: Vec::new(),
+                estimator: None,
+                notes: Vec::new(),
+            })
+        }
+        PoseSource::Odometry => {
+            let Some(o) = odom else {
+                return Err(PipelineError::Refused(
+                    "log.pose_source = \"odometry\" but the log has no odometry topic".into(),
+                ));
+            };
+            let msgs = &inv.odom[&o.topic];
+            let off = crate::offset_ns(o.sensor.time_offset_s);
+            let buffer =
+                buffer_of(cfg, msgs.iter().map(|m| (Stamp(m.stamp.0.saturating_add(off)), m.pose)).collect(), &mut counts);
+            if buffer.is_empty() {
+                return Err(PipelineError::Refused(format!("the odometry `{}` holds no usable pose", o.topic)));
+            }
+            Ok(ChosenTrack {
+                source,
+                track: Track::Timed(Box::new(buffer)),
+                name: format!("odometry `{}`", o.topic),
+                counts,
+                stamps: msgs.iter().map(|m| m.stamp).collect(),
+                receive: msgs.iter().map(|m| m.receive_stamp).collect(),
+                estimator: None,
+                notes: Vec::new(),
+            })
+        }
+        PoseSource::Tf => {
+            let stamps: Vec<Stamp> = tf_samples.iter().map(|s| s.0).collect();
+            let buffer = buffer_of(cfg, tf_samples, &mut counts);
+            if buffer.is_empty() {
+                return Err(PipelineError::Refused(format!("no usable TF pose of `{}`", cfg.base_frame)));
+            }
+            Ok(ChosenTrack {
+                source,
+                track: Track::Timed(Box::new(buffer)),
+                name: format!("TF `… → {}`", cfg.base_frame),
+                counts,
+                receive: vec![None; stamps.len()],
+                stamps,
+                estimator: None,
+                notes: Vec::new(),
+            })
+        }
+        PoseSource::Estimator => estimate(),
+        PoseSource::Auto => unreachable!("resolved above"),
+    }
+}
