@@ -70,7 +70,9 @@ pub enum FrameError {
     },
     /// The quaternion is too far from unit length to be a rotation written with rounding
     /// errors (tf2 refuses these as well rather than guess what was meant).
-    #[error("transform {parent} → {child}: quaternion has squared norm {norm_squared:.6}, not within {tolerance} of 1")]
+    #[error(
+        "transform {parent} → {child}: quaternion has squared norm {norm_squared:.6}, not within {tolerance} of 1"
+    )]
     NotUnitQuaternion {
         /// Parent frame.
         parent: String,

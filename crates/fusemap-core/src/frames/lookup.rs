@@ -37,7 +37,9 @@ impl FrameTree {
     pub fn lookup_static(&self, target: &str, source: &str) -> Result<Pose3, LookupError> {
         self.resolve(target, source, |edge| match &edge.data {
             EdgeData::Static(pose) => Ok(*pose),
-            EdgeData::Dynamic(_) => Err(self.edge_error(edge, |parent, child| LookupError::DynamicEdge { parent, child })),
+            EdgeData::Dynamic(_) => {
+                Err(self.edge_error(edge, |parent, child| LookupError::DynamicEdge { parent, child }))
+            }
         })
     }
 
@@ -124,7 +126,9 @@ impl FrameTree {
                 self.edge_error(edge, |parent, child| match miss {
                     Miss::Before(ns) => LookupError::BeforeSamples { parent, child, by_s: seconds(ns) },
                     Miss::After(ns) => LookupError::AfterSamples { parent, child, by_s: seconds(ns) },
-                    Miss::Gap(ns) => LookupError::Gap { parent, child, gap_s: seconds(ns), limit_s: self.limits.max_gap_s },
+                    Miss::Gap(ns) => {
+                        LookupError::Gap { parent, child, gap_s: seconds(ns), limit_s: self.limits.max_gap_s }
+                    }
                 })
             }),
         }

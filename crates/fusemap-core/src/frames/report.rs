@@ -223,7 +223,12 @@ impl Tally {
                 r.loops += 1;
                 self.loops
                     .entry((parent.clone(), child.clone()))
-                    .or_insert_with(|| LoopEntry { parent: parent.clone(), child: child.clone(), cycle: cycle.clone(), count: 0 })
+                    .or_insert_with(|| LoopEntry {
+                        parent: parent.clone(),
+                        child: child.clone(),
+                        cycle: cycle.clone(),
+                        count: 0,
+                    })
                     .count += 1;
             }
             Err(FrameError::KindClash { parent, child, existing, .. }) => {
@@ -250,16 +255,15 @@ impl Tally {
     }
 
     fn conflict(&mut self, parent: &str, child: &str, kind: EdgeKind, translation_m: f64, rotation_deg: f64) {
-        let entry = self.conflicts.entry(((parent.to_owned(), child.to_owned()), kind)).or_insert_with(|| {
-            ConflictEntry {
+        let entry =
+            self.conflicts.entry(((parent.to_owned(), child.to_owned()), kind)).or_insert_with(|| ConflictEntry {
                 parent: parent.to_owned(),
                 child: child.to_owned(),
                 kind,
                 count: 0,
                 max_translation_m: 0.0,
                 max_rotation_deg: 0.0,
-            }
-        });
+            });
         entry.count += 1;
         entry.max_translation_m = entry.max_translation_m.max(translation_m);
         entry.max_rotation_deg = entry.max_rotation_deg.max(rotation_deg);

@@ -127,7 +127,12 @@ impl FrameTree {
     }
 
     /// Adds a static transform `parent_from_child` (from `/tf_static`).
-    pub fn add_static(&mut self, parent: &str, child: &str, parent_from_child: Pose3) -> Result<AddOutcome, FrameError> {
+    pub fn add_static(
+        &mut self,
+        parent: &str,
+        child: &str,
+        parent_from_child: Pose3,
+    ) -> Result<AddOutcome, FrameError> {
         let result = self.add(EdgeKind::Static, Stamp::ZERO, parent, child, parent_from_child);
         self.tally.record(EdgeKind::Static, &result);
         result
