@@ -106,6 +106,13 @@ fn long_gaps_are_refused() {
     assert!(matches!(e, LookupError::Gap { gap_s, limit_s, .. } if (gap_s - 0.3).abs() < 1e-12 && limit_s == 0.15));
     // The samples at the gap's ends are exact, not interpolated.
     assert!(tf.lookup("odom", "base_link", Stamp(400 * MS)).is_ok());
+    for exact_only in [0.0, -1.0, f64::NAN] {
+        let mut tf = FrameTree::new(FrameTreeLimits { max_gap_s: exact_only, ..limits });
+        tf.add_dynamic(Stamp(0), "a", "b", planar(0.0, 0.0, 0.0)).unwrap();
+        tf.add_dynamic(Stamp(10), "a", "b", planar(1.0, 0.0, 0.0)).unwrap();
+        assert!(tf.lookup("a", "b", Stamp(10)).is_ok());
+        assert!(matches!(tf.lookup("a", "b", Stamp(5)), Err(LookupError::Gap { .. })), "{exact_only}");
+    }
     let unlimited = FrameTreeLimits { max_gap_s: f64::INFINITY, ..limits };
     let mut tf = FrameTree::new(unlimited);
     tf.add_dynamic(Stamp(0), "a", "b", planar(0.0, 0.0, 0.0)).unwrap();

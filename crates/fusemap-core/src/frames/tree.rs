@@ -6,16 +6,18 @@ use super::samples::{self, Inserted, Samples};
 use super::{AddOutcome, EdgeKind, FrameError};
 use crate::geometry::Pose3;
 use crate::time::Stamp;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
 /// The tolerances a [`FrameTree`] applies.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct FrameTreeLimits {
     /// Longest interval between two samples of a dynamic edge that a lookup interpolates
     /// across, seconds (infinite: any). Interpolating over a long silence invents a
     /// straight-line motion the robot may not have made; the default matches the
-    /// configuration's `log.max_pose_gap_s`.
+    /// configuration's `log.max_pose_gap_s`. Zero, negative or NaN: only stamps that
+    /// fall exactly on a sample are answered.
     pub max_gap_s: f64,
     /// Largest accepted `|x² + y² + z² + w² − 1|` of an incoming quaternion (tf2 uses
     /// 0.01). Accepted quaternions are normalised; others are refused.
