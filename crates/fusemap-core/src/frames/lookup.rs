@@ -26,8 +26,8 @@ impl FrameTree {
     /// `target_from_source` at `stamp`: maps points in `source` into `target`. Dynamic
     /// edges are interpolated between the samples around the stamp (linear translation,
     /// slerp rotation), static edges hold at every stamp. A stamp outside an edge's
-    /// samples, or inside a gap longer than [`super::FrameTreeLimits::max_gap_s`], is an
-    /// error: never an extrapolation.
+    /// samples, or inside a gap longer than [`super::FrameTreeLimits::max_gap_s`] (and
+    /// not bridged), is an error: never an extrapolation.
     pub fn lookup(&self, target: &str, source: &str, stamp: Stamp) -> Result<Pose3, LookupError> {
         self.resolve(target, source, |edge| self.edge_at(edge, stamp))
     }
@@ -122,7 +122,7 @@ impl FrameTree {
     fn edge_at(&self, edge: &Edge, stamp: Stamp) -> Result<Pose3, LookupError> {
         match &edge.data {
             EdgeData::Static(pose) => Ok(*pose),
-            EdgeData::Dynamic(samples) => samples.at(stamp, self.max_gap_ns).map_err(|miss| {
+            EdgeData::Dynamic(samples) => samples.at(stamp, &self.gaps).map_err(|miss| {
                 self.edge_error(edge, |parent, child| match miss {
                     Miss::Before(ns) => LookupError::BeforeSamples { parent, child, by_s: seconds(ns) },
                     Miss::After(ns) => LookupError::AfterSamples { parent, child, by_s: seconds(ns) },

@@ -52,6 +52,40 @@ pub(super) enum Miss {
     Gap(i128),
 }
 
+/// When the interval between two samples is too long to interpolate across.
+///
+/// The error of interpolating over a silence is bounded by the motion over it, not by
+/// its length: odometry drivers and CARMEN loggers go quiet while the robot stands (the
+/// Intel bag's `odom → base_link` pauses longer than 0.5 s before 15 % of its scans), so
+/// a long gap whose two ends differ by at most the bridge motion is interpolated like a
+/// short one (as [`crate::time::PoseBuffer::bridging_gaps`] does for planar poses).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct GapRule {
+    /// Longest interval interpolated whatever the motion, nanoseconds.
+    pub(super) max_gap_ns: i128,
+    /// Longer intervals are interpolated when the ends are at most this far apart, metres
+    /// (negative: never) …
+    pub(super) bridge_m: f64,
+    /// … and their rotations at most this far apart, radians.
+    pub(super) bridge_rad: f64,
+}
+
+impl GapRule {
+    /// Interpolation across `max_gap_ns` at most, no bridging.
+    #[cfg(test)]
+    pub(super) fn max_gap(max_gap_ns: i128) -> Self {
+        Self { max_gap_ns, bridge_m: -1.0, bridge_rad: -1.0 }
+    }
+
+    fn allows(&self, gap_ns: i128, a: &Pose3, b: &Pose3) -> bool {
+        if gap_ns <= self.max_gap_ns {
+            return true;
+        }
+        let (dt, dr) = difference(a, b);
+        dt <= self.bridge_m && dr <= self.bridge_rad
+    }
+}
+
 /// Samples of one edge, sorted by stamp, one per stamp. Never empty once created.
 #[derive(Clone, Debug)]
 pub(super) struct Samples {
@@ -103,8 +137,8 @@ impl Samples {
     }
 
     /// The transform at `stamp`: a held sample, or the interpolation (linear translation,
-    /// slerp rotation) between the two around it when they are at most `max_gap_ns` apart.
-    pub(super) fn at(&self, stamp: Stamp, max_gap_ns: i128) -> Result<Pose3, Miss> {
+    /// slerp rotation) between the two around it when `rule` allows their gap.
+    pub(super) fn at(&self, stamp: Stamp, rule: &GapRule) -> Result<Pose3, Miss> {
         let (first, last) = self.span();
         if stamp < first {
             return Err(Miss::Before(first.0 as i128 - stamp.0 as i128));
@@ -120,11 +154,12 @@ impl Samples {
         // stamp > first, so i >= 1.
         let (t0, t1) = (self.stamps[i - 1].0 as i128, self.stamps[i].0 as i128);
         let gap = t1 - t0;
-        if gap > max_gap_ns {
+        let (a, b) = (&self.poses[i - 1], &self.poses[i]);
+        if !rule.allows(gap, a, b) {
             return Err(Miss::Gap(gap));
         }
         let f = (stamp.0 as i128 - t0) as f64 / gap as f64;
-        Ok(self.poses[i - 1].interpolate(&self.poses[i], f))
+        Ok(a.interpolate(b, f))
     }
 }
 
@@ -141,16 +176,31 @@ mod tests {
     fn interpolates_at_the_midpoint_and_refuses_outside() {
         let mut s = Samples::new(Stamp(1_000), yaw(1.0, 0.2));
         assert_eq!(s.insert(Stamp(2_000), yaw(3.0, 0.6)), Inserted::Appended);
-        let m = s.at(Stamp(1_500), i128::MAX).unwrap().to_mount();
+        let m = s.at(Stamp(1_500), &GapRule::max_gap(i128::MAX)).unwrap().to_mount();
         assert!((m.x - 2.0).abs() < 1e-12 && (m.yaw - 0.4).abs() < 1e-12, "{m:?}");
-        let q = s.at(Stamp(1_250), i128::MAX).unwrap().to_mount();
+        let q = s.at(Stamp(1_250), &GapRule::max_gap(i128::MAX)).unwrap().to_mount();
         assert!((q.x - 1.5).abs() < 1e-12 && (q.yaw - 0.3).abs() < 1e-12, "{q:?}");
-        assert_eq!(s.at(Stamp(1_000), 0), Ok(yaw(1.0, 0.2)));
-        assert_eq!(s.at(Stamp(2_000), 0), Ok(yaw(3.0, 0.6)));
-        assert_eq!(s.at(Stamp(999), i128::MAX), Err(Miss::Before(1)));
-        assert_eq!(s.at(Stamp(2_003), i128::MAX), Err(Miss::After(3)));
-        assert_eq!(s.at(Stamp(1_500), 999), Err(Miss::Gap(1_000)));
-        assert!(s.at(Stamp(1_500), 1_000).is_ok());
+        assert_eq!(s.at(Stamp(1_000), &GapRule::max_gap(0)), Ok(yaw(1.0, 0.2)));
+        assert_eq!(s.at(Stamp(2_000), &GapRule::max_gap(0)), Ok(yaw(3.0, 0.6)));
+        assert_eq!(s.at(Stamp(999), &GapRule::max_gap(i128::MAX)), Err(Miss::Before(1)));
+        assert_eq!(s.at(Stamp(2_003), &GapRule::max_gap(i128::MAX)), Err(Miss::After(3)));
+        assert_eq!(s.at(Stamp(1_500), &GapRule::max_gap(999)), Err(Miss::Gap(1_000)));
+        assert!(s.at(Stamp(1_500), &GapRule::max_gap(1_000)).is_ok());
+    }
+
+    #[test]
+    fn long_gaps_are_bridged_only_over_small_motion() {
+        let mut s = Samples::new(Stamp(0), yaw(1.0, 0.3));
+        s.insert(Stamp(3_000), yaw(1.0004, 0.31));
+        s.insert(Stamp(6_000), yaw(1.5, 0.31));
+        s.insert(Stamp(9_000), yaw(1.5, 0.5));
+        let rule = GapRule { max_gap_ns: 1_000, bridge_m: 0.01, bridge_rad: 0.02 };
+        let m = s.at(Stamp(1_500), &rule).unwrap().to_mount();
+        assert!((m.x - 1.0002).abs() < 1e-12 && (m.yaw - 0.305).abs() < 1e-12, "{m:?}");
+        // Moved 0.5 m, then turned 0.19 rad, during the next two pauses: refused.
+        assert_eq!(s.at(Stamp(4_500), &rule), Err(Miss::Gap(3_000)));
+        assert_eq!(s.at(Stamp(7_500), &rule), Err(Miss::Gap(3_000)));
+        assert_eq!(s.at(Stamp(1_500), &GapRule::max_gap(1_000)), Err(Miss::Gap(3_000)));
     }
 
     #[test]
@@ -160,7 +210,7 @@ mod tests {
         let Inserted::Conflict(dt, dr) = s.insert(Stamp(0), yaw(1.5, 0.1)) else { panic!("conflict expected") };
         assert!((dt - 0.5).abs() < 1e-12 && (dr - 0.1).abs() < 1e-12);
         assert_eq!(s.len(), 1);
-        assert_eq!(s.at(Stamp(0), 0), Ok(yaw(1.0, 0.0)));
+        assert_eq!(s.at(Stamp(0), &GapRule::max_gap(0)), Ok(yaw(1.0, 0.0)));
     }
 
     #[test]
@@ -168,9 +218,9 @@ mod tests {
         let mut s = Samples::new(Stamp(i64::MIN), yaw(0.0, 0.0));
         s.insert(Stamp(i64::MAX), yaw(2.0, 0.0));
         assert_eq!(s.longest_gap_ns(), u64::MAX as i128);
-        let m = s.at(Stamp(0), i128::MAX).unwrap();
+        let m = s.at(Stamp(0), &GapRule::max_gap(i128::MAX)).unwrap();
         assert!((m.translation[0] - 1.0).abs() < 1e-9);
-        assert_eq!(s.at(Stamp(0), 10), Err(Miss::Gap(u64::MAX as i128)));
+        assert_eq!(s.at(Stamp(0), &GapRule::max_gap(10)), Err(Miss::Gap(u64::MAX as i128)));
     }
 
     proptest! {
@@ -190,7 +240,7 @@ mod tests {
             // Each pose was x = stamp: interpolation anywhere inside reproduces x = t.
             let (lo, hi) = s.span();
             for t in lo.0..=hi.0 {
-                let p = s.at(Stamp(t), i128::MAX).unwrap();
+                let p = s.at(Stamp(t), &GapRule::max_gap(i128::MAX)).unwrap();
                 prop_assert!((p.translation[0] - t as f64).abs() < 1e-9);
             }
         }

@@ -113,6 +113,16 @@ fn long_gaps_are_refused() {
         assert!(tf.lookup("a", "b", Stamp(10)).is_ok());
         assert!(matches!(tf.lookup("a", "b", Stamp(5)), Err(LookupError::Gap { .. })), "{exact_only}");
     }
+    // A 3 s pause while standing (1 cm, 1°) is bridged by default, not when disabled.
+    let mut tf = FrameTree::default();
+    tf.add_dynamic(Stamp(0), "odom", "base_link", planar(2.0, 1.0, 0.0)).unwrap();
+    tf.add_dynamic(Stamp(3_000 * MS), "odom", "base_link", planar(2.01, 1.0, 1f64.to_radians())).unwrap();
+    let m = pose2(&tf.lookup("odom", "base_link", Stamp(1_500 * MS)).unwrap());
+    assert!((m.x - 2.005).abs() < 1e-12 && (m.theta - 0.5f64.to_radians()).abs() < 1e-12, "{m:?}");
+    let mut strict = FrameTree::new(FrameTreeLimits { bridge_motion_m: -1.0, ..FrameTreeLimits::default() });
+    strict.add_dynamic(Stamp(0), "odom", "base_link", planar(2.0, 1.0, 0.0)).unwrap();
+    strict.add_dynamic(Stamp(3_000 * MS), "odom", "base_link", planar(2.01, 1.0, 1f64.to_radians())).unwrap();
+    assert!(matches!(strict.lookup("odom", "base_link", Stamp(1_500 * MS)), Err(LookupError::Gap { .. })));
     let unlimited = FrameTreeLimits { max_gap_s: f64::INFINITY, ..limits };
     let mut tf = FrameTree::new(unlimited);
     tf.add_dynamic(Stamp(0), "a", "b", planar(0.0, 0.0, 0.0)).unwrap();
@@ -247,6 +257,19 @@ fn non_finite_and_bad_quaternions_are_refused_without_a_trace() {
     let near = Pose3 { translation: [0.0; 3], rotation: [0.0, 0.0, 0.0, 0.999] };
     tf.add_static("a", "b", near).unwrap();
     assert_eq!(tf.lookup_static("a", "b").unwrap().rotation, [0.0, 0.0, 0.0, 1.0]);
+}
+
+#[test]
+fn one_leading_slash_is_ignored_everywhere() {
+    let mut tf = FrameTree::default();
+    tf.add_static("/base_link", "laser", planar(0.2, 0.0, 0.0)).unwrap();
+    tf.add_static("base_link", "/laser", planar(0.2, 0.0, 0.0)).unwrap();
+    tf.add_static("//odd", "base_link", planar(1.0, 0.0, 0.0)).unwrap();
+    assert_eq!(tf.frames().collect::<Vec<_>>(), ["base_link", "laser", "/odd"]);
+    assert_eq!(tf.parent("/base_link"), Some("/odd"));
+    assert!(tf.lookup_static("//odd", "/laser").is_ok());
+    assert!(!tf.contains("odd"));
+    assert_eq!(tf.accepted().identical_static_duplicates, 1);
 }
 
 #[test]

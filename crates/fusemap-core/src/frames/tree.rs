@@ -2,7 +2,7 @@
 
 use super::check;
 use super::report::Tally;
-use super::samples::{self, Inserted, Samples};
+use super::samples::{self, GapRule, Inserted, Samples};
 use super::{AddOutcome, EdgeKind, FrameError};
 use crate::geometry::Pose3;
 use crate::time::Stamp;
@@ -17,8 +17,15 @@ pub struct FrameTreeLimits {
     /// across, seconds (infinite: any). Interpolating over a long silence invents a
     /// straight-line motion the robot may not have made; the default matches the
     /// configuration's `log.max_pose_gap_s`. Zero, negative or NaN: only stamps that
-    /// fall exactly on a sample are answered.
+    /// fall exactly on a sample are answered (unless bridged, below).
     pub max_gap_s: f64,
+    /// Also interpolate across a longer gap when its two samples' translations are at most
+    /// this far apart, metres (negative: never). A robot standing still makes long silent
+    /// gaps with nothing to invent in them; default as `log.gap_bridge_motion_m`.
+    pub bridge_motion_m: f64,
+    /// … and their rotations at most this far apart, degrees (default as
+    /// `log.gap_bridge_motion_deg`).
+    pub bridge_motion_deg: f64,
     /// Largest accepted `|x² + y² + z² + w² − 1|` of an incoming quaternion (tf2 uses
     /// 0.01). Accepted quaternions are normalised; others are refused.
     pub quaternion_norm_tolerance: f64,
@@ -26,7 +33,7 @@ pub struct FrameTreeLimits {
 
 impl Default for FrameTreeLimits {
     fn default() -> Self {
-        Self { max_gap_s: 0.5, quaternion_norm_tolerance: 0.01 }
+        Self { max_gap_s: 0.5, bridge_motion_m: 0.05, bridge_motion_deg: 2.0, quaternion_norm_tolerance: 0.01 }
     }
 }
 
@@ -85,8 +92,8 @@ impl Edge {
 #[derive(Clone, Debug)]
 pub struct FrameTree {
     pub(super) limits: FrameTreeLimits,
-    /// `max_gap_s` in nanoseconds.
-    pub(super) max_gap_ns: i128,
+    /// The limits' gap rule in the units the samples use.
+    pub(super) gaps: GapRule,
     /// Frame names by id.
     pub(super) names: Vec<String>,
     /// Frame ids by name.
@@ -112,9 +119,12 @@ impl FrameTree {
             // Saturating float → integer conversion: +inf becomes i128::MAX.
             (limits.max_gap_s * 1e9).max(0.0) as i128
         };
+        // A NaN bridge compares false: never bridges.
+        let gaps =
+            GapRule { max_gap_ns, bridge_m: limits.bridge_motion_m, bridge_rad: limits.bridge_motion_deg.to_radians() };
         Self {
             limits,
-            max_gap_ns,
+            gaps,
             names: Vec::new(),
             index: HashMap::new(),
             parent_edge: Vec::new(),
@@ -208,7 +218,8 @@ impl FrameTree {
             let (parent, child) = names();
             return Err(FrameError::Loop { cycle: vec![child.clone(), child.clone()], parent, child });
         }
-        let (p, c) = (self.id(parent), self.id(child));
+        // Already cleaned: look up as they are (a second `/` stays part of the name).
+        let (p, c) = (self.index.get(parent).copied(), self.index.get(child).copied());
         if let Some(e) = c.and_then(|c| self.parent_edge[c]) {
             if Some(self.edges[e].parent) != p {
                 return Err(FrameError::TwoParents {
