@@ -31,6 +31,7 @@
 #![warn(missing_docs)]
 
 pub mod config;
+pub mod frames;
 pub mod fusion;
 pub mod geometry;
 pub mod grid;
