@@ -16,6 +16,25 @@
 //! Every sensor stamps with its own clock: `true time + time_offset_s`.
 //! The same scenario (same `world.seed`) always gives the same recording.
 //!
+//! A scenario file overrides only what it names; a list it names (`[[world.objects]]`,
+//! `[[gnss.zones]]`, `world.grooves`, `robot.waypoints`) replaces the default list whole:
+//!
+//! ```toml
+//! [world]
+//! seed = 7
+//! [robot]
+//! duration_s = 240.0
+//! [lidar]
+//! glass_pass_probability = 0.8
+//! time_offset_s = 0.03          # the scan stamps lag the truth by 30 ms
+//! [gnss]
+//! dropout_mode = "no_fix"       # publish NO_FIX instead of nothing
+//! [[gnss.zones]]
+//! name = "loading_bay"
+//! kind = "degraded"             # or "dropout"
+//! area = { min = [20.0, 0.0], max = [30.0, 9.0] }
+//! ```
+//!
 //! ```
 //! use fusemap_core::sim::production::{simulate, Scenario};
 //! let mut scenario = Scenario::default();
@@ -38,7 +57,6 @@ mod world;
 #[cfg(test)]
 mod tests;
 
-pub use gnss::GnssOutput;
 pub use imu::STANDARD_GRAVITY;
 pub use lidar::LidarStats;
 pub use messages::{

@@ -155,7 +155,9 @@ impl Trajectory {
     /// step's exact arc, speeds are the step's constant command.
     pub fn sample_at(&self, t: f64) -> TruthSample {
         let last = self.samples.len().saturating_sub(1);
-        let k = ((t * TRUTH_RATE_HZ).floor().max(0.0) as usize).min(last);
+        // The nudge keeps a time on a step boundary (0.29 s · 200 = 57.999…) in the step it
+        // starts rather than the one before.
+        let k = ((t * TRUTH_RATE_HZ + 1e-6).floor().max(0.0) as usize).min(last);
         let s = self.samples[k];
         let dt = (t - s.t).clamp(0.0, 1.0 / TRUTH_RATE_HZ);
         TruthSample { t, pose: unicycle_step(s.pose, s.v, s.omega, dt), ..s }

@@ -389,3 +389,48 @@ fn invalid_scenarios_are_refused_and_generation_is_quick() {
         t.elapsed().as_secs_f64()
     );
 }
+
+#[test]
+fn time_offsets_move_stamps_not_measurements() {
+    let mut s = clean(10.0);
+    let base = simulate(&s).unwrap();
+    s.lidar.time_offset_s = 0.03;
+    s.imu.time_offset_s = -0.01;
+    let shifted = simulate(&s).unwrap();
+    let scans = |r: &SimRecording| -> Vec<SimScan> {
+        r.messages.iter().filter_map(|m| if let SimMessage::Scan(x) = m { Some(x.clone()) } else { None }).collect()
+    };
+    let imus = |r: &SimRecording| -> Vec<Stamp> {
+        r.messages.iter().filter_map(|m| if let SimMessage::Imu(x) = m { Some(x.stamp) } else { None }).collect()
+    };
+    let (a, b) = (scans(&base), scans(&shifted));
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(y.stamp.0 - x.stamp.0, 30_000_000);
+        assert_eq!(format!("{:?}", x.ranges), format!("{:?}", y.ranges));
+    }
+    assert!(imus(&base).iter().zip(imus(&shifted)).all(|(x, y)| y.0 - x.0 == -10_000_000));
+    assert_eq!(base.truth_trajectory, shifted.truth_trajectory);
+}
+
+#[test]
+fn imu_lateral_acceleration_is_centripetal() {
+    let mut s = clean(120.0);
+    s.imu.accel_noise_std_mps2 = 0.0;
+    s.imu.accel_bias_mps2 = [0.0; 3];
+    let run = simulate(&s).unwrap();
+    let start = Stamp(s.world.start_time_s * 1_000_000_000);
+    let traj = Trajectory::generate(&s.robot);
+    let (mut worst, mut turning) = (0.0f64, 0);
+    for m in &run.messages {
+        if let SimMessage::Imu(i) = m {
+            let t = traj.sample_at(secs(i.stamp, start));
+            // The IMU sits on the base's z axis: no lever-arm terms in the plane.
+            worst = worst.max((i.linear_acceleration[1] - t.v * t.omega).abs());
+            worst = worst.max((i.linear_acceleration[0] - t.accel).abs());
+            turning += usize::from(t.omega.abs() > 0.2);
+        }
+    }
+    eprintln!("imu: {turning} samples turning faster than 0.2 rad/s, worst accel mismatch {worst:.2e} m/s²");
+    assert!(turning > 1_000 && worst < 1e-9);
+}
