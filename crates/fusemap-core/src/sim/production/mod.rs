@@ -65,7 +65,7 @@ pub use messages::{
     STATUS_NO_FIX, STATUS_SBAS_FIX,
 };
 pub use path::{rounded_loop, Trajectory, TruthSample, TRUTH_RATE_HZ};
-pub use recording::{SimRecording, TruthRaster};
+pub use recording::{segment_meets_box, SimRecording, TruthRaster, TruthRasterError, MAX_TRUTH_CELLS};
 pub use scenario::{FramesConfig, RobotConfig, Scenario, WorldConfig};
 pub use sensors::{DropoutMode, GnssConfig, GnssZone, ImuConfig, LidarConfig, OdometryConfig, ZoneKind};
 pub use world::{production_hall_objects, Caster, Hit, Material, Rect, Shape, WorldObject};

@@ -37,6 +37,21 @@ pub struct SimRecording {
     pub extent: Rect,
 }
 
+/// Largest truth raster [`SimRecording::truth_occupancy`] builds: 2²⁸ cells (256 MB of
+/// flags), e.g. a 800 m square at 5 cm.
+pub const MAX_TRUTH_CELLS: usize = 1 << 28;
+
+/// Why a truth raster cannot be built.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum TruthRasterError {
+    /// The world's extent holds too many cells at this resolution.
+    #[error("the truth raster would hold {cells} cells (limit {limit})", limit = MAX_TRUTH_CELLS)]
+    TooLarge {
+        /// Cells the extent needs (saturated when beyond the grid's index range).
+        cells: u128,
+    },
+}
+
 /// The truly occupied cells of a rectangle of a grid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TruthRaster {
@@ -81,11 +96,19 @@ impl SimRecording {
     /// occupied when its square touches the object's solid, i.e. its centre lies inside
     /// the object's outline (a thick segment's rectangle, a polygon) or the square meets
     /// an outline edge (so an ideal, zero-thickness line marks every cell it crosses).
-    pub fn truth_occupancy(&self, geometry: GridGeometry) -> TruthRaster {
+    /// Refuses rasters above [`MAX_TRUTH_CELLS`] cells instead of exhausting memory.
+    pub fn truth_occupancy(&self, geometry: GridGeometry) -> Result<TruthRaster, TruthRasterError> {
         let e = &self.extent;
-        let lo = geometry.cell_of(Point2::new(e.min[0], e.min[1])).unwrap_or_default();
-        let hi = geometry.cell_of(Point2::new(e.max[0], e.max[1])).unwrap_or(lo);
-        let (width, height) = ((hi.x - lo.x + 1).max(1) as usize, (hi.y - lo.y + 1).max(1) as usize);
+        let (Some(lo), Some(hi)) =
+            (geometry.cell_of(Point2::new(e.min[0], e.min[1])), geometry.cell_of(Point2::new(e.max[0], e.max[1])))
+        else {
+            return Err(TruthRasterError::TooLarge { cells: u128::MAX });
+        };
+        let (w, h) = ((hi.x - lo.x + 1).max(1) as u128, (hi.y - lo.y + 1).max(1) as u128);
+        if w * h > MAX_TRUTH_CELLS as u128 {
+            return Err(TruthRasterError::TooLarge { cells: w * h });
+        }
+        let (width, height) = (w as usize, h as usize);
         let mut occupied = vec![false; width * height];
         let res = geometry.resolution();
         for o in &self.objects {
@@ -116,7 +139,7 @@ impl SimRecording {
                 }
             }
         }
-        TruthRaster { geometry, first_cell: lo, width, height, occupied }
+        Ok(TruthRaster { geometry, first_cell: lo, width, height, occupied })
     }
 
     /// The true `map_from_base` at `stamp` (true clock), interpolated; `None` outside the run.
@@ -159,6 +182,7 @@ pub fn segment_meets_box(a: Point2, b: Point2, lo: Point2, hi: Point2) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::production::{simulate, Scenario};
 
     #[test]
     fn segment_box_cases() {
@@ -171,5 +195,16 @@ mod tests {
         assert!(segment_meets_box(p(1.0, -1.0), p(1.0, 2.0), lo, hi), "along the border");
         assert!(!segment_meets_box(p(-1.0, 0.5), p(-0.1, 0.5), lo, hi), "stops short");
         assert!(segment_meets_box(p(-0.5, 0.0), p(0.0, -0.5), p(-0.3, -0.3), p(-0.2, -0.2)), "corner cut");
+    }
+
+    #[test]
+    fn oversized_rasters_are_refused() {
+        let mut s = Scenario::default();
+        s.robot.duration_s = 1.0;
+        s.world.extent = Rect::new(-5_000.0, -5_000.0, 5_000.0, 5_000.0);
+        let run = simulate(&s).unwrap();
+        let err = run.truth_occupancy(GridGeometry::centered(0.05).unwrap()).unwrap_err();
+        assert_eq!(err, TruthRasterError::TooLarge { cells: 200_001 * 200_001 });
+        assert!(run.truth_occupancy(GridGeometry::centered(10.0).unwrap()).is_ok());
     }
 }

@@ -128,6 +128,9 @@ impl Default for FramesConfig {
     }
 }
 
+/// Most lidar beams a run may simulate (8 bytes each in memory).
+pub const MAX_BEAMS: f64 = 5e7;
+
 /// `Ok` when `v` is finite and > 0.
 pub(crate) fn positive(field: &str, v: f64) -> Result<(), String> {
     if v.is_finite() && v > 0.0 {
@@ -181,8 +184,8 @@ impl Scenario {
         positive("robot.max_accel_mps2", r.max_accel_mps2)?;
         positive("robot.max_angular_accel_radps2", r.max_angular_accel_radps2)?;
         positive("robot.duration_s", r.duration_s)?;
-        if r.duration_s > 86_400.0 {
-            return Err(format!("robot.duration_s must be at most one day, got {}", r.duration_s));
+        if r.duration_s > 3_600.0 {
+            return Err(format!("robot.duration_s must be at most 3600 (one hour in memory), got {}", r.duration_s));
         }
         non_negative("robot.corner_radius_m", r.corner_radius_m)?;
         positive("robot.lookahead_m", r.lookahead_m)?;
@@ -196,6 +199,12 @@ impl Scenario {
             }
         }
         self.lidar.validate()?;
+        let beams = self.lidar.beams as f64 * self.lidar.rate_hz * r.duration_s;
+        if beams > MAX_BEAMS {
+            return Err(format!(
+                "lidar.beams × lidar.rate_hz × robot.duration_s = {beams:.3e} beams, more than the {MAX_BEAMS:.0e} a run may hold in memory"
+            ));
+        }
         self.odometry.validate()?;
         self.imu.validate()?;
         self.gnss.validate()?;
@@ -241,6 +250,10 @@ mod tests {
         let mut s = Scenario::default();
         s.frames.gps.clear();
         assert!(s.validate().unwrap_err().starts_with("frames.gps"));
+        let mut s = Scenario::default();
+        s.robot.duration_s = 3_600.0;
+        s.lidar.beams = 2_000;
+        assert!(s.validate().unwrap_err().starts_with("lidar.beams × lidar.rate_hz"));
         let mut s = Scenario::default();
         s.odometry.rate_hz = f64::NAN;
         assert!(s.validate().unwrap_err().starts_with("odometry.rate_hz"));

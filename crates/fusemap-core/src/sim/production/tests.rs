@@ -351,7 +351,7 @@ fn imu_reports_rate_plus_bias_and_gravity_without_orientation() {
 fn truth_occupancy_contains_every_wall_and_leaves_the_path_free() {
     let run = default_run();
     let g = GridGeometry::centered(0.05).unwrap();
-    let raster = run.truth_occupancy(g);
+    let raster = run.truth_occupancy(g).unwrap();
     let mut checked = 0;
     for o in &run.objects {
         let edges = o.outline();
