@@ -64,7 +64,7 @@ pub use messages::{
     COVARIANCE_TYPE_DIAGONAL_KNOWN, COVARIANCE_TYPE_UNKNOWN, SERVICE_GALILEO, SERVICE_GPS, STATUS_FIX, STATUS_GBAS_FIX,
     STATUS_NO_FIX, STATUS_SBAS_FIX,
 };
-pub use path::{rounded_loop, Trajectory, TruthSample, TRUTH_RATE_HZ};
+pub use path::{rounded_loop, Approach, Trajectory, TruthSample, TRUTH_RATE_HZ};
 pub use recording::{segment_meets_box, SimRecording, TruthRaster, TruthRasterError, MAX_TRUTH_CELLS};
 pub use scenario::{FramesConfig, RobotConfig, Scenario, WorldConfig};
 pub use sensors::{DropoutMode, GnssConfig, GnssZone, ImuConfig, LidarConfig, OdometryConfig, ZoneKind};

@@ -7,6 +7,7 @@
 //! true motion to rounding.
 
 use super::scenario::RobotConfig;
+use super::world::WorldObject;
 use crate::geometry::{normalize_angle, Point2, Pose2};
 
 /// Integration and truth rate, Hz.
@@ -167,6 +168,33 @@ impl Trajectory {
     pub fn pose_at(&self, t: f64) -> Pose2 {
         self.sample_at(t).pose
     }
+
+    /// Where the base origin comes closest to an object (every 200 Hz sample against
+    /// every object's solid): a scenario check for the command line, and what the tests
+    /// hold to ≥ 0.5 m. `None` without objects.
+    pub fn closest_approach(&self, objects: &[WorldObject]) -> Option<Approach> {
+        let mut best: Option<Approach> = None;
+        for s in &self.samples {
+            for (object, o) in objects.iter().enumerate() {
+                let distance_m = o.distance(s.pose.translation());
+                if best.is_none_or(|b| distance_m < b.distance_m) {
+                    best = Some(Approach { distance_m, object, t: s.t });
+                }
+            }
+        }
+        best
+    }
+}
+
+/// The closest approach of the robot to the world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Approach {
+    /// Distance from the base origin to the object's solid, metres.
+    pub distance_m: f64,
+    /// Index of the object.
+    pub object: usize,
+    /// When, seconds since the start.
+    pub t: f64,
 }
 
 #[cfg(test)]

@@ -93,17 +93,15 @@ fn same_seed_same_recording_other_seed_differs() {
 fn the_path_keeps_clearance_from_every_object() {
     let s = Scenario::default();
     let traj = Trajectory::generate(&s.robot);
-    let mut worst = (f64::INFINITY, String::new(), 0.0);
-    for sample in traj.samples() {
-        for o in &s.world.objects {
-            let d = o.distance(sample.pose.translation());
-            if d < worst.0 {
-                worst = (d, o.name.clone(), sample.t);
-            }
-        }
-    }
-    eprintln!("closest approach: {:.2} m to {} at t = {:.1} s", worst.0, worst.1, worst.2);
-    assert!(worst.0 >= 0.5, "{worst:?}");
+    let worst = traj.closest_approach(&s.world.objects).unwrap();
+    let name = &s.world.objects[worst.object].name;
+    eprintln!("closest approach: {:.2} m to {name} at t = {:.1} s", worst.distance_m, worst.t);
+    assert!(worst.distance_m >= 0.5, "{worst:?}");
+    // The check finds a path that does not keep clear.
+    let mut tight = s.clone();
+    tight.robot.waypoints[1] = [20.0, 7.0];
+    let close = Trajectory::generate(&tight.robot).closest_approach(&tight.world.objects).unwrap();
+    assert!(close.distance_m < 0.5, "{close:?}");
     // The loop is closed: the robot passes its start again.
     let start = traj.samples()[0].pose.translation();
     let back = traj.samples().iter().filter(|x| x.t > 30.0).map(|x| x.pose.translation().distance(start));
