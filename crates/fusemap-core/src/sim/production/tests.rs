@@ -4,7 +4,7 @@
 
 use super::*;
 use crate::geometry::Point2;
-use crate::grid::GridGeometry;
+use crate::grid::{CellIndex, GridGeometry};
 use std::sync::OnceLock;
 
 fn default_run() -> &'static SimRecording {
@@ -431,4 +431,80 @@ fn imu_lateral_acceleration_is_centripetal() {
     }
     eprintln!("imu: {turning} samples turning faster than 0.2 rad/s, worst accel mismatch {worst:.2e} m/s²");
     assert!(turning > 1_000 && worst < 1e-9);
+}
+
+/// Maps a run through the core's own engine with true, de-skewed poses and measures the
+/// map against the truth raster: the precision of its occupied cells (within one cell of
+/// truth) and the share of glass-fence cells it marks occupied.
+fn map_with_true_poses(s: &Scenario) -> (f64, f64, usize) {
+    use crate::fusion::Engine;
+    use crate::grid::{OccupancyGrid, OccupancyParams, Ternary};
+    use crate::sensor::{LaserScan, LidarModel, LidarParams};
+    let run = simulate(s).unwrap();
+    let traj = Trajectory::generate(&s.robot);
+    let start = Stamp(s.world.start_time_s * 1_000_000_000);
+    let g = GridGeometry::centered(0.05).unwrap();
+    let mut engine = Engine::new(OccupancyGrid::new(g, OccupancyParams::default()));
+    let params = LidarParams { max_range: s.lidar.range_max_m, ..LidarParams::default() };
+    let laser = engine.add_lidar("laser", LidarModel::new(params, s.lidar.mount.to_planar(1e-6).unwrap()));
+    for m in &run.messages {
+        if let SimMessage::Scan(x) = m {
+            let scan = LaserScan {
+                stamp: x.stamp,
+                angle_min: x.angle_min as f64,
+                angle_increment: x.angle_increment as f64,
+                ranges: x.ranges.clone(),
+            };
+            let t0 = secs(x.stamp, start) - s.lidar.time_offset_s;
+            let ti = x.time_increment as f64;
+            engine.insert_scan_with(laser, &scan, |i| traj.pose_at(t0 + i as f64 * ti)).unwrap();
+        }
+    }
+    let truth = run.truth_occupancy(g).unwrap();
+    let near_truth =
+        |c: CellIndex| (-1..=1).any(|dy| (-1..=1).any(|dx| truth.is_occupied(CellIndex::new(c.x + dx, c.y + dy))));
+    let grid = engine.grid();
+    let known = grid.known_box().unwrap();
+    let (mut tp, mut fp) = (0usize, 0usize);
+    for y in known.min.y..=known.max.y {
+        for x in known.min.x..=known.max.x {
+            let c = CellIndex::new(x, y);
+            if grid.ternary(c) == Ternary::Occupied {
+                if near_truth(c) {
+                    tp += 1
+                } else {
+                    fp += 1
+                }
+            }
+        }
+    }
+    // Glass-fence cells on the fence line, x ∈ [6, 24] (away from its ends).
+    let fence: Vec<CellIndex> =
+        (0..=360).map(|i| g.cell_of(Point2::new(6.0 + 0.05 * i as f64, 10.5)).unwrap()).collect();
+    let fence_seen =
+        fence.iter().filter(|&&c| grid.ternary(c) == Ternary::Occupied).count() as f64 / fence.len() as f64;
+    (tp as f64 / (tp + fp) as f64, fence_seen, fp)
+}
+
+#[test]
+fn the_failures_reach_a_map_built_from_true_poses() {
+    let mut clean_run = clean(90.0);
+    clean_run.lidar.glass_pass_probability = 0.0;
+    let (p_clean, fence_clean, fp_clean) = map_with_true_poses(&clean_run);
+    let mut faulty = Scenario::default();
+    faulty.robot.duration_s = 90.0;
+    let (p_faulty, fence_faulty, fp_faulty) = map_with_true_poses(&faulty);
+    eprintln!(
+        "map from true poses, 90 s: without failures precision {p_clean:.3} ({fp_clean} stray cells), glass fence \
+         {:.0} % occupied; with the production line's failures precision {p_faulty:.3} ({fp_faulty} stray cells), \
+         glass fence {:.0} % occupied",
+        100.0 * fence_clean,
+        100.0 * fence_faulty
+    );
+    assert!(p_clean > 0.98, "{p_clean}");
+    assert!(fence_clean > 0.9, "{fence_clean}");
+    // Flying points and mixed pixels put obstacles where there are none...
+    assert!(fp_faulty > 5 * fp_clean.max(10), "{fp_faulty} vs {fp_clean}");
+    // ...and glass that passes 60 % of the beams fades from the map.
+    assert!(fence_faulty < fence_clean - 0.2, "{fence_faulty} vs {fence_clean}");
 }
