@@ -172,6 +172,9 @@ impl Scenario {
     pub fn validate(&self) -> Result<(), String> {
         let w = &self.world;
         w.extent.check("world.extent")?;
+        if w.start_time_s.unsigned_abs() > 9_000_000_000 {
+            return Err(format!("world.start_time_s must lie within ±9e9 s (year 2255), got {}", w.start_time_s));
+        }
         for (i, o) in w.objects.iter().enumerate() {
             o.check(&format!("world.objects[{i}]"))?;
         }
@@ -250,6 +253,9 @@ mod tests {
         let mut s = Scenario::default();
         s.frames.gps.clear();
         assert!(s.validate().unwrap_err().starts_with("frames.gps"));
+        let mut s = Scenario::default();
+        s.world.start_time_s = i64::MAX;
+        assert!(s.validate().unwrap_err().starts_with("world.start_time_s"));
         let mut s = Scenario::default();
         s.robot.duration_s = 3_600.0;
         s.lidar.beams = 2_000;

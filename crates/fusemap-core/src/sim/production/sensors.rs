@@ -31,7 +31,8 @@ pub struct LidarConfig {
     pub rate_hz: f64,
     /// Beams per scan.
     pub beams: usize,
-    /// Field of view, degrees, centred on the sensor's x axis.
+    /// Field of view, degrees, centred on the sensor's x axis: the first beam at
+    /// `-fov/2`, the last at `+fov/2` (or one increment short of it for 360°).
     pub fov_deg: f64,
     /// Shortest range reported as valid, metres.
     pub range_min_m: f64,
@@ -89,9 +90,12 @@ impl LidarConfig {
         -self.fov_deg.to_radians() / 2.0
     }
 
-    /// Angle between beams, radians.
+    /// Angle between beams, radians. A full turn (`fov_deg = 360`) spaces the beams by
+    /// `2π / beams` so the last beam does not repeat the first.
     pub fn angle_increment(&self) -> f64 {
-        if self.beams > 1 {
+        if self.fov_deg >= 360.0 {
+            std::f64::consts::TAU / self.beams as f64
+        } else if self.beams > 1 {
             self.fov_deg.to_radians() / (self.beams - 1) as f64
         } else {
             0.0
@@ -399,5 +403,35 @@ impl GnssConfig {
             kind = Some(z.kind);
         }
         kind
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Point2;
+
+    #[test]
+    fn beam_layout() {
+        let l = LidarConfig::default();
+        assert!((l.angle_min() + 135f64.to_radians()).abs() < 1e-12);
+        let last = l.angle_min() + l.angle_increment() * (l.beams - 1) as f64;
+        assert!((last - 135f64.to_radians()).abs() < 1e-12);
+        assert!((l.time_increment() * 540.0 - 0.05).abs() < 1e-15);
+        let full = LidarConfig { fov_deg: 360.0, beams: 360, ..LidarConfig::default() };
+        assert!((full.angle_increment() - 1f64.to_radians()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn dropout_zones_win_over_degraded_ones() {
+        let mut g = GnssConfig::default();
+        g.zones.push(GnssZone {
+            name: "overlap".into(),
+            kind: ZoneKind::Degraded,
+            area: Rect::new(8.0, 10.8, 9.0, 12.0),
+        });
+        assert_eq!(g.zone_at(Point2::new(8.5, 11.0)), Some(ZoneKind::Dropout));
+        assert_eq!(g.zone_at(Point2::new(25.0, 3.0)), Some(ZoneKind::Degraded));
+        assert_eq!(g.zone_at(Point2::new(3.0, 3.0)), None);
     }
 }
