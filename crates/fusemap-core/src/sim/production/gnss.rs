@@ -1,0 +1,126 @@
+//! The RTK receiver: the true antenna position (lever arm on the true pose) in the map's
+//! ENU frame, plus the error of the zone it is in, converted to WGS84 through the datum
+//! (exact ECEF maths, [`crate::geometry::geodetic`]).
+//!
+//! Degraded zones carry a first-order Gauss–Markov error
+//! `e_k = φ·e_(k−1) + σ·√(1 − φ²)·n_k`, `φ = exp(−Δt/τ)` (stationary σ; Brown & Hwang,
+//! *Introduction to Random Signals and Applied Kalman Filtering*, §2.9), and occasional
+//! outliers the reported covariance does not admit, which a robust estimator must reject.
+
+use super::messages::{
+    diagonal3, SimFix, COVARIANCE_TYPE_DIAGONAL_KNOWN, COVARIANCE_TYPE_UNKNOWN, SERVICE_GALILEO, SERVICE_GPS,
+    STATUS_FIX, STATUS_GBAS_FIX, STATUS_NO_FIX,
+};
+use super::path::Trajectory;
+use super::sensors::{DropoutMode, GnssConfig, ZoneKind};
+use crate::geometry::{Datum, Point2};
+use crate::sim::SplitMix64;
+use crate::time::Stamp;
+
+/// The fixes and the ground truth of their errors.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GnssOutput {
+    /// Published fixes.
+    pub fixes: Vec<SimFix>,
+    /// Stamps of fixes carrying an unreported outlier.
+    pub outliers: Vec<Stamp>,
+    /// Intervals (receiver clock) with the antenna in a dropout zone.
+    pub dropouts: Vec<(Stamp, Stamp)>,
+}
+
+/// Simulates the receiver over the run. `start` is the clock at t = 0.
+pub fn simulate_gnss(
+    cfg: &GnssConfig,
+    datum: &Datum,
+    frame_id: &str,
+    traj: &Trajectory,
+    start: Stamp,
+    rng: &mut SplitMix64,
+) -> GnssOutput {
+    let clock = |t: f64| Stamp(start.0 + ((t + cfg.time_offset_s) * 1e9).round() as i64);
+    let antenna = |t: f64| {
+        let p = traj.pose_at(t) * Point2::new(cfg.mount.x, cfg.mount.y);
+        (p, cfg.zone_at(p))
+    };
+    let mut out = GnssOutput::default();
+    // Dropout intervals from the 200 Hz truth.
+    let mut open: Option<Stamp> = None;
+    let mut last = Stamp::ZERO;
+    for s in traj.samples() {
+        let inside = antenna(s.t).1 == Some(ZoneKind::Dropout);
+        match (inside, open) {
+            (true, None) => open = Some(clock(s.t)),
+            (false, Some(a)) => {
+                out.dropouts.push((a, last));
+                open = None;
+            }
+            _ => {}
+        }
+        last = clock(s.t);
+    }
+    if let Some(a) = open {
+        out.dropouts.push((a, last));
+    }
+    let dt = 1.0 / cfg.rate_hz;
+    let phi = (-dt / cfg.degraded_tau_s).exp();
+    let drive = cfg.degraded_sigma_m * (1.0 - phi * phi).sqrt();
+    let mut gm = [cfg.degraded_sigma_m * rng.gaussian(), cfg.degraded_sigma_m * rng.gaussian()];
+    let mut k = 0usize;
+    while k as f64 * dt <= traj.duration() {
+        let t = k as f64 * dt;
+        k += 1;
+        gm = [phi * gm[0] + drive * rng.gaussian(), phi * gm[1] + drive * rng.gaussian()];
+        let white = [rng.gaussian(), rng.gaussian(), rng.gaussian()];
+        let (p, zone) = antenna(t);
+        let stamp = clock(t);
+        let (status, sigma, err) = match zone {
+            Some(ZoneKind::Dropout) => {
+                if cfg.dropout_mode == DropoutMode::NoFix {
+                    out.fixes.push(SimFix {
+                        stamp,
+                        topic: cfg.topic.clone(),
+                        frame_id: frame_id.into(),
+                        status: STATUS_NO_FIX,
+                        service: SERVICE_GPS | SERVICE_GALILEO,
+                        latitude: f64::NAN,
+                        longitude: f64::NAN,
+                        altitude: f64::NAN,
+                        position_covariance: [0.0; 9],
+                        position_covariance_type: COVARIANCE_TYPE_UNKNOWN,
+                    });
+                }
+                continue;
+            }
+            Some(ZoneKind::Degraded) => {
+                let g = cfg.good_sigma_m;
+                let mut e = [gm[0] + g * white[0], gm[1] + g * white[1], 2.0 * cfg.degraded_sigma_m * white[2]];
+                if rng.next_f64() < cfg.outlier_probability {
+                    let size = rng.uniform(cfg.outlier_min_m, cfg.outlier_max_m);
+                    let (s, c) = rng.uniform(-std::f64::consts::PI, std::f64::consts::PI).sin_cos();
+                    e[0] += size * c;
+                    e[1] += size * s;
+                    out.outliers.push(stamp);
+                }
+                (STATUS_FIX, cfg.degraded_sigma_m, e)
+            }
+            None => {
+                let g = cfg.good_sigma_m;
+                (STATUS_GBAS_FIX, g, [g * white[0], g * white[1], 2.0 * g * white[2]])
+            }
+        };
+        let (latitude, longitude, altitude) = datum.to_geodetic([p.x + err[0], p.y + err[1], cfg.mount.z + err[2]]);
+        out.fixes.push(SimFix {
+            stamp,
+            topic: cfg.topic.clone(),
+            frame_id: frame_id.into(),
+            status,
+            service: SERVICE_GPS | SERVICE_GALILEO,
+            latitude,
+            longitude,
+            altitude,
+            position_covariance: diagonal3([sigma * sigma, sigma * sigma, 4.0 * sigma * sigma]),
+            position_covariance_type: COVARIANCE_TYPE_DIAGONAL_KNOWN,
+        });
+    }
+    out
+}

@@ -1,0 +1,210 @@
+//! What a run produces: the time-ordered messages and the ground truth to score an
+//! estimator and a map against.
+
+use super::lidar::LidarStats;
+use super::messages::SimMessage;
+use super::world::{polygon_contains, Rect, WorldObject};
+use crate::geometry::{Datum, Point2, Pose2};
+use crate::grid::{CellIndex, GridGeometry};
+use crate::time::Stamp;
+
+/// A simulated run.
+#[derive(Clone, Debug)]
+pub struct SimRecording {
+    /// Every message, sorted by header stamp (ties keep the order static transforms,
+    /// scans, odometry, IMU, fixes).
+    pub messages: Vec<SimMessage>,
+    /// `map_from_base` at 50 Hz, true clock (no sensor offset). The map frame is ENU at
+    /// the GNSS datum: x east, y north.
+    pub truth_trajectory: Vec<(Stamp, Pose2)>,
+    /// Stamps of the fixes that carry an unreported outlier.
+    pub injected_outliers: Vec<Stamp>,
+    /// Intervals (receiver clock) with the antenna in a dropout zone.
+    pub dropouts: Vec<(Stamp, Stamp)>,
+    /// The IMU's true gyro z bias, rad/s.
+    pub gyro_bias_radps: f64,
+    /// The odometry's true scale error (reported / true travel off the grooves).
+    pub odometry_scale: f64,
+    /// 5 ms integration steps with a wheel over a groove.
+    pub slipping_steps: u64,
+    /// What the lidar's failure modes did.
+    pub lidar_stats: LidarStats,
+    /// The map frame's datum.
+    pub datum: Datum,
+    /// The world's objects (for truth rasters and reports).
+    pub objects: Vec<WorldObject>,
+    /// The world's extent.
+    pub extent: Rect,
+}
+
+/// Largest truth raster [`SimRecording::truth_occupancy`] builds: 2²⁸ cells (256 MB of
+/// flags), e.g. a 800 m square at 5 cm.
+pub const MAX_TRUTH_CELLS: usize = 1 << 28;
+
+/// Why a truth raster cannot be built.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum TruthRasterError {
+    /// The world's extent holds too many cells at this resolution.
+    #[error("the truth raster would hold {cells} cells (limit {limit})", limit = MAX_TRUTH_CELLS)]
+    TooLarge {
+        /// Cells the extent needs (saturated when beyond the grid's index range).
+        cells: u128,
+    },
+}
+
+/// The truly occupied cells of a rectangle of a grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TruthRaster {
+    /// The grid placement the cells refer to.
+    pub geometry: GridGeometry,
+    /// The cell at row 0, column 0.
+    pub first_cell: CellIndex,
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// Row-major (row 0 = lowest y), true where an object covers the cell.
+    pub occupied: Vec<bool>,
+}
+
+impl TruthRaster {
+    /// Whether the cell is occupied (`false` outside the raster).
+    pub fn is_occupied(&self, c: CellIndex) -> bool {
+        let (dx, dy) = (c.x - self.first_cell.x, c.y - self.first_cell.y);
+        dx >= 0
+            && dy >= 0
+            && (dx as usize) < self.width
+            && (dy as usize) < self.height
+            && self.occupied[dy as usize * self.width + dx as usize]
+    }
+
+    /// Number of occupied cells.
+    pub fn occupied_count(&self) -> usize {
+        self.occupied.iter().filter(|&&o| o).count()
+    }
+
+    /// The occupied cells.
+    pub fn occupied_cells(&self) -> impl Iterator<Item = CellIndex> + '_ {
+        self.occupied.iter().enumerate().filter(|(_, &o)| o).map(|(i, _)| {
+            CellIndex::new(self.first_cell.x + (i % self.width) as i64, self.first_cell.y + (i / self.width) as i64)
+        })
+    }
+}
+
+impl SimRecording {
+    /// Rasterises every object into `geometry` over the world's extent: a cell is
+    /// occupied when its square touches the object's solid, i.e. its centre lies inside
+    /// the object's outline (a thick segment's rectangle, a polygon) or the square meets
+    /// an outline edge (so an ideal, zero-thickness line marks every cell it crosses).
+    /// Refuses rasters above [`MAX_TRUTH_CELLS`] cells instead of exhausting memory.
+    pub fn truth_occupancy(&self, geometry: GridGeometry) -> Result<TruthRaster, TruthRasterError> {
+        let e = &self.extent;
+        let (Some(lo), Some(hi)) =
+            (geometry.cell_of(Point2::new(e.min[0], e.min[1])), geometry.cell_of(Point2::new(e.max[0], e.max[1])))
+        else {
+            return Err(TruthRasterError::TooLarge { cells: u128::MAX });
+        };
+        let (w, h) = ((hi.x - lo.x + 1).max(1) as u128, (hi.y - lo.y + 1).max(1) as u128);
+        if w * h > MAX_TRUTH_CELLS as u128 {
+            return Err(TruthRasterError::TooLarge { cells: w * h });
+        }
+        let (width, height) = (w as usize, h as usize);
+        let mut occupied = vec![false; width * height];
+        let res = geometry.resolution();
+        for o in &self.objects {
+            let edges = o.outline();
+            let corners: Vec<[f64; 2]> = edges.iter().map(|(a, _)| [a.x, a.y]).collect();
+            let (mut bx0, mut by0, mut bx1, mut by1) =
+                (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+            for (a, b) in &edges {
+                for p in [a, b] {
+                    (bx0, by0, bx1, by1) = (bx0.min(p.x), by0.min(p.y), bx1.max(p.x), by1.max(p.y));
+                }
+            }
+            let (Some(c0), Some(c1)) =
+                (geometry.cell_of(Point2::new(bx0, by0)), geometry.cell_of(Point2::new(bx1, by1)))
+            else {
+                continue;
+            };
+            for y in c0.y.max(lo.y)..=c1.y.min(hi.y) {
+                for x in c0.x.max(lo.x)..=c1.x.min(hi.x) {
+                    let cell = CellIndex::new(x, y);
+                    let corner = geometry.cell_corner(cell);
+                    let far = Point2::new(corner.x + res, corner.y + res);
+                    let hit = (corners.len() >= 3 && polygon_contains(&corners, geometry.cell_center(cell)))
+                        || edges.iter().any(|&(a, b)| segment_meets_box(a, b, corner, far));
+                    if hit {
+                        occupied[(y - lo.y) as usize * width + (x - lo.x) as usize] = true;
+                    }
+                }
+            }
+        }
+        Ok(TruthRaster { geometry, first_cell: lo, width, height, occupied })
+    }
+
+    /// The true `map_from_base` at `stamp` (true clock), interpolated; `None` outside the run.
+    pub fn truth_at(&self, stamp: Stamp) -> Option<Pose2> {
+        let i = self.truth_trajectory.partition_point(|(s, _)| *s <= stamp);
+        if i == 0 {
+            return None;
+        }
+        let (s0, p0) = self.truth_trajectory[i - 1];
+        if s0 == stamp {
+            return Some(p0);
+        }
+        let (s1, p1) = *self.truth_trajectory.get(i)?;
+        Some(p0.interpolate(p1, stamp.secs_since(s0) / s1.secs_since(s0)))
+    }
+}
+
+/// Whether the segment `a`–`b` meets the closed box `lo`–`hi` (Liang & Barsky 1984
+/// parametric clipping).
+pub fn segment_meets_box(a: Point2, b: Point2, lo: Point2, hi: Point2) -> bool {
+    let (dx, dy) = (b.x - a.x, b.y - a.y);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [(-dx, a.x - lo.x), (dx, hi.x - a.x), (-dy, a.y - lo.y), (dy, hi.y - a.y)] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return false;
+            }
+        } else {
+            let r = q / p;
+            if p < 0.0 {
+                t0 = t0.max(r);
+            } else {
+                t1 = t1.min(r);
+            }
+        }
+    }
+    t0 <= t1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::production::{simulate, Scenario};
+
+    #[test]
+    fn segment_box_cases() {
+        let (lo, hi) = (Point2::new(0.0, 0.0), Point2::new(1.0, 1.0));
+        let p = Point2::new;
+        assert!(segment_meets_box(p(-1.0, 0.5), p(2.0, 0.5), lo, hi));
+        assert!(segment_meets_box(p(0.2, 0.2), p(0.3, 0.3), lo, hi), "inside");
+        assert!(!segment_meets_box(p(-1.0, 1.5), p(2.0, 1.5), lo, hi), "above");
+        assert!(!segment_meets_box(p(1.5, -1.0), p(3.0, 0.5), lo, hi), "diagonal miss");
+        assert!(segment_meets_box(p(1.0, -1.0), p(1.0, 2.0), lo, hi), "along the border");
+        assert!(!segment_meets_box(p(-1.0, 0.5), p(-0.1, 0.5), lo, hi), "stops short");
+        assert!(segment_meets_box(p(-0.5, 0.0), p(0.0, -0.5), p(-0.3, -0.3), p(-0.2, -0.2)), "corner cut");
+    }
+
+    #[test]
+    fn oversized_rasters_are_refused() {
+        let mut s = Scenario::default();
+        s.robot.duration_s = 1.0;
+        s.world.extent = Rect::new(-5_000.0, -5_000.0, 5_000.0, 5_000.0);
+        let run = simulate(&s).unwrap();
+        let err = run.truth_occupancy(GridGeometry::centered(0.05).unwrap()).unwrap_err();
+        assert_eq!(err, TruthRasterError::TooLarge { cells: 200_001 * 200_001 });
+        assert!(run.truth_occupancy(GridGeometry::centered(10.0).unwrap()).is_ok());
+    }
+}

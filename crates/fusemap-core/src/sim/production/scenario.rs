@@ -1,0 +1,267 @@
+//! The scenario: every parameter of a production-line run, readable from TOML.
+//!
+//! Each table has `#[serde(deny_unknown_fields, default)]`: a misspelt key is an error,
+//! a missing key takes the production line's value. [`Scenario::validate`] names the
+//! offending field in the TOML path form (`lidar.glass_pass_probability`).
+
+use super::sensors::{GnssConfig, ImuConfig, LidarConfig, OdometryConfig};
+use super::world::{production_hall_objects, Rect, WorldObject};
+use serde::{Deserialize, Serialize};
+
+/// A whole simulated run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Scenario {
+    /// The hall and the random seed.
+    pub world: WorldConfig,
+    /// The robot's motion.
+    pub robot: RobotConfig,
+    /// The 2D lidar.
+    pub lidar: LidarConfig,
+    /// Wheel odometry.
+    pub odometry: OdometryConfig,
+    /// The IMU.
+    pub imu: ImuConfig,
+    /// The RTK GNSS receiver.
+    pub gnss: GnssConfig,
+    /// Frame names (REP 105).
+    pub frames: FramesConfig,
+}
+
+/// The world. Coordinates are the map frame: ENU at the GNSS datum, x east, y north.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WorldConfig {
+    /// The area the world occupies (truth rasters cover it).
+    pub extent: Rect,
+    /// Seed of every random draw: the same scenario and seed give the same recording.
+    pub seed: u64,
+    /// Clock reading at the start of the run, whole seconds (Unix time by default, so
+    /// recordings look like real logs; integer so stamps stay exact to the nanosecond).
+    pub start_time_s: i64,
+    /// The objects.
+    pub objects: Vec<WorldObject>,
+    /// Floor grooves: the wheels slip while over them.
+    pub grooves: Vec<Rect>,
+}
+
+impl Default for WorldConfig {
+    fn default() -> Self {
+        Self {
+            extent: Rect::new(-0.5, -0.5, 30.5, 15.5),
+            seed: 20_261_201,
+            // 2026-01-01T00:00:00Z.
+            start_time_s: 1_767_225_600,
+            objects: production_hall_objects(),
+            grooves: vec![Rect::new(9.6, 0.2, 10.2, 5.0), Rect::new(19.6, 10.7, 20.2, 14.8)],
+        }
+    }
+}
+
+/// The robot's motion: a closed loop of waypoints with rounded corners, followed by a
+/// unicycle controller under speed, acceleration and turn-rate limits.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RobotConfig {
+    /// Top speed, m/s.
+    pub max_speed_mps: f64,
+    /// Top turn rate, rad/s.
+    pub max_turn_rate_radps: f64,
+    /// Top linear acceleration, m/s².
+    pub max_accel_mps2: f64,
+    /// Top angular acceleration, rad/s².
+    pub max_angular_accel_radps2: f64,
+    /// Length of the run, seconds.
+    pub duration_s: f64,
+    /// Corners of the closed loop, metres in the map frame. The robot starts at the first,
+    /// facing the second, at rest.
+    pub waypoints: Vec<[f64; 2]>,
+    /// Radius of the arcs that round the corners, metres.
+    pub corner_radius_m: f64,
+    /// Pure-pursuit look-ahead distance, metres.
+    pub lookahead_m: f64,
+}
+
+impl Default for RobotConfig {
+    fn default() -> Self {
+        Self {
+            max_speed_mps: 0.8,
+            max_turn_rate_radps: 0.6,
+            max_accel_mps2: 0.5,
+            max_angular_accel_radps2: 1.5,
+            duration_s: 180.0,
+            waypoints: vec![[3.0, 3.0], [27.0, 3.0], [27.0, 12.5], [3.0, 12.5]],
+            corner_radius_m: 2.0,
+            lookahead_m: 1.0,
+        }
+    }
+}
+
+/// Frame names, as REP 105 spells them by default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FramesConfig {
+    /// The global, GNSS-anchored ENU frame.
+    pub map: String,
+    /// The odometry frame (continuous, drifting).
+    pub odom: String,
+    /// The robot body.
+    pub base_link: String,
+    /// The lidar.
+    pub laser: String,
+    /// The IMU.
+    pub imu_link: String,
+    /// The GNSS antenna.
+    pub gps: String,
+}
+
+impl Default for FramesConfig {
+    fn default() -> Self {
+        Self {
+            map: "map".into(),
+            odom: "odom".into(),
+            base_link: "base_link".into(),
+            laser: "laser".into(),
+            imu_link: "imu_link".into(),
+            gps: "gps".into(),
+        }
+    }
+}
+
+/// Most lidar beams a run may simulate (8 bytes each in memory).
+pub const MAX_BEAMS: f64 = 5e7;
+
+/// `Ok` when `v` is finite and > 0.
+pub(crate) fn positive(field: &str, v: f64) -> Result<(), String> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("{field} must be a finite number > 0, got {v}"))
+    }
+}
+
+/// `Ok` when `v` is finite and ≥ 0.
+pub(crate) fn non_negative(field: &str, v: f64) -> Result<(), String> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!("{field} must be a finite number >= 0, got {v}"))
+    }
+}
+
+/// `Ok` when `v` is a probability.
+pub(crate) fn probability(field: &str, v: f64) -> Result<(), String> {
+    if (0.0..=1.0).contains(&v) {
+        Ok(())
+    } else {
+        Err(format!("{field} must lie in [0, 1], got {v}"))
+    }
+}
+
+/// `Ok` when `v` is finite.
+pub(crate) fn finite(field: &str, v: f64) -> Result<(), String> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{field} must be finite, got {v}"))
+    }
+}
+
+impl Scenario {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        let w = &self.world;
+        w.extent.check("world.extent")?;
+        if w.start_time_s.unsigned_abs() > 9_000_000_000 {
+            return Err(format!("world.start_time_s must lie within ±9e9 s (year 2255), got {}", w.start_time_s));
+        }
+        for (i, o) in w.objects.iter().enumerate() {
+            o.check(&format!("world.objects[{i}]"))?;
+        }
+        for (i, g) in w.grooves.iter().enumerate() {
+            g.check(&format!("world.grooves[{i}]"))?;
+        }
+        let r = &self.robot;
+        positive("robot.max_speed_mps", r.max_speed_mps)?;
+        positive("robot.max_turn_rate_radps", r.max_turn_rate_radps)?;
+        positive("robot.max_accel_mps2", r.max_accel_mps2)?;
+        positive("robot.max_angular_accel_radps2", r.max_angular_accel_radps2)?;
+        positive("robot.duration_s", r.duration_s)?;
+        if r.duration_s > 3_600.0 {
+            return Err(format!("robot.duration_s must be at most 3600 (one hour in memory), got {}", r.duration_s));
+        }
+        non_negative("robot.corner_radius_m", r.corner_radius_m)?;
+        positive("robot.lookahead_m", r.lookahead_m)?;
+        if r.waypoints.len() < 3 || r.waypoints.iter().flatten().any(|v| !v.is_finite()) {
+            return Err("robot.waypoints needs at least 3 finite points (a closed loop)".into());
+        }
+        for i in 0..r.waypoints.len() {
+            let (a, b) = (r.waypoints[i], r.waypoints[(i + 1) % r.waypoints.len()]);
+            if (a[0] - b[0]).hypot(a[1] - b[1]) < 1e-6 {
+                return Err(format!("robot.waypoints[{i}] repeats the next waypoint"));
+            }
+        }
+        self.lidar.validate()?;
+        let beams = self.lidar.beams as f64 * self.lidar.rate_hz * r.duration_s;
+        if beams > MAX_BEAMS {
+            return Err(format!(
+                "lidar.beams × lidar.rate_hz × robot.duration_s = {beams:.3e} beams, more than the {MAX_BEAMS:.0e} a run may hold in memory"
+            ));
+        }
+        self.odometry.validate()?;
+        self.imu.validate()?;
+        self.gnss.validate()?;
+        let f = &self.frames;
+        for (field, name) in [
+            ("frames.map", &f.map),
+            ("frames.odom", &f.odom),
+            ("frames.base_link", &f.base_link),
+            ("frames.laser", &f.laser),
+            ("frames.imu_link", &f.imu_link),
+            ("frames.gps", &f.gps),
+        ] {
+            if name.is_empty() {
+                return Err(format!("{field} must not be empty"));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_is_valid_and_errors_name_the_field() {
+        assert_eq!(Scenario::default().validate(), Ok(()));
+        let mut s = Scenario::default();
+        s.robot.max_speed_mps = -1.0;
+        assert!(s.validate().unwrap_err().starts_with("robot.max_speed_mps"));
+        let mut s = Scenario::default();
+        s.lidar.glass_pass_probability = 1.5;
+        assert!(s.validate().unwrap_err().starts_with("lidar.glass_pass_probability"));
+        let mut s = Scenario::default();
+        s.world.grooves[1] = Rect::new(1.0, 1.0, 0.0, 2.0);
+        assert!(s.validate().unwrap_err().starts_with("world.grooves[1]"));
+        let mut s = Scenario::default();
+        s.gnss.datum_lat_deg = 91.0;
+        assert!(s.validate().unwrap_err().starts_with("gnss.datum"));
+        let mut s = Scenario::default();
+        s.robot.waypoints.truncate(2);
+        assert!(s.validate().unwrap_err().starts_with("robot.waypoints"));
+        let mut s = Scenario::default();
+        s.frames.gps.clear();
+        assert!(s.validate().unwrap_err().starts_with("frames.gps"));
+        let mut s = Scenario::default();
+        s.world.start_time_s = i64::MAX;
+        assert!(s.validate().unwrap_err().starts_with("world.start_time_s"));
+        let mut s = Scenario::default();
+        s.robot.duration_s = 3_600.0;
+        s.lidar.beams = 2_000;
+        assert!(s.validate().unwrap_err().starts_with("lidar.beams × lidar.rate_hz"));
+        let mut s = Scenario::default();
+        s.odometry.rate_hz = f64::NAN;
+        assert!(s.validate().unwrap_err().starts_with("odometry.rate_hz"));
+    }
+}
