@@ -2,9 +2,10 @@
 //! `rosbags` library (`rosbags_dump.py` beside this file) opens the bag, and every topic,
 //! type, count, QoS profile, message definition and every field of every message must be
 //! what was written. rosbags must also serialise each message back to exactly the bytes
-//! in the bag, so the CDR layout matches its encoder byte for byte.
+//! in the bag, so the CDR layout matches its encoder byte for byte. The `mcap-ros2-support`
+//! decoder, which knows types only from the schemas, must decode every message too.
 //!
-//! Without python3 and rosbags (pip install -r tests/fixtures/requirements.txt) the test
+//! Without python3, rosbags and mcap-ros2-support (pip install -r tests/fixtures/requirements.txt) the test
 //! is skipped, or fails under `FUSEMAP_NO_SKIP=1`.
 
 use fusemap_core::time::Stamp;
@@ -22,18 +23,18 @@ use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// `$FUSEMAP_PYTHON`, else `python3`, if it can import rosbags.
+/// `$FUSEMAP_PYTHON`, else `python3`, if it can import rosbags and mcap_ros2.
 fn python_with_rosbags() -> Option<String> {
     let python = std::env::var("FUSEMAP_PYTHON").unwrap_or_else(|_| "python3".into());
     let ok = Command::new(&python)
-        .args(["-c", "import rosbags.rosbag2, rosbags.typesys, numpy"])
+        .args(["-c", "import rosbags.rosbag2, rosbags.typesys, numpy, mcap.reader, mcap_ros2.decoder"])
         .output()
         .is_ok_and(|o| o.status.success());
     if ok {
         Some(python)
     } else {
         testdata::skip(&format!(
-            "`{python}` cannot import rosbags and numpy (pip install -r tests/fixtures/requirements.txt)"
+            "`{python}` cannot import rosbags, numpy and mcap_ros2 (pip install -r tests/fixtures/requirements.txt)"
         ));
         None
     }
@@ -358,5 +359,9 @@ fn rosbags_reads_what_fusemap_writes() {
             assert_eq!(r["own_definitions_agree"], json!(true), "message {i} on {topic}: the bag's own definitions");
             assert_eq!(r["reserialised_identical"], json!(true), "message {i} on {topic}: rosbags' bytes differ");
         }
+        assert_eq!(
+            got["mcap"],
+            json!({ "profile": "ros2", "metadata_records": ["rosbag2"], "decoded_from_schemas": msgs.len() })
+        );
     }
 }

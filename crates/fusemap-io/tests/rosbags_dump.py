@@ -6,7 +6,9 @@ type, count, QoS and whether the schema's message definition equals the one rosb
 generates for ROS 2 Humble; for every message its log time, the message deserialised by
 the Humble type store (as plain JSON), whether a type store built from the bag's own
 definitions deserialises it to the same value, and whether rosbags serialises it back to
-exactly the bytes in the bag.
+exactly the bytes in the bag. Then it reads the MCAP file again with the `mcap` and
+`mcap-ros2-support` packages, whose decoder builds each type from the schema text alone,
+and prints the header, the metadata record names and how many messages decoded.
 
 usage: python3 rosbags_dump.py BAG_DIR
 """
@@ -14,8 +16,11 @@ usage: python3 rosbags_dump.py BAG_DIR
 import dataclasses
 import json
 import sys
+from pathlib import Path
 
 import numpy as np
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore, get_types_from_msg
 
@@ -79,6 +84,16 @@ def main():
                     "reserialised_identical": bytes(humble.serialize_cdr(msg, conn.msgtype)) == bytes(raw),
                 }
             )
+    (storage,) = sorted(Path(sys.argv[1]).glob("*.mcap"))
+    with storage.open("rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        header = reader.get_header()
+        decoded = sum(1 for _ in reader.iter_decoded_messages())
+        out["mcap"] = {
+            "profile": header.profile,
+            "metadata_records": [m.name for m in reader.iter_metadata()],
+            "decoded_from_schemas": decoded,
+        }
     json.dump(out, sys.stdout)
 
 
