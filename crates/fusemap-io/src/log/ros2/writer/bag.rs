@@ -137,7 +137,8 @@ impl Rosbag2Writer {
     }
 
     /// Offers `topic` with `qos` instead of the default ([`QosProfile::LATCHED`] for static
-    /// transforms, else [`QosProfile::DEFAULT`]). Must come before the topic's first message.
+    /// transforms and `/tf_static`, else [`QosProfile::DEFAULT`]). Must come before the
+    /// topic's first message.
     pub fn set_topic_qos(&mut self, topic: &str, qos: QosProfile) -> Result<()> {
         if self.by_name.contains_key(topic) {
             return Err(self.message_error(
@@ -279,12 +280,18 @@ impl Rosbag2Writer {
             Some(&id) => id,
             None => {
                 let id = mcap.add_schema(&type_name, "ros2msg", def.full_text().as_bytes());
-                let id = id.map_err(|e| mcap_error(&storage_path, e))?;
+                let id = id.map_err(|e| {
+                    self.failed = true;
+                    mcap_error(&storage_path, e)
+                })?;
                 self.schema_ids.insert(def.name, id);
                 id
             }
         };
-        let qos = self.qos_overrides.get(topic).copied().unwrap_or(if tf_static == Some(true) {
+        // `/tf_static` is latched whatever the flag says: tf2 listeners subscribe to it
+        // transient_local and would miss transforms published before they started.
+        let latched = tf_static == Some(true) || (topic == "/tf_static" && tf_static.is_some());
+        let qos = self.qos_overrides.get(topic).copied().unwrap_or(if latched {
             QosProfile::LATCHED
         } else {
             QosProfile::DEFAULT

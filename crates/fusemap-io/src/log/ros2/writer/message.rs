@@ -28,8 +28,9 @@ pub enum OutMessage {
     NavSatFix(NavSatFix),
     /// `geometry_msgs/msg/PoseWithCovarianceStamped`.
     PoseWithCovarianceStamped(PoseWithCovarianceStamped),
-    /// `tf2_msgs/msg/TFMessage`. `is_static` transforms are offered latched
-    /// ([`QosProfile::LATCHED`](super::QosProfile::LATCHED)); they belong on `/tf_static`.
+    /// `tf2_msgs/msg/TFMessage`. Topics with `is_static` transforms, and `/tf_static`
+    /// always, are offered latched ([`QosProfile::LATCHED`](super::QosProfile::LATCHED));
+    /// static transforms belong on `/tf_static`, which fusemap's reader treats as static.
     Tf {
         /// True for static transforms (valid at all times).
         is_static: bool,

@@ -43,6 +43,8 @@ impl StagingDir {
             _ => PathBuf::from("."),
         };
         check_target(target, overwrite)?;
+        // Like `ros2 bag record -o a/b/run`, missing parent directories are made.
+        std::fs::create_dir_all(&parent).map_err(|e| Error::io(target, e))?;
         let temp = sibling(&parent, &name, "tmp");
         std::fs::create_dir(&temp).map_err(|e| Error::io(target, e))?;
         Ok(Self { target: target.to_path_buf(), parent, name, temp, overwrite, committed: false })

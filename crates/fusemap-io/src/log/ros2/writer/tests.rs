@@ -360,17 +360,25 @@ fn bad_messages_are_refused_and_the_bag_stays_good() {
     assert!(w.set_topic_qos("/imu", QosProfile::LATCHED).is_err());
     w.set_topic_qos("/late", QosProfile::LATCHED).unwrap();
     w.write(Stamp(14), "/late", &ok).unwrap();
+    // `/tf_static` is latched even when the transforms are not flagged static.
+    w.write(Stamp(15), "/tf_static", &tf(false)).unwrap();
     let written = w.finish().unwrap();
-    assert_eq!(written.message_count, 3);
-    assert_eq!(written.topics.iter().map(|t| t.name.as_str()).collect::<Vec<_>>(), ["/imu", "/tf", "/late"]);
-    assert_eq!(written.topics[2].qos, QosProfile::LATCHED);
-    assert_eq!(read_all(&dir).0.len(), 3);
+    assert_eq!(written.message_count, 4);
+    let names: Vec<&str> = written.topics.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(names, ["/imu", "/tf", "/late", "/tf_static"]);
+    let qos: Vec<QosProfile> = written.topics.iter().map(|t| t.qos).collect();
+    assert_eq!(qos, [QosProfile::DEFAULT, QosProfile::DEFAULT, QosProfile::LATCHED, QosProfile::LATCHED]);
+    assert_eq!(read_all(&dir).0.len(), 4);
     std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn existing_bags_are_not_overwritten_and_abandoned_ones_leave_nothing() {
     let d = crate::testdata::temp_dir("writer-dir");
+    let nested = d.join("new/parents/bag");
+    Rosbag2Writer::create(&nested).unwrap().finish().unwrap();
+    assert!(nested.join("metadata.yaml").is_file() && nested.join("bag_0.mcap").is_file());
+    std::fs::remove_dir_all(d.join("new")).unwrap();
     let dir = d.join("bag");
     let mut w = Rosbag2Writer::create(&dir).unwrap();
     w.write(Stamp(1), "/imu", &OutMessage::Imu(imu(1))).unwrap();
