@@ -35,6 +35,7 @@ mod db3;
 mod mcap_reader;
 pub mod msgs;
 pub mod rosbag2;
+pub mod writer;
 
 use crate::error::{Error, Location, Result};
 use crate::log::{ImuMessage, LogMessage, LogReader, OdomMessage, ReadStats, ScanMessage, TfMessage, Transform};
