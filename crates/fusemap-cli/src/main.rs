@@ -51,6 +51,22 @@ enum Command {
         /// The log.
         log: PathBuf,
     },
+    /// Simulate the design document's production line (or a scenario file's world) and
+    /// write it as a rosbag2 bag (MCAP) with its ground truth: DIR/bag, DIR/truth.yaml +
+    /// truth.pgm (map_server), DIR/truth.tum.
+    Simulate {
+        /// A scenario file (TOML); default: the built-in production line.
+        scenario: Option<PathBuf>,
+        /// Output directory (created if needed).
+        #[arg(long)]
+        out: PathBuf,
+        /// Cell side of the true map, metres.
+        #[arg(long, default_value_t = 0.05)]
+        resolution: f64,
+        /// Replace an existing bag in DIR.
+        #[arg(long)]
+        overwrite: bool,
+    },
     /// Insertion throughput on fixed synthetic workloads (a: corridor, b: corridor x500,
     /// c: 39 m box with 1,081-beam scans).
     Bench {
@@ -79,6 +95,9 @@ fn main() {
             commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out)
         }
         Command::Doctor { config, log } => commands::doctor::run(config.as_deref(), &log),
+        Command::Simulate { scenario, out, resolution, overwrite } => {
+            commands::simulate::run(scenario.as_deref(), &out, resolution, overwrite)
+        }
         Command::Bench { workload, scanfile, max_scans, json } => {
             commands::bench::run(workload, scanfile.as_deref(), max_scans, json)
         }

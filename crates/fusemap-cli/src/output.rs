@@ -9,10 +9,10 @@ use fusemap_core::grid::Raster;
 use fusemap_core::metrics::map_entropy;
 use fusemap_core::sensor::ReturnCounts;
 use fusemap_core::time::Stamp;
-use std::time::Instant;
 use fusemap_io::atomic::{ensure_not_input, write_atomic};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 /// The files of a run, in `dir`.
 pub struct OutputFiles {
@@ -125,4 +125,3 @@ pub fn finish(
     summary.wall_time_s = started.elapsed().as_secs_f64();
     Ok(summary)
 }
-

@@ -40,7 +40,12 @@ pub fn parse_config_str(text: &str, path: &Path) -> Result<Config> {
     for i in 0..config.sensor.len() {
         let field = format!("sensor[{i}].datum");
         if let Some(n) = array_len(text, &field).filter(|&n| n != 3) {
-            return Err(field_error(path, text, &field, format!("expected [latitude, longitude, altitude], got {n} numbers")));
+            return Err(field_error(
+                path,
+                text,
+                &field,
+                format!("expected [latitude, longitude, altitude], got {n} numbers"),
+            ));
         }
     }
     config.validate().map_err(|e| field_error(path, text, &e.field, e.message))?;
@@ -259,7 +264,8 @@ mod tests {
         let e = parse("[map]\norigin = [1.0, 2.0, 0.5]\n").unwrap_err();
         assert_eq!(location(e).0, Location::LineField(2, "map.origin".into()));
         assert!(parse("[map]\norigin = [1.0]\n").is_err());
-        let e = parse("[[sensor]]\nkind = \"imu\"\nname = \"a\"\n[[sensor]]\nkind = \"lidar\"\nname = \"a\"\n").unwrap_err();
+        let e = parse("[[sensor]]\nkind = \"imu\"\nname = \"a\"\n[[sensor]]\nkind = \"lidar\"\nname = \"a\"\n")
+            .unwrap_err();
         assert_eq!(location(e).0, Location::LineField(6, "sensor[1].name".into()));
         let e = parse("[[sensor]]\nkind = \"imu\"\np_occ = 0.7\n").unwrap_err();
         assert_eq!(location(e).0, Location::LineField(3, "sensor[0].p_occ".into()));

@@ -47,7 +47,8 @@ pub fn read_tum(path: &Path) -> Result<Vec<(Stamp, Pose2)>> {
         if f.len() != 8 {
             return Err(bad(&format!("expected 8 fields (t x y z qx qy qz qw), got {}", f.len())));
         }
-        let stamp = Stamp::parse_decimal(f[0]).ok_or_else(|| bad("the timestamp is not a decimal number of seconds"))?;
+        let stamp =
+            Stamp::parse_decimal(f[0]).ok_or_else(|| bad("the timestamp is not a decimal number of seconds"))?;
         let mut v = [0.0; 7];
         for (k, s) in f[1..].iter().enumerate() {
             v[k] = s.parse().map_err(|_| bad(&format!("field {} is not a number: `{s}`", k + 2)))?;
@@ -70,8 +71,10 @@ mod tests {
     fn round_trip_keeps_stamps_and_poses() {
         let dir = crate::testdata::temp_dir("tum");
         let p = dir.join("t.tum");
-        let poses =
-            vec![(Stamp(1_700_000_000_123_456_789), Pose2::new(1.5, -2.25, 3.0)), (Stamp(-500_000_000), Pose2::new(0.0, 0.0, -1.0))];
+        let poses = vec![
+            (Stamp(1_700_000_000_123_456_789), Pose2::new(1.5, -2.25, 3.0)),
+            (Stamp(-500_000_000), Pose2::new(0.0, 0.0, -1.0)),
+        ];
         write_tum(&p, &poses).unwrap();
         let back = read_tum(&p).unwrap();
         assert_eq!(back.len(), 2);

@@ -197,7 +197,12 @@ pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
                     });
                 }
                 Track::ScanLine => {
-                    sync = Some(Sync { topic: topic.clone(), scans: stamps.len() as u64, source: chosen.name.clone(), track: None })
+                    sync = Some(Sync {
+                        topic: topic.clone(),
+                        scans: stamps.len() as u64,
+                        source: chosen.name.clone(),
+                        track: None,
+                    })
                 }
             }
             notes.extend(chosen.notes.iter().cloned());

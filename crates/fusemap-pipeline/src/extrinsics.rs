@@ -56,7 +56,12 @@ pub struct ExtrinsicsReport {
 }
 
 /// The log's mount of `frame`: static TF first, then the first dynamic transforms.
-pub fn from_tf(tf_static: &[Transform], tf_dynamic: &[Transform], base: &str, frame: &str) -> Option<(Mount3, &'static str)> {
+pub fn from_tf(
+    tf_static: &[Transform],
+    tf_dynamic: &[Transform],
+    base: &str,
+    frame: &str,
+) -> Option<(Mount3, &'static str)> {
     if frame.is_empty() {
         return None;
     }

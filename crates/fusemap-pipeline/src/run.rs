@@ -137,7 +137,11 @@ pub fn prepare(plan: &Plan, inv: &Inventory) -> Result<(Bound, ChosenTrack, f64)
 }
 
 /// Maps a recording whose first pass is done.
-pub fn map_inventory(plan: &Plan, inv: &Inventory, progress: &mut dyn FnMut(Progress)) -> Result<MapRun, PipelineError> {
+pub fn map_inventory(
+    plan: &Plan,
+    inv: &Inventory,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<MapRun, PipelineError> {
     let cfg = &plan.log;
     let (bound, chosen, track_s) = prepare(plan, inv)?;
     let mut notes = bound.notes.clone();
@@ -287,8 +291,8 @@ pub fn map_inventory(plan: &Plan, inv: &Inventory, progress: &mut dyn FnMut(Prog
             inv.stats.malformed_examples.join("; ")
         ));
     }
-    let pose_timing = (!chosen.stamps.is_empty())
-        .then(|| StreamTiming::analyze(&chosen.stamps, &chosen.receive, limits(cfg)));
+    let pose_timing =
+        (!chosen.stamps.is_empty()).then(|| StreamTiming::analyze(&chosen.stamps, &chosen.receive, limits(cfg)));
     let first = &lidars[0].report;
     let report = LogReport {
         format: inv.format.to_string(),
@@ -308,7 +312,12 @@ pub fn map_inventory(plan: &Plan, inv: &Inventory, progress: &mut dyn FnMut(Prog
             .lidars
             .iter()
             .map(|b| (b.lidar.name.clone(), format!("lidar {}", b.topic)))
-            .chain(bound.sensors.iter().map(|b| (b.sensor.name.clone(), format!("{} {}", b.sensor.kind.as_str(), b.topic))))
+            .chain(
+                bound
+                    .sensors
+                    .iter()
+                    .map(|b| (b.sensor.name.clone(), format!("{} {}", b.sensor.kind.as_str(), b.topic))),
+            )
             .collect(),
         pose_track: chosen.counts.clone(),
         scan_timing: first.timing,

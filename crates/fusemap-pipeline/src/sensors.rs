@@ -88,7 +88,10 @@ pub fn bind(plan: &Plan, topics: &BTreeMap<SensorKind, BTreeMap<String, u64>>) -
     if plan.lidars.iter().all(|l| l.topic.is_none()) && scan_topics.len() > out.lidars.len() {
         let unused: Vec<&str> =
             scan_topics.keys().filter(|t| !out.lidars.iter().any(|b| &b.topic == *t)).map(String::as_str).collect();
-        out.notes.push(format!("scan topics not mapped (list them as [[sensor]] lidars to map them): {}", unused.join(", ")));
+        out.notes.push(format!(
+            "scan topics not mapped (list them as [[sensor]] lidars to map them): {}",
+            unused.join(", ")
+        ));
     }
     for kind in [SensorKind::WheelOdometry, SensorKind::Imu, SensorKind::Gnss, SensorKind::Pose] {
         let listed = plan.sensors.iter().filter(|s| s.kind == kind);

@@ -133,7 +133,9 @@ pub fn choose(
     match source {
         PoseSource::ScanLine => {
             if !lines_have_poses {
-                return Err(PipelineError::Refused("log.pose_source = \"scan_line\" but the scans carry no pose".into()));
+                return Err(PipelineError::Refused(
+                    "log.pose_source = \"scan_line\" but the scans carry no pose".into(),
+                ));
             }
             Ok(ChosenTrack {
                 source,
@@ -154,8 +156,11 @@ pub fn choose(
             };
             let msgs = &inv.odom[&o.topic];
             let off = crate::offset_ns(o.sensor.time_offset_s);
-            let buffer =
-                buffer_of(cfg, msgs.iter().map(|m| (Stamp(m.stamp.0.saturating_add(off)), m.pose)).collect(), &mut counts);
+            let buffer = buffer_of(
+                cfg,
+                msgs.iter().map(|m| (Stamp(m.stamp.0.saturating_add(off)), m.pose)).collect(),
+                &mut counts,
+            );
             if buffer.is_empty() {
                 return Err(PipelineError::Refused(format!("the odometry `{}` holds no usable pose", o.topic)));
             }

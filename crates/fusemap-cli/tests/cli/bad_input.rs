@@ -106,7 +106,10 @@ fn config_clamp_min_not_below_the_prior() {
 
 #[test]
 fn config_tilted_mount() {
-    let (p, line) = config_error("tilt", "[[sensor]]\nkind = \"lidar\"\nname = \"laser\"\n\n[sensor.base_from_sensor]\npitch = 0.5\n");
+    let (p, line) = config_error(
+        "tilt",
+        "[[sensor]]\nkind = \"lidar\"\nname = \"laser\"\n\n[sensor.base_from_sensor]\npitch = 0.5\n",
+    );
     assert_names(&line, &[&p, "sensor[0].base_from_sensor", "tilted"]);
 }
 

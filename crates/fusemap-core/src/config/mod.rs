@@ -8,9 +8,7 @@
 
 mod sensor;
 
-pub use sensor::{
-    auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind,
-};
+pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 
 use crate::geometry::Point2;
 use crate::grid::{GridGeometry, OccupancyParams};

@@ -371,14 +371,25 @@ pub(super) fn plan_sensors(
             lidars.push(plan_lidar(i, s, name, prior)?);
             continue;
         }
-        let d = OdometryNoise { translation_per_m: 0.05, translation_per_rad: 0.01, rotation_per_rad: 0.05, rotation_per_m: 0.02 };
+        let d = OdometryNoise {
+            translation_per_m: 0.05,
+            translation_per_rad: 0.01,
+            rotation_per_rad: 0.05,
+            rotation_per_m: 0.02,
+        };
         let odometry = OdometryNoise {
-            translation_per_m: positive(&f("translation_noise_per_m"), s.translation_noise_per_m.unwrap_or(d.translation_per_m))?,
+            translation_per_m: positive(
+                &f("translation_noise_per_m"),
+                s.translation_noise_per_m.unwrap_or(d.translation_per_m),
+            )?,
             translation_per_rad: positive(
                 &f("translation_noise_per_rad"),
                 s.translation_noise_per_rad.unwrap_or(d.translation_per_rad),
             )?,
-            rotation_per_rad: positive(&f("rotation_noise_per_rad"), s.rotation_noise_per_rad.unwrap_or(d.rotation_per_rad))?,
+            rotation_per_rad: positive(
+                &f("rotation_noise_per_rad"),
+                s.rotation_noise_per_rad.unwrap_or(d.rotation_per_rad),
+            )?,
             rotation_per_m: positive(&f("rotation_noise_per_m"), s.rotation_noise_per_m.unwrap_or(d.rotation_per_m))?,
         };
         let gyro = s.gyro_noise_rad_s.unwrap_or(0.005);
@@ -390,7 +401,10 @@ pub(super) fn plan_sensors(
                 finite(&f("datum"), v)?;
             }
             if lat.abs() > 90.0 || lon.abs() > 180.0 {
-                return Err(err(f("datum"), format!("latitude must be within ±90° and longitude ±180°, got {lat}, {lon}")));
+                return Err(err(
+                    f("datum"),
+                    format!("latitude must be within ±90° and longitude ±180°, got {lat}, {lon}"),
+                ));
             }
         }
         let gnss = GnssNoise {

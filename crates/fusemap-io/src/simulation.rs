@@ -1,0 +1,154 @@
+//! A simulated run written as a user's robot would record it: a rosbag2 directory (MCAP
+//! storage, standard message types, CDR, `/tf_static` latched) with the ground truth
+//! beside it — the occupancy map as map_server PGM + YAML and the true trajectory as TUM.
+//!
+//! Scenario files are TOML mapping one to one onto
+//! [`fusemap_core::sim::production::Scenario`]; unknown keys are errors naming their line.
+
+use crate::config_file::{field_error, read_text, toml_error};
+use crate::log::ros2::writer::msgs::geometry_msgs::{PoseWithCovariance, TransformStamped, TwistWithCovariance};
+use crate::log::ros2::writer::msgs::nav_msgs::Odometry;
+use crate::log::ros2::writer::msgs::sensor_msgs::{Imu, LaserScan, NavSatFix, NavSatStatus};
+use crate::log::ros2::writer::msgs::std_msgs::Header;
+use crate::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions, WrittenBag};
+use crate::Result;
+use fusemap_core::grid::logodds::logit;
+use fusemap_core::grid::{GridGeometry, OccupancyParams, Raster};
+use fusemap_core::sim::production::{Scenario, SimMessage, SimRecording};
+use std::path::{Path, PathBuf};
+
+/// Reads and validates a scenario file.
+pub fn load_scenario(path: &Path) -> Result<Scenario> {
+    let text = read_text(path)?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let s: Scenario = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+    s.validate().map_err(|m| {
+        // The simulator names the field first: `lidar.rate_hz: must be > 0`.
+        let field = m.split(':').next().unwrap_or("").trim().to_string();
+        field_error(path, text, &field, m)
+    })?;
+    Ok(s)
+}
+
+/// The ROS message of a simulated one.
+pub fn to_out_message(m: &SimMessage) -> OutMessage {
+    let header = |stamp, frame: &str| Header { stamp, frame_id: frame.to_string() };
+    match m {
+        SimMessage::Scan(s) => OutMessage::LaserScan(LaserScan {
+            header: header(s.stamp, &s.frame_id),
+            angle_min: s.angle_min,
+            angle_max: s.angle_max,
+            angle_increment: s.angle_increment,
+            time_increment: s.time_increment,
+            scan_time: s.scan_time,
+            range_min: s.range_min,
+            range_max: s.range_max,
+            ranges: s.ranges.clone(),
+            intensities: s.intensities.clone(),
+        }),
+        SimMessage::Odometry(o) => OutMessage::Odometry(Odometry {
+            header: header(o.stamp, &o.frame_id),
+            child_frame_id: o.child_frame_id.clone(),
+            pose: PoseWithCovariance {
+                position: o.position,
+                orientation: o.orientation,
+                covariance: o.pose_covariance,
+            },
+            twist: TwistWithCovariance { linear: o.linear, angular: o.angular, covariance: o.twist_covariance },
+        }),
+        SimMessage::Imu(i) => OutMessage::Imu(Imu {
+            header: header(i.stamp, &i.frame_id),
+            orientation: i.orientation,
+            orientation_covariance: i.orientation_covariance,
+            angular_velocity: i.angular_velocity,
+            angular_velocity_covariance: i.angular_velocity_covariance,
+            linear_acceleration: i.linear_acceleration,
+            linear_acceleration_covariance: i.linear_acceleration_covariance,
+        }),
+        SimMessage::Fix(f) => OutMessage::NavSatFix(NavSatFix {
+            header: header(f.stamp, &f.frame_id),
+            status: NavSatStatus { status: f.status, service: f.service },
+            latitude: f.latitude,
+            longitude: f.longitude,
+            altitude: f.altitude,
+            position_covariance: f.position_covariance,
+            position_covariance_type: f.position_covariance_type,
+        }),
+        SimMessage::StaticTransform(t) => OutMessage::Tf { is_static: true, transforms: vec![transform(t)] },
+    }
+}
+
+fn transform(t: &fusemap_core::sim::production::SimStaticTransform) -> TransformStamped {
+    TransformStamped {
+        header: Header { stamp: t.stamp, frame_id: t.frame_id.clone() },
+        child_frame_id: t.child_frame_id.clone(),
+        translation: t.translation,
+        rotation: t.rotation,
+    }
+}
+
+/// Writes `rec` as a rosbag2 directory at `dir`: every message with its header stamp as
+/// log time, the static mounts as one latched `/tf_static` message (as a ROS static
+/// broadcaster publishes them).
+pub fn write_bag(rec: &SimRecording, dir: &Path, overwrite: bool) -> Result<WrittenBag> {
+    let mut w = Rosbag2Writer::create_with(dir, Rosbag2WriterOptions { overwrite, ..Default::default() })?;
+    let statics: Vec<&SimMessage> =
+        rec.messages.iter().filter(|m| matches!(m, SimMessage::StaticTransform(_))).collect();
+    if let Some(first) = statics.first() {
+        let transforms = statics
+            .iter()
+            .filter_map(|m| match m {
+                SimMessage::StaticTransform(t) => Some(transform(t)),
+                _ => None,
+            })
+            .collect();
+        w.write(first.stamp(), first.topic(), &OutMessage::Tf { is_static: true, transforms })?;
+    }
+    for m in rec.messages.iter().filter(|m| !matches!(m, SimMessage::StaticTransform(_))) {
+        w.write(m.stamp(), m.topic(), &to_out_message(m))?;
+    }
+    w.finish()
+}
+
+/// The true occupancy as a map raster: occupied where an object covers the cell, free
+/// elsewhere inside the hall.
+pub fn truth_raster(rec: &SimRecording, geometry: GridGeometry) -> Option<Raster> {
+    let t = rec.truth_occupancy(geometry).ok()?;
+    let params = OccupancyParams::default();
+    let (occ, free) = (logit(params.clamp_max) as f32, logit(params.clamp_min) as f32);
+    let origin = geometry.cell_corner(t.first_cell);
+    Some(Raster {
+        width: t.width,
+        height: t.height,
+        resolution: geometry.resolution(),
+        origin,
+        first_cell: t.first_cell,
+        log_odds: t.occupied.iter().map(|&o| if o { occ } else { free }).collect(),
+        known: vec![true; t.occupied.len()],
+        params,
+    })
+}
+
+/// What [`write_simulation`] wrote.
+pub struct SimulationFiles {
+    /// The rosbag2 directory.
+    pub bag: WrittenBag,
+    /// `truth.yaml` (map_server; `truth.pgm` beside it).
+    pub truth_map: Option<PathBuf>,
+    /// `truth.tum`.
+    pub truth_trajectory: PathBuf,
+}
+
+/// Writes the bag (`out/bag`), the true map (`out/truth.yaml` + `.pgm`, at `resolution`)
+/// and the true trajectory (`out/truth.tum`).
+pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwrite: bool) -> Result<SimulationFiles> {
+    std::fs::create_dir_all(out).map_err(|e| crate::Error::io(out, e))?;
+    let bag = write_bag(rec, &out.join("bag"), overwrite)?;
+    let truth_map = match GridGeometry::centered(resolution).ok().and_then(|g| truth_raster(rec, g)) {
+        Some(r) => Some(crate::map_server::write_map_server(&out.join("truth.yaml"), &r)?),
+        None => None,
+    };
+    let truth_trajectory = out.join("truth.tum");
+    crate::trajectory::write_tum(&truth_trajectory, &rec.truth_trajectory)?;
+    Ok(SimulationFiles { bag, truth_map, truth_trajectory })
+}
