@@ -8,36 +8,11 @@
 use crate::recording::ScanTopic;
 use crate::PipelineError;
 use fusemap_core::config::{ExtrinsicsSource, LogConfig};
+use fusemap_core::frames::{FrameTree, FrameTreeLimits, LookupError};
 use fusemap_core::geometry::{normalize_angle, Mount3, Pose3};
+use fusemap_core::time::Stamp;
 use fusemap_io::log::Transform;
 use serde::Serialize;
-use std::collections::{HashMap, VecDeque};
-
-/// The transform `base_from_frame` through a list of transforms taken as a tree (either
-/// direction per edge), breadth first from `base`.
-pub fn chain(transforms: &[Transform], base: &str, frame: &str) -> Option<Pose3> {
-    let mut edges: HashMap<&str, Vec<(&str, Pose3)>> = HashMap::new();
-    for t in transforms {
-        let p = Pose3::new(t.translation, t.rotation);
-        edges.entry(t.parent.as_str()).or_default().push((t.child.as_str(), p));
-        edges.entry(t.child.as_str()).or_default().push((t.parent.as_str(), p.inverse()));
-    }
-    let mut seen: HashMap<&str, Pose3> = HashMap::from([(base, Pose3::IDENTITY)]);
-    let mut queue = VecDeque::from([base]);
-    while let Some(f) = queue.pop_front() {
-        let here = seen[f];
-        if f == frame {
-            return Some(here);
-        }
-        for (next, p) in edges.get(f).into_iter().flatten() {
-            if !seen.contains_key(next) {
-                seen.insert(next, here.compose(p));
-                queue.push_back(next);
-            }
-        }
-    }
-    None
-}
 
 /// What was decided about one sensor's mount.
 #[derive(Debug, Clone, Serialize)]
@@ -55,20 +30,55 @@ pub struct ExtrinsicsReport {
     pub yaw_difference_deg: Option<f64>,
 }
 
-/// The log's mount of `frame`: static TF first, then the first dynamic transforms.
-pub fn from_tf(
-    tf_static: &[Transform],
-    tf_dynamic: &[Transform],
-    base: &str,
-    frame: &str,
-) -> Option<(Mount3, &'static str)> {
+/// The log's frame tree (`/tf_static` and `/tf`), with what it refused in plain words:
+/// a second parent, a loop, a static transform given twice with different values.
+pub fn frame_tree(cfg: &LogConfig, tf_static: &[Transform], tf_dynamic: &[Transform]) -> (FrameTree, Vec<String>) {
+    let mut tree = FrameTree::new(FrameTreeLimits {
+        max_gap_s: cfg.max_pose_gap_s,
+        bridge_motion_m: cfg.gap_bridge_motion_m,
+        bridge_motion_deg: cfg.gap_bridge_motion_deg,
+        ..FrameTreeLimits::default()
+    });
+    // Each refusal is counted by the tree; the first few are spelt out.
+    let mut first = Vec::new();
+    for t in tf_static {
+        let p = Pose3 { translation: t.translation, rotation: t.rotation };
+        if let Err(e) = tree.add_static(&t.parent, &t.child, p) {
+            if first.len() < 3 {
+                first.push(format!("/tf_static {} → {}: {e}", t.parent, t.child));
+            }
+        }
+    }
+    for t in tf_dynamic {
+        let p = Pose3 { translation: t.translation, rotation: t.rotation };
+        if let Err(e) = tree.add_dynamic(t.stamp, &t.parent, &t.child, p) {
+            if first.len() < 3 {
+                first.push(format!("/tf {} → {}: {e}", t.parent, t.child));
+            }
+        }
+    }
+    let mut notes = Vec::new();
+    let refused = tree.rejected().total();
+    if refused > 0 {
+        notes.push(format!("{refused} transforms refused by the frame tree; first: {}", first.join("; ")));
+    }
+    (tree, notes)
+}
+
+/// The log's mount of `frame` from the frame tree: a static chain, else the chain at
+/// `stamp` (a sensor on a moving mount gets the mount at its first scan).
+pub fn from_tf(tree: &FrameTree, base: &str, frame: &str, stamp: Option<Stamp>) -> Option<(Mount3, &'static str)> {
     if frame.is_empty() {
         return None;
     }
     if frame == base {
         return Some((Mount3::default(), "tf"));
     }
-    chain(tf_static, base, frame).or_else(|| chain(tf_dynamic, base, frame)).map(|p| (p.to_mount(), "tf"))
+    match tree.lookup_static(base, frame) {
+        Ok(p) => Some((p.to_mount(), "tf")),
+        Err(LookupError::DynamicEdge { .. }) => tree.lookup(base, frame, stamp?).ok().map(|p| (p.to_mount(), "tf")),
+        Err(_) => None,
+    }
 }
 
 /// Resolves the mount of the sensor of `frame` (`name` for messages). `config_mount` is
@@ -125,13 +135,12 @@ pub fn resolve(
 
 /// A lidar's mount from the log: TF of its frame, else CARMEN laser poses on its lines.
 pub fn lidar_mount_from_log(
-    tf_static: &[Transform],
-    tf_dynamic: &[Transform],
+    tree: &FrameTree,
     base: &str,
     frame: &str,
     topic: &ScanTopic,
 ) -> Option<(Mount3, &'static str)> {
-    from_tf(tf_static, tf_dynamic, base, frame).or_else(|| {
+    from_tf(tree, base, frame, topic.stamps.iter().min().copied()).or_else(|| {
         topic.first_laser_pose.map(|(robot, laser)| {
             let p = robot.inverse() * laser;
             (Mount3 { x: p.x, y: p.y, yaw: p.theta, ..Default::default() }, "scan_line")

@@ -128,6 +128,8 @@ pub struct LogReport {
     pub merge: Vec<StreamStats>,
     /// The most scans the merge held at once.
     pub merge_peak_queued: usize,
+    /// The frame tree of `/tf_static` and `/tf`: frames, edges, and what it refused.
+    pub frames: fusemap_core::frames::FrameReport,
     /// Records skipped by type.
     pub skipped_by_type: BTreeMap<String, u64>,
     /// Malformed records skipped.

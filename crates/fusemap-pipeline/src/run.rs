@@ -8,7 +8,7 @@
 //! de-skewed). Every scan that cannot be posed is skipped and counted with its reason;
 //! clock faults are reported, and the usable part of the log is still mapped.
 
-use crate::extrinsics::{lidar_mount_from_log, resolve, ExtrinsicsReport};
+use crate::extrinsics::{frame_tree, lidar_mount_from_log, resolve, ExtrinsicsReport};
 use crate::merge::{OrderedMerge, Pushed};
 use crate::recording::{for_each_scan, Inventory};
 use crate::report::{LidarReport, LogReport, Skipped};
@@ -156,11 +156,13 @@ pub fn map_inventory(
     };
     let mut merge: OrderedMerge<ScanMessage> = OrderedMerge::new(window);
     let mut engine = Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy));
+    let (tree, tree_notes) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
+    notes.extend(tree_notes);
     let mut lidars = Vec::new();
     for b in &bound.lidars {
         let topic = &inv.scans[&b.topic];
         let frame = b.lidar.frame.clone().or_else(|| topic.frame().map(str::to_string)).unwrap_or_default();
-        let log_mount = lidar_mount_from_log(&inv.tf_static, &inv.tf_dynamic, &cfg.base_frame, &frame, topic);
+        let log_mount = lidar_mount_from_log(&tree, &cfg.base_frame, &frame, topic);
         let config_mount = b.lidar.mount_given.then_some(b.lidar.mount);
         let ext: ExtrinsicsReport = resolve(&frame, cfg, config_mount, log_mount, &mut notes)?;
         let planar: PlanarMount = ext
@@ -326,6 +328,7 @@ pub fn map_inventory(
         estimator: chosen.estimator.clone(),
         merge: merge.stats().to_vec(),
         merge_peak_queued: merge.peak_queued(),
+        frames: tree.report(),
         skipped_by_type: inv.stats.skipped_by_type.clone(),
         malformed_records: inv.stats.malformed,
         decode_s: inv.read_s,
