@@ -11,6 +11,7 @@
 //! | the measurement every sensor model produces | [`measurement`] |
 //! | sensor models (lidar inverse model) | [`sensor`] |
 //! | the engine taking time-ordered measurements | [`fusion`] |
+//! | the `map → base_link` track from odometry, gyro, GNSS (EKF + RTS smoother) | [`estimator`] |
 //! | entropy, precision / recall | [`metrics`] |
 //! | simulated worlds and scanners | [`sim`] |
 //! | the validated run configuration | [`config`] |
@@ -31,6 +32,7 @@
 #![warn(missing_docs)]
 
 pub mod config;
+pub mod estimator;
 pub mod fusion;
 pub mod geometry;
 pub mod grid;

@@ -1,0 +1,286 @@
+//! The estimator on a simulated drive, and its edge cases.
+
+use super::filter::{update, StepRecord, N};
+use super::linalg::{identity, Mat};
+use super::smoother::smooth;
+use super::test_drive::{gaussian, simulate, Drive, DriveSpec};
+use super::*;
+use crate::geometry::Point2;
+use crate::sim::SplitMix64;
+use crate::time::Stamp;
+
+fn rms(errors: &[f64]) -> f64 {
+    (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt()
+}
+
+/// Position errors of a track against the truth at the odometry stamps, all and inside `window` (s).
+fn errors(drive: &Drive, track: impl Fn(Stamp) -> Option<Pose2>, window: (f64, f64)) -> (Vec<f64>, Vec<f64>) {
+    let t0 = drive.truth[0].0;
+    let (mut all, mut inside) = (Vec::new(), Vec::new());
+    for &(t, truth) in &drive.truth {
+        let Some(p) = track(t) else { continue };
+        let e = p.translation().distance(truth.translation());
+        all.push(e);
+        let s = t.secs_since(t0);
+        if s >= window.0 && s < window.1 {
+            inside.push(e);
+        }
+    }
+    (all, inside)
+}
+
+#[test]
+fn drive_with_slip_outliers_and_a_dropout() {
+    let drive = simulate(&DriveSpec::standard(7));
+    let est = estimate(&drive.inputs, &EstimatorConfig::default()).unwrap();
+    let r = &est.report;
+
+    // Raw odometry aligned at the start pose.
+    let align = drive.truth[0].1.compose(drive.odometry[0].inverse());
+    let raw: Vec<f64> = drive
+        .truth
+        .iter()
+        .zip(&drive.odometry)
+        .map(|(&(_, truth), &odo)| align.compose(odo).translation().distance(truth.translation()))
+        .collect();
+    let (filt, filt_drop) = errors(&drive, |t| est.filtered_pose_at(t).ok().map(|p| p.0), drive.dropout);
+    let (smooth, smooth_drop) = errors(&drive, |t| est.pose_at(t).ok().map(|p| p.0), drive.dropout);
+    assert_eq!(smooth.len(), drive.truth.len(), "every odometry stamp has a smoothed pose");
+    let (ate_raw, ate_filt, ate_smooth) = (rms(&raw), rms(&filt), rms(&smooth));
+    let (drop_filt, drop_smooth) = (rms(&filt_drop), rms(&smooth_drop));
+
+    let rejected: std::collections::HashSet<Stamp> =
+        r.rejected_fixes.iter().filter(|f| f.reason == FixRejection::Gate).map(|f| f.stamp).collect();
+    let outliers_rejected = drive.outlier_fixes.iter().filter(|t| rejected.contains(t)).count();
+    let good_rejected = drive.good_fixes.iter().filter(|t| rejected.contains(t)).count();
+    let outlier_rate = outliers_rejected as f64 / drive.outlier_fixes.len() as f64;
+    let good_rate = good_rejected as f64 / drive.good_fixes.len() as f64;
+    let bias_err = (r.gyro_bias - drive.gyro_bias).abs() / drive.gyro_bias;
+    let scale_err =
+        ((r.odometry_scale - 1.0) - (drive.odometry_scale - 1.0)).abs() / (drive.odometry_scale - 1.0).abs();
+
+    println!("ATE raw odometry {ate_raw:.3} m, filter {ate_filt:.3} m, smoother {ate_smooth:.3} m");
+    println!("dropout RMS: filter {drop_filt:.3} m, smoother {drop_smooth:.3} m ({} samples)", smooth_drop.len());
+    println!(
+        "outliers rejected {outliers_rejected}/{} ({:.1} %), good fixes rejected {good_rejected}/{} ({:.2} %), gate resets {}",
+        drive.outlier_fixes.len(),
+        100.0 * outlier_rate,
+        drive.good_fixes.len(),
+        100.0 * good_rate,
+        r.gate_resets
+    );
+    println!(
+        "gyro bias {:.5} ± {:.5} rad/s (true {:.5}, error {:.1} %); odometry scale {:.5} ± {:.5} (true {:.5}, error of the deviation {:.1} %)",
+        r.gyro_bias,
+        r.gyro_bias_sigma,
+        drive.gyro_bias,
+        100.0 * bias_err,
+        r.odometry_scale,
+        r.odometry_scale_sigma,
+        drive.odometry_scale,
+        100.0 * scale_err
+    );
+    println!("heading init: {:?}", r.heading_init);
+    println!("slip stretches {:?} (injected {:?} s)", r.slip_stretches, drive.slips);
+    println!(
+        "fix NIS: mean accepted {:.2}, above gate {:.3}; zero-rate updates {} over {:.1} s",
+        r.fixes.innovation.mean_nis_accepted, r.fixes.innovation.share_above_gate, r.zero_rate.used, r.stationary_s
+    );
+
+    assert!(ate_smooth <= ate_raw / 5.0, "smoother {ate_smooth} vs raw {ate_raw}");
+    assert!(drop_smooth < drop_filt, "dropout: smoother {drop_smooth} vs filter {drop_filt}");
+    assert!(!smooth_drop.is_empty());
+    assert!(outlier_rate >= 0.95, "outliers rejected {outlier_rate}");
+    assert!(good_rate <= 0.02, "good fixes rejected {good_rate}");
+    assert!(bias_err <= 0.2, "gyro bias {} vs {}", r.gyro_bias, drive.gyro_bias);
+    assert!(scale_err <= 0.2, "odometry scale {} vs {}", r.odometry_scale, drive.odometry_scale);
+    // Every slip burst is reported, and the reports stay near the bursts.
+    let t0 = drive.truth[0].0;
+    for &(a, b) in &drive.slips {
+        assert!(
+            r.slip_stretches.iter().any(|s| s.start.secs_since(t0) < b && s.end.secs_since(t0) > a),
+            "burst {a}..{b} not reported"
+        );
+    }
+    let flagged: f64 = r.slip_stretches.iter().map(|s| s.end.secs_since(s.start)).sum();
+    assert!(flagged < 3.0 * 2.0 * drive.slips.len() as f64, "{flagged} s flagged");
+    assert!(matches!(r.heading_init.source, HeadingSource::CourseOverGround { .. }));
+}
+
+/// A linear random walk observed directly: the RTS smoother must equal the batch
+/// least-squares solution (the posterior mean and variance of the whole problem).
+#[test]
+fn rts_equals_the_batch_solution_on_a_linear_problem() {
+    let mut rng = SplitMix64::new(3);
+    let (n, q, r, p0, m0) = (25, 0.04, 0.09, 1.0, 0.3);
+    let z: Vec<f64> = (0..n).map(|k| (k as f64 * 0.3).sin() + 0.3 * gaussian(&mut rng)).collect();
+    // Kalman filter on state 0 of the five; the others sit still with unit variance.
+    let mut x = [m0, 0.0, 0.0, 0.0, 1.0];
+    let mut p: Mat<N, N> = identity();
+    p[0][0] = p0;
+    let mut records = Vec::new();
+    for (k, &zk) in z.iter().enumerate() {
+        let (x_pred, mut p_pred) = (x, p);
+        if k > 0 {
+            p_pred[0][0] += q;
+        }
+        let (mut xf, mut pf) = (x_pred, p_pred);
+        let h = [[1.0, 0.0, 0.0, 0.0, 0.0]];
+        let nu = [zk - xf[0]];
+        assert!(update(&mut xf, &mut pf, nu, &h, &[[r]], f64::INFINITY).accepted);
+        records.push(StepRecord { stamp: Stamp(k as i64), x: xf, p: pf, x_pred, p_pred, f: identity() });
+        (x, p) = (xf, pf);
+    }
+    let smoothed = smooth(&records);
+    // Batch: information matrix A and vector b of
+    // (x0 − m0)²/p0 + Σ (x_k − x_{k−1})²/q + Σ (z_k − x_k)²/r.
+    let mut a = vec![vec![0.0; n]; n];
+    let mut b = vec![0.0; n];
+    a[0][0] += 1.0 / p0;
+    b[0] += m0 / p0;
+    for k in 0..n {
+        a[k][k] += 1.0 / r;
+        b[k] += z[k] / r;
+        if k > 0 {
+            a[k][k] += 1.0 / q;
+            a[k - 1][k - 1] += 1.0 / q;
+            a[k][k - 1] -= 1.0 / q;
+            a[k - 1][k] -= 1.0 / q;
+        }
+    }
+    // Gauss–Jordan for A⁻¹ and the mean A⁻¹ b.
+    let mut aug: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            let mut row = a[i].clone();
+            row.extend((0..n).map(|j| if i == j { 1.0 } else { 0.0 }));
+            row
+        })
+        .collect();
+    for c in 0..n {
+        let piv = aug[c][c];
+        for v in aug[c].iter_mut() {
+            *v /= piv;
+        }
+        for i in 0..n {
+            if i != c {
+                let f = aug[i][c];
+                let row_c = aug[c].clone();
+                for (v, rc) in aug[i].iter_mut().zip(&row_c) {
+                    *v -= f * rc;
+                }
+            }
+        }
+    }
+    for k in 0..n {
+        let mean: f64 = (0..n).map(|j| aug[k][n + j] * b[j]).sum();
+        let var = aug[k][n + k];
+        assert!((smoothed[k].0[0] - mean).abs() < 1e-9, "mean {k}: {} vs {mean}", smoothed[k].0[0]);
+        assert!((smoothed[k].1[0][0] - var).abs() < 1e-9, "variance {k}: {} vs {var}", smoothed[k].1[0][0]);
+    }
+}
+
+fn odometry_line(n: i64) -> Vec<EstimatorInput> {
+    (0..=n)
+        .map(|i| EstimatorInput::Odometry {
+            stamp: Stamp(i * 20_000_000),
+            pose: Pose2::new(0.02 * i as f64, 0.0, 0.0),
+            covariance: None,
+        })
+        .collect()
+}
+
+#[test]
+fn non_finite_inputs_are_counted_not_fatal() {
+    let mut inputs = odometry_line(200);
+    let nan = f64::NAN;
+    inputs.push(EstimatorInput::Odometry { stamp: Stamp(5), pose: Pose2::new(nan, 0.0, 0.0), covariance: None });
+    inputs.push(EstimatorInput::Odometry {
+        stamp: Stamp(30_000_000),
+        pose: Pose2::new(0.03, 0.0, 0.0),
+        covariance: Some([[nan; 3]; 3]),
+    });
+    for i in 0..400 {
+        let rate = if i == 7 { nan } else { 0.0 };
+        let variance = if i == 8 { Some(0.0) } else { None };
+        inputs.push(EstimatorInput::Gyro { stamp: Stamp(i * 10_000_000), yaw_rate: rate, variance });
+    }
+    inputs.push(EstimatorInput::Heading { stamp: Stamp(1_000_000_000), yaw: nan, variance: 0.01 });
+    inputs.push(EstimatorInput::Heading { stamp: Stamp(1_100_000_000), yaw: 0.0, variance: nan });
+    let fix = |t: i64, enu: [f64; 2], cov: f64| EstimatorInput::Position {
+        stamp: Stamp(t),
+        enu,
+        covariance: [[cov, 0.0], [0.0, cov]],
+        antenna: Point2::default(),
+        quality: FixQuality::Unknown,
+    };
+    inputs.push(fix(2_000_000_000, [nan, 1.0], 0.01));
+    inputs.push(fix(2_200_000_000, [0.44, 0.0], 0.0));
+    inputs.push(fix(2_400_000_000, [0.48, 0.0], nan));
+    inputs.push(fix(9_000_000_000, [0.48, 0.0], 0.01));
+    inputs.push(EstimatorInput::Pose {
+        stamp: Stamp(3_000_000_000),
+        pose: Pose2::new(0.6, 0.0, nan),
+        covariance: [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]],
+    });
+    inputs.push(EstimatorInput::Pose {
+        stamp: Stamp(3_100_000_000),
+        pose: Pose2::new(0.62, 0.0, 0.0),
+        covariance: [[nan; 3]; 3],
+    });
+    let est = estimate(&inputs, &EstimatorConfig::default()).unwrap();
+    let r = &est.report;
+    assert_eq!(r.odometry.not_finite, 1);
+    assert_eq!(r.odometry.covariance_fallbacks, 1);
+    assert_eq!(r.gyro.not_finite, 1);
+    assert_eq!(r.gyro.variance_fallbacks, 1);
+    assert_eq!(r.headings.rejected_not_finite, 1);
+    assert_eq!(r.headings.covariance_fallbacks, 1);
+    assert_eq!(r.fixes.rejected_not_finite, 1);
+    assert_eq!(r.fixes.covariance_fallbacks, 2);
+    assert_eq!(r.fixes.ignored_outside_track, 1);
+    assert_eq!(r.poses.rejected_not_finite, 1);
+    assert_eq!(r.poses.covariance_fallbacks, 1);
+    assert!(matches!(r.heading_init.source, HeadingSource::AbsolutePose | HeadingSource::ImuHeading));
+    assert!(est.smoothed.iter().all(|s| s.pose.is_finite()));
+    let reasons: Vec<FixRejection> = r.rejected_fixes.iter().map(|f| f.reason).collect();
+    assert!(reasons.contains(&FixRejection::NotFinite) && reasons.contains(&FixRejection::OutsideTrack));
+}
+
+#[test]
+fn refusals_are_explicit() {
+    assert_eq!(estimate(&[], &EstimatorConfig::default()).unwrap_err(), EstimatorError::NoInputs);
+    let gyro_only: Vec<_> =
+        (0..10).map(|i| EstimatorInput::Gyro { stamp: Stamp(i), yaw_rate: 0.0, variance: None }).collect();
+    assert!(matches!(estimate(&gyro_only, &EstimatorConfig::default()), Err(EstimatorError::NoOdometry { .. })));
+    // Fixes, but the robot drives 1 m only: the heading cannot be observed.
+    let mut inputs = odometry_line(50);
+    for i in 0..5 {
+        inputs.push(EstimatorInput::Position {
+            stamp: Stamp(i * 200_000_000),
+            enu: [0.2 * i as f64, 0.0],
+            covariance: [[1e-4, 0.0], [0.0, 1e-4]],
+            antenna: Point2::default(),
+            quality: FixQuality::RtkFixed,
+        });
+    }
+    assert!(matches!(estimate(&inputs, &EstimatorConfig::default()), Err(EstimatorError::HeadingNotObservable { .. })));
+    let bad = EstimatorConfig { slip_sigma: 0.0, ..Default::default() };
+    assert!(matches!(estimate(&inputs, &bad), Err(EstimatorError::Config(m)) if m.contains("slip_sigma")));
+}
+
+/// Ten minutes of 50 Hz odometry, 100 Hz gyro and 5 Hz fixes: the time of filter +
+/// smoother, printed (run with `--release --ignored --nocapture`).
+#[test]
+#[ignore]
+fn ten_minutes_perf() {
+    let drive = simulate(&DriveSpec::long(11, 600.0));
+    let start = std::time::Instant::now();
+    let est = estimate(&drive.inputs, &EstimatorConfig::default()).unwrap();
+    let elapsed = start.elapsed();
+    println!(
+        "{} inputs, {} steps: estimate() took {:.3} s",
+        drive.inputs.len(),
+        est.report.steps,
+        elapsed.as_secs_f64()
+    );
+}
