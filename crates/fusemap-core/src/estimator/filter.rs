@@ -129,7 +129,7 @@ pub(crate) fn update<const M: usize>(
         return Gated { nis: f64::NAN, accepted: false };
     };
     let nis: f64 = (0..M).map(|i| (0..M).map(|j| nu[i] * s_inv[i][j] * nu[j]).sum::<f64>()).sum();
-    if !(nis <= gate) {
+    if nis.is_nan() || nis > gate {
         return Gated { nis, accepted: false };
     }
     let k = mul(&mul(p, &ht), &s_inv);

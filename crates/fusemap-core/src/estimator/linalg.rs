@@ -7,6 +7,9 @@
 //! RTS smoother need (product, transpose, sum, Cholesky inverse of a symmetric positive
 //! definite matrix).
 
+// Index loops read like the formulas they implement (`m[i][j] += a[i][k] * b[k][j]`).
+#![allow(clippy::needless_range_loop)]
+
 /// A row-major `R × C` matrix.
 pub(crate) type Mat<const R: usize, const C: usize> = [[f64; C]; R];
 
