@@ -76,6 +76,11 @@ pub struct EstimatorConfig {
     pub slip_sigma: f64,
     /// Factor on the odometry noise variance while it slips.
     pub slip_noise_inflation: f64,
+    /// Length of the window over which the odometry distance is compared with precise
+    /// fixes to detect wheel slip, seconds.
+    pub slip_fix_window_s: f64,
+    /// Only fixes with a largest standard deviation up to this judge slip, metres.
+    pub slip_fix_max_sigma_m: f64,
     /// Slip intervals closer than this are reported as one stretch, seconds.
     pub slip_merge_gap_s: f64,
     /// Odometry slower than this (translation) counts as standing still, m/s.
@@ -120,6 +125,8 @@ impl Default for EstimatorConfig {
             slip_window_s: 0.5,
             slip_sigma: 4.0,
             slip_noise_inflation: 400.0,
+            slip_fix_window_s: 1.0,
+            slip_fix_max_sigma_m: 0.1,
             slip_merge_gap_s: 0.5,
             stationary_max_speed_mps: 0.005,
             stationary_max_rate: 0.005,
@@ -150,6 +157,8 @@ impl EstimatorConfig {
             ("fallback_pose_sigma_rad", self.fallback_pose_sigma_rad),
             ("slip_window_s", self.slip_window_s),
             ("slip_sigma", self.slip_sigma),
+            ("slip_fix_window_s", self.slip_fix_window_s),
+            ("slip_fix_max_sigma_m", self.slip_fix_max_sigma_m),
             ("stationary_min_s", self.stationary_min_s),
             ("max_sample_gap_s", self.max_sample_gap_s),
         ];

@@ -9,7 +9,8 @@
 //! | step | module |
 //! |---|---|
 //! | inputs, validation and sorting | [`input`](self::EstimatorInput) (`input.rs`) |
-//! | odometry and gyro as functions of time, slip detection | `streams.rs` |
+//! | odometry and gyro as functions of time, slip against the gyro | `streams.rs` |
+//! | slip against precise fixes | `slip_fixes.rs` |
 //! | gyro bias at rest, dead reckoning, heading initialisation | `init.rs` |
 //! | prediction and gated Joseph-form update | `filter.rs`, `models.rs` |
 //! | the forward pass | `run.rs` |
@@ -56,6 +57,7 @@ mod models;
 mod output;
 mod report;
 mod run;
+mod slip_fixes;
 mod smoother;
 mod streams;
 
@@ -119,7 +121,8 @@ pub fn estimate(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> Result<Esti
         stationary_s: 0.0,
         steps_without_gyro: 0,
     };
-    let out = run::run(&odo, gyro.as_ref(), &slip, &sorted.corrections, &init, cfg, &mut rc)?;
+    let fix_slip = slip_fixes::FixSlipCheck::new(&sorted.corrections, cfg);
+    let out = run::run(&odo, gyro.as_ref(), &slip, &fix_slip, &sorted.corrections, &init, cfg, &mut rc)?;
     let smoothed = smoother::smooth(&out.records);
 
     let slip_stretches = slip_stretches(&odo, &out.slip, cfg.slip_merge_gap_s);

@@ -10,6 +10,7 @@ use super::input::{Correction, FixQuality};
 use super::linalg::{all_finite, identity, spd_inverse, Mat};
 use super::models;
 use super::report::{CorrectionReport, FixQualityCount, FixRejection, RejectedFix};
+use super::slip_fixes::FixSlipCheck;
 use super::streams::{GyroTrack, OdometryTrack, SlipDetector};
 use crate::time::Stamp;
 
@@ -107,12 +108,16 @@ impl Filter<'_> {
             last.iter().map(|(v, _)| v[0]).sum::<f64>() / m as f64,
             last.iter().map(|(v, _)| v[1]).sum::<f64>() / m as f64,
         ];
+        // Each innovation within the gate of the mean, and the spread small beside the
+        // mean offset: a few outliers of metres in random directions do not line up.
+        let offset = mean[0].hypot(mean[1]);
         let consistent = last.iter().all(|(v, s)| {
             let d = [v[0] - mean[0], v[1] - mean[1]];
-            spd_inverse(s).is_some_and(|si| {
-                d[0] * (si[0][0] * d[0] + si[0][1] * d[1]) + d[1] * (si[1][0] * d[0] + si[1][1] * d[1])
-                    <= self.gates.two
-            })
+            d[0].hypot(d[1]) <= 0.25 * offset
+                && spd_inverse(s).is_some_and(|si| {
+                    d[0] * (si[0][0] * d[0] + si[0][1] * d[1]) + d[1] * (si[1][0] * d[0] + si[1][1] * d[1])
+                        <= self.gates.two
+                })
         });
         if !consistent {
             return false;
@@ -145,6 +150,7 @@ pub(crate) fn run(
     odo: &OdometryTrack,
     gyro: Option<&GyroTrack>,
     slip: &SlipDetector,
+    fix_slip: &FixSlipCheck,
     corrections: &[(Stamp, Correction)],
     init: &Init,
     cfg: &EstimatorConfig,
@@ -184,7 +190,7 @@ pub(crate) fn run(
     let mut t_cur = t0;
     for (i, iv) in odo.intervals.iter().enumerate() {
         let t_end = odo.stamps[i + 1];
-        slips[i] = !iv.stationary && slip.slips(i, f.x[3]);
+        slips[i] = !iv.stationary && (slip.slips(i, f.x[3]) || fix_slip.slips(t_cur, t_end, odo, &f.x, &f.p));
         let inflation = if slips[i] { cfg.slip_noise_inflation } else { 1.0 };
         loop {
             let t = match corrections.get(j) {

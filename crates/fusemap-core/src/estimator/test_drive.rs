@@ -26,7 +26,8 @@ pub(crate) struct Drive {
     pub outlier_fixes: Vec<Stamp>,
     /// Stamps of every other fix.
     pub good_fixes: Vec<Stamp>,
-    /// Slip bursts: (start, end), seconds.
+    /// Slip bursts: (start, end), seconds. The wheels spin (distance ×1.5–2) and one side
+    /// skids (a yaw-rate error of 0.2–0.4 rad/s).
     pub slips: Vec<(f64, f64)>,
     /// The RTK dropout, seconds.
     pub dropout: (f64, f64),
@@ -124,7 +125,7 @@ pub(crate) fn simulate(spec: &DriveSpec) -> Drive {
     let slip_at = |t: f64| slips.iter().position(|&(a, b)| t >= a && t < b);
     let slip_gain: Vec<f64> = slips.iter().map(|_| rng.uniform(1.5, 2.0)).collect();
     let slip_yaw: Vec<f64> =
-        slips.iter().map(|_| rng.uniform(0.15, 0.3) * if rng.next_f64() < 0.5 { -1.0 } else { 1.0 }).collect();
+        slips.iter().map(|_| rng.uniform(0.2, 0.4) * if rng.next_f64() < 0.5 { -1.0 } else { 1.0 }).collect();
 
     // Truth on a fine clock (the gyro's), odometry and fixes on theirs.
     let dt = 1.0 / spec.gyro_hz;
