@@ -122,7 +122,8 @@ pub fn estimate(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> Result<Esti
         steps_without_gyro: 0,
     };
     let fix_slip = slip_fixes::FixSlipCheck::new(&sorted.corrections, cfg);
-    let out = run::run(&odo, gyro.as_ref(), &slip, &fix_slip, &sorted.corrections, &init, cfg, &mut rc)?;
+    let sources = run::MotionSources { odo: &odo, gyro: gyro.as_ref(), slip: &slip, fix_slip: &fix_slip };
+    let out = run::run(&sources, &sorted.corrections, &init, cfg, &mut rc)?;
     let smoothed = smoother::smooth(&out.records);
 
     let slip_stretches = slip_stretches(&odo, &out.slip, cfg.slip_merge_gap_s);

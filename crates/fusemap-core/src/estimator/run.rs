@@ -145,17 +145,24 @@ fn record(rep: &mut CorrectionReport, g: Gated, accepted: bool) {
     }
 }
 
+/// The motion streams and the slip checks on them.
+#[derive(Clone, Copy)]
+pub(crate) struct MotionSources<'a> {
+    pub odo: &'a OdometryTrack,
+    pub gyro: Option<&'a GyroTrack>,
+    pub slip: &'a SlipDetector,
+    pub fix_slip: &'a FixSlipCheck,
+}
+
 /// Runs the filter over the whole track.
 pub(crate) fn run(
-    odo: &OdometryTrack,
-    gyro: Option<&GyroTrack>,
-    slip: &SlipDetector,
-    fix_slip: &FixSlipCheck,
+    motion: &MotionSources,
     corrections: &[(Stamp, Correction)],
     init: &Init,
     cfg: &EstimatorConfig,
     counts: &mut RunCounts,
 ) -> Result<RunOutput, EstimatorError> {
+    let MotionSources { odo, gyro, slip, fix_slip } = *motion;
     let p = cfg.gate_probability;
     let q = |dof| {
         chi_square_quantile(dof, p).ok_or_else(|| EstimatorError::Config(format!("estimator.gate_probability {p}")))
