@@ -121,7 +121,7 @@ pub fn estimate(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> Result<Esti
         stationary_s: 0.0,
         steps_without_gyro: 0,
     };
-    let fix_slip = slip_fixes::FixSlipCheck::new(&sorted.corrections, cfg);
+    let fix_slip = slip_fixes::FixSlipCheck::new(&sorted.corrections, &odo, cfg);
     let sources = run::MotionSources { odo: &odo, gyro: gyro.as_ref(), slip: &slip, fix_slip: &fix_slip };
     let out = run::run(&sources, &sorted.corrections, &init, cfg, &mut rc)?;
     let smoothed = smoother::smooth(&out.records);

@@ -13,7 +13,7 @@ use super::filter::N;
 use super::input::Correction;
 use super::linalg::Mat;
 use super::streams::OdometryTrack;
-use crate::geometry::{normalize_angle, Point2};
+use crate::geometry::{normalize_angle, Point2, Pose2};
 use crate::time::Stamp;
 
 /// Precise fixes for the slip check.
@@ -22,18 +22,21 @@ pub(crate) struct FixSlipCheck {
     z: Vec<[f64; 2]>,
     antenna: Vec<Point2>,
     var: Vec<f64>,
+    /// The odometry pose at each fix, looked up once.
+    odo: Vec<Pose2>,
     half_window_ns: i64,
     k: f64,
     translation_var_per_m: f64,
 }
 
 impl FixSlipCheck {
-    pub fn new(corrections: &[(Stamp, Correction)], cfg: &EstimatorConfig) -> Self {
+    pub fn new(corrections: &[(Stamp, Correction)], odo: &OdometryTrack, cfg: &EstimatorConfig) -> Self {
         let mut s = Self {
             stamps: Vec::new(),
             z: Vec::new(),
             antenna: Vec::new(),
             var: Vec::new(),
+            odo: Vec::new(),
             half_window_ns: (cfg.slip_fix_window_s * 0.5e9) as i64,
             k: cfg.slip_sigma,
             translation_var_per_m: cfg.odometry_translation_noise.powi(2),
@@ -41,7 +44,8 @@ impl FixSlipCheck {
         for (t, c) in corrections {
             if let Correction::Position { z, r, antenna, .. } = c {
                 let max_var = r[0][0].max(r[1][1]);
-                if max_var <= cfg.slip_fix_max_sigma_m.powi(2) && s.stamps.last() != Some(t) {
+                if max_var <= cfg.slip_fix_max_sigma_m.powi(2) && s.stamps.last() != Some(t) && odo.contains(*t) {
+                    s.odo.push(odo.pose_at(*t));
                     s.stamps.push(*t);
                     s.z.push(*z);
                     s.antenna.push(*antenna);
@@ -53,30 +57,30 @@ impl FixSlipCheck {
     }
 
     /// The base position of fix `j`, its lever arm removed with the filter's heading
-    /// carried to the fix's stamp by the odometry.
-    fn base(&self, j: usize, odo: &OdometryTrack, x: &[f64; N], t_cur: Stamp) -> [f64; 2] {
-        let dtheta = normalize_angle(odo.pose_at(self.stamps[j]).theta - odo.pose_at(t_cur).theta);
+    /// carried to the fix's stamp by the odometry (`odo_theta_now`: the odometry heading at
+    /// the filter's stamp).
+    fn base(&self, j: usize, x: &[f64; N], odo_theta_now: f64) -> [f64; 2] {
+        let dtheta = normalize_angle(self.odo[j].theta - odo_theta_now);
         let (s, c) = (x[2] + dtheta).sin_cos();
         let a = self.antenna[j];
         [self.z[j][0] - (c * a.x - s * a.y), self.z[j][1] - (s * a.x + c * a.y)]
     }
 
     /// (excess distance of the fixes over the scaled odometry, its variance) between fixes `a` and `b`.
-    fn excess(&self, a: usize, b: usize, odo: &OdometryTrack, x: &[f64; N], p: &Mat<N, N>, t_cur: Stamp) -> (f64, f64) {
-        let (ba, bb) = (self.base(a, odo, x, t_cur), self.base(b, odo, x, t_cur));
+    fn excess(&self, a: usize, b: usize, x: &[f64; N], p: &Mat<N, N>, odo_theta_now: f64) -> (f64, f64) {
+        let (ba, bb) = (self.base(a, x, odo_theta_now), self.base(b, x, odo_theta_now));
         let fix_d = (bb[0] - ba[0]).hypot(bb[1] - ba[1]);
-        let inc = odo.pose_at(self.stamps[a]).inverse().compose(odo.pose_at(self.stamps[b]));
-        let odo_d = inc.x.hypot(inc.y);
+        let odo_d = self.odo[a].translation().distance(self.odo[b].translation());
         let var = self.var[a] + self.var[b] + self.translation_var_per_m * odo_d + p[4][4] * odo_d * odo_d + 1e-4;
         (fix_d - x[4] * odo_d, var)
     }
 
     /// True when the precise fixes in the window centred at `centre` show the odometry
     /// distance off by more than `slip_sigma` standard deviations, both halves agreeing.
-    fn window_slips(&self, centre: Stamp, odo: &OdometryTrack, x: &[f64; N], p: &Mat<N, N>, t_cur: Stamp) -> bool {
+    fn window_slips(&self, centre: Stamp, x: &[f64; N], p: &Mat<N, N>, odo_theta_now: f64) -> bool {
         let lo = self.stamps.partition_point(|&s| s.0 < centre.0 - self.half_window_ns);
         let hi = self.stamps.partition_point(|&s| s.0 <= centre.0 + self.half_window_ns);
-        if hi < lo + 3 || !odo.contains(self.stamps[lo]) || !odo.contains(self.stamps[hi - 1]) {
+        if hi < lo + 3 {
             return false;
         }
         let (first, last) = (lo, hi - 1);
@@ -84,9 +88,9 @@ impl FixSlipCheck {
             return false;
         }
         let mid = (first + last) / 2;
-        let (e, v) = self.excess(first, last, odo, x, p, t_cur);
-        let (e1, v1) = self.excess(first, mid, odo, x, p, t_cur);
-        let (e2, v2) = self.excess(mid, last, odo, x, p, t_cur);
+        let (e, v) = self.excess(first, last, x, p, odo_theta_now);
+        let (e1, v1) = self.excess(first, mid, x, p, odo_theta_now);
+        let (e2, v2) = self.excess(mid, last, x, p, odo_theta_now);
         e * e > self.k * self.k * v && e1 * e > 0.0 && e2 * e > 0.0 && e1 * e1 > v1 && e2 * e2 > v2
     }
 
@@ -97,8 +101,14 @@ impl FixSlipCheck {
             return false;
         }
         let c = Stamp(a.0 + (b.0 - a.0) / 2);
+        // Quick exit: no precise fix near the increment.
+        let lo = self.stamps.partition_point(|&s| s.0 < c.0 - 2 * self.half_window_ns);
+        if self.stamps.get(lo).is_none_or(|s| s.0 > c.0 + 2 * self.half_window_ns) {
+            return false;
+        }
+        let odo_theta_now = odo.pose_at(a).theta;
         [c, Stamp(c.0 - self.half_window_ns), Stamp(c.0 + self.half_window_ns)]
             .into_iter()
-            .any(|w| self.window_slips(w, odo, x, p, a))
+            .any(|w| self.window_slips(w, x, p, odo_theta_now))
     }
 }
