@@ -290,3 +290,71 @@ fn ten_minutes_perf() {
         elapsed.as_secs_f64()
     );
 }
+
+fn smoothed_and_raw_ate(drive: &Drive, est: &Estimate) -> (f64, f64) {
+    let align = drive.truth[0].1.compose(drive.odometry[0].inverse());
+    let raw: Vec<f64> = drive
+        .truth
+        .iter()
+        .zip(&drive.odometry)
+        .map(|(&(_, truth), &odo)| align.compose(odo).translation().distance(truth.translation()))
+        .collect();
+    let (smooth, _) = errors(drive, |t| est.pose_at(t).ok().map(|p| p.0), (0.0, 0.0));
+    (rms(&smooth), rms(&raw))
+}
+
+/// Without a gyro the odometry's heading increment predicts the heading; the bias stays
+/// at its prior (nothing observes it) and the fixes still hold the track.
+#[test]
+fn without_a_gyro_the_odometry_heading_is_used() {
+    let mut drive = simulate(&DriveSpec::standard(7));
+    drive.inputs.retain(|i| !matches!(i, EstimatorInput::Gyro { .. }));
+    let cfg = EstimatorConfig::default();
+    let est = estimate(&drive.inputs, &cfg).unwrap();
+    let r = &est.report;
+    let (smooth, raw) = smoothed_and_raw_ate(&drive, &est);
+    println!(
+        "no gyro: ATE raw {raw:.3} m, smoother {smooth:.3} m; odometry scale {:.4}; slip stretches {}",
+        r.odometry_scale,
+        r.slip_stretches.len()
+    );
+    assert_eq!(r.gyro.received, 0);
+    // Every moving step took its heading from the odometry (steps while standing still do not turn).
+    assert!(r.gyro.steps_without_gyro as f64 >= 0.9 * r.steps as f64, "{} of {}", r.gyro.steps_without_gyro, r.steps);
+    // Nothing observes the bias: it keeps its prior mean and its uncertainty only grows.
+    assert_eq!(r.gyro_bias, 0.0);
+    assert!(r.gyro_bias_sigma >= cfg.initial_gyro_bias_sigma);
+    assert!(smooth <= raw / 5.0, "smoother {smooth} vs raw {raw}");
+}
+
+/// An IMU yaw sets the heading at its first sample, carried back to the start.
+#[test]
+fn an_imu_heading_initialises_the_heading() {
+    let mut drive = simulate(&DriveSpec::standard(7));
+    let mut rng = SplitMix64::new(99);
+    let truth_start = drive.truth[0].1.theta;
+    // 10 Hz yaw from the second second on, σ = 0.01 rad.
+    let headings: Vec<EstimatorInput> = drive
+        .truth
+        .iter()
+        .skip(50)
+        .step_by(5)
+        .map(|&(stamp, p)| EstimatorInput::Heading { stamp, yaw: p.theta + 0.01 * gaussian(&mut rng), variance: 1e-4 })
+        .collect();
+    let first = headings[0].stamp();
+    drive.inputs.extend(headings);
+    let est = estimate(&drive.inputs, &EstimatorConfig::default()).unwrap();
+    let r = &est.report;
+    let h = &r.heading_init;
+    let err = crate::geometry::normalize_angle(h.start_heading_rad - truth_start);
+    let (smooth, raw) = smoothed_and_raw_ate(&drive, &est);
+    println!(
+        "IMU heading: start heading error {err:.4} rad (σ {:.4}), headings used {}/{}, ATE raw {raw:.3} m, smoother {smooth:.3} m",
+        h.start_heading_sigma_rad, r.headings.used, r.headings.received
+    );
+    assert_eq!(h.source, HeadingSource::ImuHeading);
+    assert_eq!(h.stamp, Some(first));
+    assert!(err.abs() <= 3.0 * h.start_heading_sigma_rad, "{err} vs σ {}", h.start_heading_sigma_rad);
+    assert!(r.headings.used as f64 >= 0.95 * r.headings.received as f64);
+    assert!(smooth <= raw / 5.0);
+}
