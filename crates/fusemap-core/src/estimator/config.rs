@@ -21,9 +21,11 @@ pub struct EstimatorConfig {
     /// course over ground, metres.
     pub heading_init_distance_m: f64,
     /// Only fixes whose largest standard deviation is at most this are used to initialise
-    /// the heading, metres.
+    /// the heading, metres. Imprecise fixes need a longer baseline: the distance used is at
+    /// least ten times the largest standard deviation of the fixes in the fit.
     pub heading_init_max_fix_sigma_m: f64,
-    /// Largest RMS residual of the course-over-ground fit, metres.
+    /// Largest RMS residual of the course-over-ground fit, metres (at least three times the
+    /// fixes' own standard deviation is always allowed).
     pub heading_init_max_residual_m: f64,
     /// Odometry translation noise: standard deviation after one metre, per axis of the
     /// base frame, m/√m.
@@ -38,7 +40,8 @@ pub struct EstimatorConfig {
     /// increment since the previous message) instead of the figures above when it is
     /// positive definite.
     pub use_odometry_covariance: bool,
-    /// Odometry gaps longer than this add `gap_speed_sigma_mps` of translation noise,
+    /// Odometry increments longer than this add translation noise for the unknown path
+    /// inside them (`gap_speed_sigma_mps` × duration, at most the distance across the gap),
     /// seconds.
     pub max_odometry_gap_s: f64,
     /// Speed uncertainty across an odometry gap, m/s.
@@ -101,7 +104,7 @@ impl Default for EstimatorConfig {
         Self {
             gate_probability: 0.99,
             heading_init_distance_m: 5.0,
-            heading_init_max_fix_sigma_m: 0.2,
+            heading_init_max_fix_sigma_m: 2.0,
             heading_init_max_residual_m: 0.3,
             odometry_translation_noise: 0.02,
             odometry_translation_noise_per_sqrt_s: 0.002,

@@ -158,9 +158,12 @@ fn course_over_ground(
     let mut travelled: f64 = 0.0;
     for a in 0..fixes.len() {
         let za = fixes[a].1;
-        let Some(b) = (a + 1..fixes.len())
-            .find(|&b| (fixes[b].1[0] - za[0]).hypot(fixes[b].1[1] - za[1]) >= cfg.heading_init_distance_m)
-        else {
+        // The baseline grows with the fixes' imprecision: ten standard deviations at least.
+        let mut sigma = max_sigma(&fixes[a].2);
+        let Some(b) = (a + 1..fixes.len()).find(|&b| {
+            sigma = sigma.max(max_sigma(&fixes[b].2));
+            (fixes[b].1[0] - za[0]).hypot(fixes[b].1[1] - za[1]) >= cfg.heading_init_distance_m.max(10.0 * sigma)
+        }) else {
             for f in &fixes[a..] {
                 travelled = travelled.max((f.1[0] - za[0]).hypot(f.1[1] - za[1]));
             }
@@ -174,11 +177,11 @@ fn course_over_ground(
             })
             .collect();
         let keep_at_least = (pairs.len() * 4).div_ceil(5).max(3);
+        let fix_var = fixes[a..=b].iter().map(|f| 0.5 * (f.2[0][0] + f.2[1][1])).sum::<f64>() / (b - a + 1) as f64;
+        let max_rms = cfg.heading_init_max_residual_m.max(3.0 * fix_var.sqrt());
         loop {
             let fit = procrustes(&pairs);
-            if fit.rms <= cfg.heading_init_max_residual_m {
-                let fix_var =
-                    fixes[a..=b].iter().map(|f| 0.5 * (f.2[0][0] + f.2[1][1])).sum::<f64>() / (b - a + 1) as f64;
+            if fit.rms <= max_rms {
                 let mid = Stamp(fixes[a].0 .0 + (fixes[b].0 .0 - fixes[a].0 .0) / 2);
                 let distance = (fixes[b].1[0] - za[0]).hypot(fixes[b].1[1] - za[1]);
                 return Ok(CourseFit { stamp: fixes[b].0, fixes: pairs.len(), fit, distance, fix_var, mid });

@@ -142,6 +142,38 @@ pub(crate) struct InputCounts {
     pub rejected_fixes: Vec<RejectedFix>,
 }
 
+/// Stamps within ±146 years of the epoch: differences of two such stamps cannot overflow.
+fn sane(t: Stamp) -> bool {
+    t.0.unsigned_abs() < 1 << 62
+}
+
+/// Counts an input with an absurd stamp as not finite.
+fn count_insane(input: &EstimatorInput, counts: &mut InputCounts) {
+    match input {
+        EstimatorInput::Odometry { .. } => {
+            counts.odometry.received += 1;
+            counts.odometry.not_finite += 1;
+        }
+        EstimatorInput::Gyro { .. } => {
+            counts.gyro.received += 1;
+            counts.gyro.not_finite += 1;
+        }
+        EstimatorInput::Heading { .. } => {
+            counts.headings.received += 1;
+            counts.headings.rejected_not_finite += 1;
+        }
+        EstimatorInput::Position { stamp, .. } => {
+            counts.fixes.received += 1;
+            counts.fixes.rejected_not_finite += 1;
+            counts.rejected_fixes.push(RejectedFix { stamp: *stamp, reason: FixRejection::NotFinite, nis: f64::NAN });
+        }
+        EstimatorInput::Pose { .. } => {
+            counts.poses.received += 1;
+            counts.poses.rejected_not_finite += 1;
+        }
+    }
+}
+
 fn finite3(m: &Mat<3, 3>) -> bool {
     m.iter().flatten().all(|v| v.is_finite())
 }
@@ -164,6 +196,10 @@ pub(crate) fn sort_inputs(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> (
     let mut corrections = Vec::new();
     let fix_var = cfg.fallback_fix_sigma_m.powi(2);
     for i in order {
+        if !sane(inputs[i].stamp()) {
+            count_insane(&inputs[i], &mut counts);
+            continue;
+        }
         match inputs[i] {
             EstimatorInput::Odometry { stamp, pose, covariance } => {
                 counts.odometry.received += 1;

@@ -55,7 +55,7 @@ pub struct CorrectionReport {
     pub used: usize,
     /// Rejected by the Mahalanobis gate.
     pub rejected_gate: usize,
-    /// Rejected because a value was NaN or infinite.
+    /// Rejected because a value (or the stamp) was NaN, infinite or absurd.
     pub rejected_not_finite: usize,
     /// Ignored because they fall outside the odometry's time span (the track).
     pub ignored_outside_track: usize,
@@ -76,7 +76,7 @@ impl CorrectionReport {
 pub struct FixQualityCount {
     /// The quality the caller reported.
     pub quality: FixQuality,
-    /// Fixes received with it.
+    /// Valid (finite) fixes received with it.
     pub received: usize,
     /// Applied to the filter.
     pub used: usize,
@@ -91,7 +91,7 @@ pub struct OdometryReport {
     pub received: usize,
     /// Messages forming the track.
     pub used: usize,
-    /// Messages with a NaN or infinite pose, skipped.
+    /// Messages with a NaN or infinite pose (or an absurd stamp), skipped.
     pub not_finite: usize,
     /// Messages repeating the previous stamp, skipped.
     pub duplicate_stamps: usize,
@@ -112,7 +112,7 @@ pub struct GyroReport {
     pub received: usize,
     /// Samples used.
     pub used: usize,
-    /// Samples with a NaN or infinite rate, skipped.
+    /// Samples with a NaN or infinite rate (or an absurd stamp), skipped.
     pub not_finite: usize,
     /// Variances present but not finite or not positive: `gyro_rate_sigma` was used.
     pub variance_fallbacks: usize,

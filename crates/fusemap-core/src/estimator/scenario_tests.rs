@@ -358,3 +358,53 @@ fn an_imu_heading_initialises_the_heading() {
     assert!(r.headings.used as f64 >= 0.95 * r.headings.received as f64);
     assert!(smooth <= raw / 5.0);
 }
+
+/// Standalone GNSS (σ ≈ 1 m, no RTK): the course over ground needs a longer baseline but
+/// still gives the heading.
+#[test]
+fn imprecise_fixes_still_initialise_the_heading() {
+    let mut drive = simulate(&DriveSpec::standard(5));
+    let mut rng = SplitMix64::new(17);
+    for input in &mut drive.inputs {
+        if let EstimatorInput::Position { enu, covariance, quality, .. } = input {
+            enu[0] += 0.8 * gaussian(&mut rng);
+            enu[1] += 0.8 * gaussian(&mut rng);
+            *covariance = [[1.0, 0.0], [0.0, 1.0]];
+            *quality = FixQuality::Fix;
+        }
+    }
+    let est = estimate(&drive.inputs, &EstimatorConfig::default()).unwrap();
+    let h = &est.report.heading_init;
+    let err = crate::geometry::normalize_angle(h.start_heading_rad - drive.truth[0].1.theta);
+    let (smooth, raw) = smoothed_and_raw_ate(&drive, &est);
+    println!(
+        "σ 1 m fixes: {:?}, start heading error {err:.4} rad (σ {:.4}); ATE raw {raw:.3} m, smoother {smooth:.3} m",
+        h.source, h.start_heading_sigma_rad
+    );
+    match h.source {
+        HeadingSource::CourseOverGround { distance_m, .. } => assert!(distance_m >= 10.0, "{distance_m}"),
+        ref other => panic!("{other:?}"),
+    }
+    assert!(err.abs() <= 3.0 * h.start_heading_sigma_rad);
+    assert!(smooth <= raw / 5.0);
+}
+
+#[test]
+fn odometry_gaps_and_absurd_stamps() {
+    let mut inputs = odometry_line(100);
+    // A 3 s silence while moving, then more odometry.
+    inputs.extend((0..50).map(|i| EstimatorInput::Odometry {
+        stamp: Stamp(5_000_000_000 + i * 20_000_000),
+        pose: Pose2::new(3.0 + 0.02 * i as f64, 0.0, 0.0),
+        covariance: None,
+    }));
+    inputs.push(EstimatorInput::Gyro { stamp: Stamp(i64::MAX), yaw_rate: 0.0, variance: None });
+    inputs.push(EstimatorInput::Odometry { stamp: Stamp(i64::MIN), pose: Pose2::IDENTITY, covariance: None });
+    let est = estimate(&inputs, &EstimatorConfig::default()).unwrap();
+    assert_eq!(est.report.odometry.gaps, 1);
+    assert_eq!(est.report.odometry.not_finite, 1);
+    assert_eq!(est.report.gyro.not_finite, 1);
+    assert!(matches!(est.pose_at(Stamp(3_000_000_000)), Err(crate::time::NoPose::Gap { .. })));
+    assert!(est.pose_at(Stamp(5_010_000_000)).is_ok());
+    assert!(matches!(est.pose_at(Stamp(-1)), Err(crate::time::NoPose::BeforeStart(_))));
+}

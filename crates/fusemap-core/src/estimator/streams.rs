@@ -60,8 +60,12 @@ impl OdometryTrack {
                 [[vt, 0.0, 0.0], [0.0, vt, 0.0], [0.0, 0.0, vr]]
             });
             if gap {
+                // Encoders count through a gap in the messages, so the increment as a whole
+                // is still measured; what is unknown is the path inside it, which a stamp
+                // inside the gap interpolates. That error is bounded by the motion across
+                // the gap (none when standing still) and by the speed uncertainty.
                 counts.gaps += 1;
-                let extra = (cfg.gap_speed_sigma_mps * dt).powi(2);
+                let extra = (cfg.gap_speed_sigma_mps * dt).min(d).powi(2);
                 cov[0][0] += extra;
                 cov[1][1] += extra;
             }
@@ -78,7 +82,7 @@ impl OdometryTrack {
             }
             let mut j = i;
             let mut duration = 0.0;
-            while j < intervals.len() && intervals[j].stationary && !intervals[j].gap {
+            while j < intervals.len() && intervals[j].stationary {
                 duration += intervals[j].dt;
                 j += 1;
             }
