@@ -8,7 +8,7 @@
 //!
 //! | step | module |
 //! |---|---|
-//! | inputs, validation and sorting | [`input`](self::EstimatorInput) (`input.rs`) |
+//! | inputs, validation and sorting | [`EstimatorInput`] (`input.rs`) |
 //! | odometry and gyro as functions of time, slip against the gyro | `streams.rs` |
 //! | slip against precise fixes | `slip_fixes.rs` |
 //! | gyro bias at rest, dead reckoning, heading initialisation | `init.rs` |

@@ -27,8 +27,6 @@ pub(crate) struct Interval {
     pub cov: Mat<3, 3>,
     /// Part of a stretch of standing still long enough for zero-rate updates.
     pub stationary: bool,
-    /// Longer than `max_odometry_gap_s`.
-    pub gap: bool,
 }
 
 /// Wheel odometry as a function of time.
@@ -70,7 +68,7 @@ impl OdometryTrack {
                 cov[1][1] += extra;
             }
             let still = d <= cfg.stationary_max_speed_mps * dt && delta.theta.abs() <= cfg.stationary_max_rate * dt;
-            intervals.push(Interval { delta, dt, cov, stationary: still, gap });
+            intervals.push(Interval { delta, dt, cov, stationary: still });
         }
         // Only runs of standing still lasting stationary_min_s count: a single quiet
         // increment at low speed is not a stop.
