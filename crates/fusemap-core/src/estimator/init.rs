@@ -236,34 +236,28 @@ pub(crate) fn initialise(
     let course = course_over_ground(odo, &dr, &good_fixes, cfg);
 
     // The earliest source wins.
-    let mut best: Option<(Stamp, u8)> = None;
-    let mut consider = |t: Stamp, which: u8| {
-        if best.is_none_or(|(bt, _)| t < bt) {
-            best = Some((t, which));
-        }
-    };
-    if let Some((t, ..)) = first_pose {
-        consider(t, 0);
+    enum Source<'a> {
+        Pose([f64; 3], f64),
+        Heading(f64, f64),
+        Course(&'a CourseFit),
     }
-    if let Some((t, ..)) = first_heading {
-        consider(t, 1);
-    }
-    if let Ok(c) = &course {
-        consider(c.stamp, 2);
-    }
+    let candidates = [
+        first_pose.map(|(t, z, var)| (t, Source::Pose(z, var))),
+        first_heading.map(|(t, yaw, var)| (t, Source::Heading(yaw, var))),
+        course.as_ref().ok().map(|c| (c.stamp, Source::Course(c))),
+    ];
+    let best = candidates.into_iter().flatten().min_by_key(|(t, _)| *t);
     let pos_var = cfg.initial_position_sigma_m.powi(2);
     let gauge = 1e-10;
     let (stamp, source, phi, phi_var, position, p_var) = match best {
-        Some((t, 0)) => {
-            let (_, z, var) = first_pose.unwrap_or((t, [0.0; 3], 0.0));
+        Some((t, Source::Pose(z, var))) => {
             let (pose, _) = dr.at(odo, t);
             let phi = normalize_angle(z[2] - pose.theta);
             let (s, c) = phi.sin_cos();
             let p = Point2::new(z[0] - (c * pose.x - s * pose.y), z[1] - (s * pose.x + c * pose.y));
             (Some(t), HeadingSource::AbsolutePose, phi, var + drift_var(t), p, pos_var)
         }
-        Some((t, 1)) => {
-            let (_, yaw, var) = first_heading.unwrap_or((t, 0.0, 0.0));
+        Some((t, Source::Heading(yaw, var))) => {
             let (pose, _) = dr.at(odo, t);
             let phi = normalize_angle(yaw - pose.theta);
             // Position from the first fix when there is one; otherwise the start is the origin.
@@ -278,23 +272,22 @@ pub(crate) fn initialise(
             };
             (Some(t), HeadingSource::ImuHeading, phi, var + drift_var(t), p, p_var)
         }
-        Some((t, _)) if course.is_ok() => {
-            let c = course.as_ref().map_err(|_| EstimatorError::NoInputs)?;
+        Some((t, Source::Course(c))) => {
+            // Rotation variance of a rigid fit: σ² / Σ|l̃|² (residual or fix noise, the larger).
             let rms2 = c.fit.rms.powi(2).max(c.fix_var);
             let var = rms2 / c.fit.spread.max(1e-9) + drift_var(c.mid);
             let source =
                 HeadingSource::CourseOverGround { fixes: c.fixes, distance_m: c.distance, residual_rms_m: c.fit.rms };
             (Some(t), source, normalize_angle(c.fit.phi), var, c.fit.t, pos_var)
         }
-        _ => {
-            if let Err(travelled) = course {
-                if first_fix.is_some() {
-                    return Err(EstimatorError::HeadingNotObservable {
-                        travelled_m: travelled,
-                        needed_m: cfg.heading_init_distance_m,
-                    });
-                }
+        None => {
+            if let (Err(travelled), Some(_)) = (&course, first_fix) {
+                return Err(EstimatorError::HeadingNotObservable {
+                    travelled_m: *travelled,
+                    needed_m: cfg.heading_init_distance_m,
+                });
             }
+            // No absolute source at all: the map frame is the start pose, exactly.
             (None, HeadingSource::StartPose, 0.0, gauge, Point2::default(), gauge)
         }
     };
