@@ -248,6 +248,16 @@ pub(crate) fn initialise(
     ];
     let best = candidates.into_iter().flatten().min_by_key(|(t, _)| *t);
     let pos_var = cfg.initial_position_sigma_m.powi(2);
+    // A position found at t and carried back to the start by dead reckoning is as uncertain
+    // as the dead reckoning over that distance: scale, heading drift and noise.
+    let carried_var = |t: Stamp| {
+        let (pose, _) = dr.at(odo, t);
+        let d = pose.x.hypot(pose.y);
+        pos_var
+            + (cfg.initial_scale_sigma * d).powi(2)
+            + drift_var(t) * d * d
+            + cfg.odometry_translation_noise.powi(2) * d
+    };
     let gauge = 1e-10;
     let (stamp, source, phi, phi_var, position, p_var) = match best {
         Some((t, Source::Pose(z, var))) => {
@@ -255,7 +265,7 @@ pub(crate) fn initialise(
             let phi = normalize_angle(z[2] - pose.theta);
             let (s, c) = phi.sin_cos();
             let p = Point2::new(z[0] - (c * pose.x - s * pose.y), z[1] - (s * pose.x + c * pose.y));
-            (Some(t), HeadingSource::AbsolutePose, phi, var + drift_var(t), p, pos_var)
+            (Some(t), HeadingSource::AbsolutePose, phi, var + drift_var(t), p, carried_var(t))
         }
         Some((t, Source::Heading(yaw, var))) => {
             let (pose, _) = dr.at(odo, t);
@@ -266,7 +276,7 @@ pub(crate) fn initialise(
                     let (pf, _) = dr.at(odo, tf);
                     let a = pf.transform_point(antenna);
                     let (s, c) = phi.sin_cos();
-                    (Point2::new(z[0] - (c * a.x - s * a.y), z[1] - (s * a.x + c * a.y)), pos_var)
+                    (Point2::new(z[0] - (c * a.x - s * a.y), z[1] - (s * a.x + c * a.y)), carried_var(tf))
                 }
                 None => (Point2::default(), gauge),
             };
@@ -278,7 +288,7 @@ pub(crate) fn initialise(
             let var = rms2 / c.fit.spread.max(1e-9) + drift_var(c.mid);
             let source =
                 HeadingSource::CourseOverGround { fixes: c.fixes, distance_m: c.distance, residual_rms_m: c.fit.rms };
-            (Some(t), source, normalize_angle(c.fit.phi), var, c.fit.t, pos_var)
+            (Some(t), source, normalize_angle(c.fit.phi), var, c.fit.t, carried_var(c.mid))
         }
         None => {
             if let (Err(travelled), Some(_)) = (&course, first_fix) {
