@@ -195,6 +195,7 @@ pub(crate) fn run(
     }
     records.push(StepRecord { stamp: t0, x: f.x, p: f.p, x_pred: init.x, p_pred: init.p, f: identity() });
     let mut t_cur = t0;
+    let mut odo_cur = odo.pose_at(t0);
     for (i, iv) in odo.intervals.iter().enumerate() {
         let t_end = odo.stamps[i + 1];
         slips[i] = !iv.stationary && (slip.slips(i, f.x[3]) || fix_slip.slips(t_cur, t_end, odo, &f.x, &f.p));
@@ -205,7 +206,8 @@ pub(crate) fn run(
                 _ => t_end,
             };
             let dt = t.secs_since(t_cur);
-            let inc = odo.pose_at(t_cur).inverse().compose(odo.pose_at(t));
+            let odo_t = odo.pose_at(t);
+            let inc = odo_cur.inverse().compose(odo_t);
             let frac = dt / iv.dt;
             let mut cov = iv.cov;
             for v in cov.iter_mut().flatten() {
@@ -248,6 +250,7 @@ pub(crate) fn run(
             }
             records.push(StepRecord { stamp: t, x: f.x, p: f.p, x_pred, p_pred, f: jac });
             t_cur = t;
+            odo_cur = odo_t;
             if t == t_end {
                 break;
             }
