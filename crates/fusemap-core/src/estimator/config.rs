@@ -79,6 +79,9 @@ pub struct EstimatorConfig {
     pub slip_sigma: f64,
     /// Factor on the odometry noise variance while it slips.
     pub slip_noise_inflation: f64,
+    /// While the odometry slips, predict with the odometry speed from before the slip
+    /// (only ever slower than the slipping odometry: spinning wheels over-count).
+    pub slip_hold_speed: bool,
     /// Length of the window over which the odometry distance is compared with precise
     /// fixes to detect wheel slip, seconds.
     pub slip_fix_window_s: f64,
@@ -127,7 +130,8 @@ impl Default for EstimatorConfig {
             fallback_pose_sigma_rad: 0.1,
             slip_window_s: 0.5,
             slip_sigma: 4.0,
-            slip_noise_inflation: 400.0,
+            slip_noise_inflation: 100.0,
+            slip_hold_speed: true,
             slip_fix_window_s: 1.0,
             slip_fix_max_sigma_m: 0.1,
             slip_merge_gap_s: 0.5,

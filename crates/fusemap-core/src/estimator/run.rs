@@ -34,6 +34,9 @@ pub(crate) struct RunOutput {
     pub slip: Vec<bool>,
 }
 
+/// Time constant of the odometry speed held through a slip, seconds.
+const SPEED_TIME_CONSTANT_S: f64 = 1.0;
+
 struct Gates {
     one: f64,
     two: f64,
@@ -194,12 +197,26 @@ pub(crate) fn run(
         j += 1;
     }
     records.push(StepRecord { stamp: t0, x: f.x, p: f.p, x_pred: init.x, p_pred: init.p, f: identity() });
+    let mut held_speed = 0.0;
     let mut t_cur = t0;
     let mut odo_cur = odo.pose_at(t0);
     for (i, iv) in odo.intervals.iter().enumerate() {
         let t_end = odo.stamps[i + 1];
         slips[i] = !iv.stationary && (slip.slips(i, f.x[3]) || fix_slip.slips(t_cur, t_end, odo, &f.x, &f.p));
         let inflation = if slips[i] { cfg.slip_noise_inflation } else { 1.0 };
+        // Spinning wheels report distance the robot did not drive; its speed rarely jumps
+        // while they spin, so a slipping increment keeps the speed of the odometry before
+        // the slip (in the odometry's direction), its inflated noise covering the rest.
+        let iv_d = iv.delta.x.hypot(iv.delta.y);
+        let speed_factor = if slips[i] && cfg.slip_hold_speed && iv_d > 0.0 {
+            (held_speed * iv.dt / iv_d).clamp(0.0, 1.0)
+        } else {
+            if !iv.stationary {
+                let a = (-iv.dt / SPEED_TIME_CONSTANT_S).exp();
+                held_speed = a * held_speed + (1.0 - a) * iv_d / iv.dt;
+            }
+            1.0
+        };
         loop {
             let t = match corrections.get(j) {
                 Some(&(tc, _)) if tc <= t_end => tc,
@@ -223,8 +240,8 @@ pub(crate) fn run(
                 HeadingMotion::Odometry
             };
             let motion = Motion {
-                dx: inc.x,
-                dy: inc.y,
+                dx: inc.x * speed_factor,
+                dy: inc.y * speed_factor,
                 dtheta: inc.theta,
                 cov,
                 heading,

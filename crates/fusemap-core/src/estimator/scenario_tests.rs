@@ -55,6 +55,28 @@ fn check_drive(drive: &Drive) {
     let (ate_raw, ate_filt, ate_smooth) = (rms(&raw), rms(&filt), rms(&smooth));
     let (drop_filt, drop_smooth) = (rms(&filt_drop), rms(&smooth_drop));
 
+    // Errors inside the slip bursts (and the second after each, where a dragged track shows).
+    let (mut slip_filt, mut slip_smooth, mut slip_blind) = (Vec::new(), Vec::new(), Vec::new());
+    // The same drive with slip ignored (no noise inflation), for comparison.
+    let blind_cfg = EstimatorConfig { slip_noise_inflation: 1.0, slip_hold_speed: false, ..Default::default() };
+    let blind = estimate(&drive.inputs, &blind_cfg).unwrap();
+    let (mut worst_burst, mut worst_blind): (f64, f64) = (0.0, 0.0);
+    for &(a, b) in &drive.slips {
+        let (_, f) = errors(drive, |t| est.filtered_pose_at(t).ok().map(|p| p.0), (a, b + 1.0));
+        let (_, s) = errors(drive, |t| est.pose_at(t).ok().map(|p| p.0), (a, b + 1.0));
+        let (_, sb) = errors(drive, |t| blind.pose_at(t).ok().map(|p| p.0), (a, b + 1.0));
+        worst_burst = worst_burst.max(rms(&s));
+        worst_blind = worst_blind.max(rms(&sb));
+        println!(
+            "burst {a:.1}..{b:.1} s: smoother {:.3} m, slip ignored {:.3} m, filter {:.3} m",
+            rms(&s),
+            rms(&sb),
+            rms(&f)
+        );
+        slip_filt.extend(f);
+        slip_smooth.extend(s);
+        slip_blind.extend(sb);
+    }
     let rejected: std::collections::HashSet<Stamp> =
         r.rejected_fixes.iter().filter(|f| f.reason == FixRejection::Gate).map(|f| f.stamp).collect();
     let outliers_rejected = drive.outlier_fixes.iter().filter(|t| rejected.contains(t)).count();
@@ -66,6 +88,12 @@ fn check_drive(drive: &Drive) {
         ((r.odometry_scale - 1.0) - (drive.odometry_scale - 1.0)).abs() / (drive.odometry_scale - 1.0).abs();
 
     println!("ATE raw odometry {ate_raw:.3} m, filter {ate_filt:.3} m, smoother {ate_smooth:.3} m");
+    println!(
+        "slip bursts RMS: filter {:.3} m, smoother {:.3} m, {:.3} m with slip ignored (worst burst {worst_burst:.3} m; {worst_blind:.3} m)",
+        rms(&slip_filt),
+        rms(&slip_smooth),
+        rms(&slip_blind)
+    );
     println!("dropout RMS: filter {drop_filt:.3} m, smoother {drop_smooth:.3} m ({} samples)", smooth_drop.len());
     println!(
         "outliers rejected {outliers_rejected}/{} ({:.1} %), good fixes rejected {good_rejected}/{} ({:.2} %), gate resets {}",
@@ -96,6 +124,8 @@ fn check_drive(drive: &Drive) {
     assert!(ate_smooth <= ate_raw / 5.0, "smoother {ate_smooth} vs raw {ate_raw}");
     assert!(drop_smooth < drop_filt, "dropout: smoother {drop_smooth} vs filter {drop_filt}");
     assert!(!smooth_drop.is_empty());
+    let (with, without) = (rms(&slip_smooth), rms(&slip_blind));
+    assert!(with < 0.5 * without, "slip drags the track: {with} vs {without} when ignored");
     assert!(outlier_rate >= 0.95, "outliers rejected {outlier_rate}");
     assert!(good_rate <= 0.02, "good fixes rejected {good_rate}");
     assert!(bias_err <= 0.2, "gyro bias {} vs {}", r.gyro_bias, drive.gyro_bias);
