@@ -26,6 +26,11 @@
 //! - the heading comes from the earliest absolute source and is carried back to the first
 //!   odometry stamp, so the track starts with the odometry and never claims a heading it
 //!   has not observed ([`HeadingInit`]);
+//! - wheel slip is detected twice — odometry yaw against the gyro, odometry distance against
+//!   precise fixes — and a slipping stretch predicts with the speed from before the slip
+//!   and an inflated noise, so it cannot drag the track; stretches are reported;
+//! - fixes pass a χ² gate; when a few rejected fixes in a row agree with each other (the
+//!   filter drifted, e.g. after correlated fix errors), the position uncertainty is reopened;
 //! - every rejected or ignored input is counted by reason in the [`EstimatorReport`].
 //!
 //! ```

@@ -211,10 +211,10 @@ pub(crate) fn run(
         let speed_factor = if slips[i] && cfg.slip_hold_speed && iv_d > 0.0 {
             (held_speed * iv.dt / iv_d).clamp(0.0, 1.0)
         } else {
-            if !iv.stationary {
-                let a = (-iv.dt / SPEED_TIME_CONSTANT_S).exp();
-                held_speed = a * held_speed + (1.0 - a) * iv_d / iv.dt;
-            }
+            // Standing still counts too: a robot that spins its wheels when starting off
+            // is slow, not at the speed it had before it stopped.
+            let a = (-iv.dt / SPEED_TIME_CONSTANT_S).exp();
+            held_speed = a * held_speed + (1.0 - a) * iv_d / iv.dt;
             1.0
         };
         loop {
