@@ -143,9 +143,15 @@ pub(crate) fn simulate(spec: &DriveSpec) -> Drive {
     let corr_tau = 3.0;
     let corr_sigma = 0.35;
     let stamp = |i: usize| Stamp(1_700_000_000_000_000_000 + (i as i64) * (1e9 / spec.gyro_hz) as i64);
+    // The robot follows its commands through a first-order lag (0.5 s): speed and turn
+    // rate ramp instead of jumping.
+    let lag = (-dt / 0.5f64).exp();
+    let (mut v, mut w) = (0.0, 0.0);
     for i in 0..=steps {
         let t = i as f64 * dt;
-        let (v, w) = command(&spec.legs, t);
+        let (vc, wc) = command(&spec.legs, t);
+        v = lag * v + (1.0 - lag) * vc;
+        w = lag * w + (1.0 - lag) * wc;
         // Gyro.
         inputs.push(EstimatorInput::Gyro {
             stamp: stamp(i),
