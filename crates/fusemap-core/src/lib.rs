@@ -5,14 +5,16 @@
 //!
 //! | concept | module |
 //! |---|---|
-//! | SE(2) poses, sensor mounts | [`geometry`] |
-//! | time stamps | [`time`] |
+//! | SE(2)/SE(3) poses, sensor mounts, WGS84 ↔ ENU | [`geometry`] |
+//! | the frame tree of `/tf_static` and `/tf` (`map ← odom ← base_link ← sensor`) | [`frames`] |
+//! | time stamps, pose buffers and the pose-track trait | [`time`] |
 //! | grid geometry, log-odds, tiles, ray traversal | [`grid`] |
 //! | the measurement every sensor model produces | [`measurement`] |
 //! | sensor models (lidar inverse model) | [`sensor`] |
 //! | the engine taking time-ordered measurements | [`fusion`] |
+//! | the `map → base_link` track from odometry, gyro, GNSS (EKF + RTS smoother) | [`estimator`] |
 //! | entropy, precision / recall | [`metrics`] |
-//! | simulated worlds and scanners | [`sim`] |
+//! | simulated worlds and scanners, the production-line simulator | [`sim`] |
 //! | the validated run configuration | [`config`] |
 //!
 //! ```
@@ -31,6 +33,7 @@
 #![warn(missing_docs)]
 
 pub mod config;
+pub mod estimator;
 pub mod frames;
 pub mod fusion;
 pub mod geometry;

@@ -1,0 +1,299 @@
+//! The estimator's inputs, and their validation into time-ordered streams.
+
+use super::config::EstimatorConfig;
+use super::linalg::{is_spd, Mat};
+use super::report::{CorrectionReport, FixRejection, GyroReport, OdometryReport, RejectedFix};
+use crate::geometry::{Point2, Pose2};
+use crate::time::Stamp;
+use serde::{Deserialize, Serialize};
+
+/// The quality of a GNSS fix, as the caller maps its receiver's status (NavSatFix
+/// `status`, NMEA GGA quality). Used for reporting; the weight of a fix is its covariance,
+/// which the caller has already floored per status.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FixQuality {
+    /// RTK with fixed integer ambiguities (centimetres).
+    RtkFixed,
+    /// A standalone or float fix (decimetres to metres).
+    Fix,
+    /// SBAS-augmented fix.
+    Sbas,
+    /// Unknown status.
+    Unknown,
+}
+
+impl FixQuality {
+    /// Every quality, in report order.
+    pub const ALL: [FixQuality; 4] = [FixQuality::RtkFixed, FixQuality::Fix, FixQuality::Sbas, FixQuality::Unknown];
+
+    pub(crate) fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// One sensor reading for the estimator. Stamps are the measurement times; inputs may
+/// come in any order (they are sorted stably by stamp).
+#[derive(Clone, Debug, PartialEq)]
+pub enum EstimatorInput {
+    /// Wheel odometry: `odom_from_base`. Consecutive messages give the motion increment.
+    Odometry {
+        /// Measurement time.
+        stamp: Stamp,
+        /// `odom_from_base`.
+        pose: Pose2,
+        /// Covariance of (x, y, yaw), read as the covariance of the increment since the
+        /// previous message in the base frame at that message (ROS drivers differ; when it
+        /// is absent or not positive definite the configuration's noise model is used).
+        covariance: Option<[[f64; 3]; 3]>,
+    },
+    /// Gyro z rate.
+    Gyro {
+        /// Measurement time.
+        stamp: Stamp,
+        /// Angular rate about the base z axis, rad/s (REP 103: counter-clockwise positive).
+        yaw_rate: f64,
+        /// Variance of the rate, (rad/s)², when the message carries one.
+        variance: Option<f64>,
+    },
+    /// An absolute yaw from the IMU's orientation (only when it has one: a magnetometer or
+    /// a dual-antenna receiver), in the map frame.
+    Heading {
+        /// Measurement time.
+        stamp: Stamp,
+        /// Yaw, radians.
+        yaw: f64,
+        /// Variance, rad².
+        variance: f64,
+    },
+    /// A GNSS antenna position in the local ENU map frame (x east, y north).
+    Position {
+        /// Measurement time.
+        stamp: Stamp,
+        /// Antenna position, metres.
+        enu: [f64; 2],
+        /// Covariance, m² (already floored per fix status by the caller).
+        covariance: [[f64; 2]; 2],
+        /// The antenna in the base frame (`base_from_antenna` translation).
+        antenna: Point2,
+        /// Reported fix quality.
+        quality: FixQuality,
+    },
+    /// An absolute `map_from_base` pose (`PoseWithCovarianceStamped`).
+    Pose {
+        /// Measurement time.
+        stamp: Stamp,
+        /// `map_from_base`.
+        pose: Pose2,
+        /// Covariance of (x, y, yaw).
+        covariance: [[f64; 3]; 3],
+    },
+}
+
+impl EstimatorInput {
+    /// The measurement time.
+    pub fn stamp(&self) -> Stamp {
+        match self {
+            EstimatorInput::Odometry { stamp, .. }
+            | EstimatorInput::Gyro { stamp, .. }
+            | EstimatorInput::Heading { stamp, .. }
+            | EstimatorInput::Position { stamp, .. }
+            | EstimatorInput::Pose { stamp, .. } => *stamp,
+        }
+    }
+}
+
+/// A validated correction.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Correction {
+    Position { z: [f64; 2], r: Mat<2, 2>, antenna: Point2, quality: FixQuality },
+    Heading { yaw: f64, var: f64 },
+    Pose { z: [f64; 3], r: Mat<3, 3> },
+}
+
+/// Odometry samples (finite, strictly increasing stamps) with their raw covariances.
+pub(crate) struct RawOdometry {
+    pub stamps: Vec<Stamp>,
+    pub poses: Vec<Pose2>,
+    pub covariances: Vec<Option<Mat<3, 3>>>,
+}
+
+/// Gyro samples (finite, strictly increasing stamps) with their variances.
+pub(crate) struct RawGyro {
+    pub stamps: Vec<Stamp>,
+    pub rates: Vec<f64>,
+    pub variances: Vec<f64>,
+}
+
+/// The inputs split by kind, validated and in time order.
+pub(crate) struct Sorted {
+    pub odometry: RawOdometry,
+    pub gyro: RawGyro,
+    pub corrections: Vec<(Stamp, Correction)>,
+}
+
+/// Counters filled while sorting.
+pub(crate) struct InputCounts {
+    pub odometry: OdometryReport,
+    pub gyro: GyroReport,
+    pub fixes: CorrectionReport,
+    pub poses: CorrectionReport,
+    pub headings: CorrectionReport,
+    pub rejected_fixes: Vec<RejectedFix>,
+}
+
+/// Stamps within ±146 years of the epoch: differences of two such stamps cannot overflow.
+fn sane(t: Stamp) -> bool {
+    t.0.unsigned_abs() < 1 << 62
+}
+
+/// Counts an input with an absurd stamp as not finite.
+fn count_insane(input: &EstimatorInput, counts: &mut InputCounts) {
+    match input {
+        EstimatorInput::Odometry { .. } => {
+            counts.odometry.received += 1;
+            counts.odometry.not_finite += 1;
+        }
+        EstimatorInput::Gyro { .. } => {
+            counts.gyro.received += 1;
+            counts.gyro.not_finite += 1;
+        }
+        EstimatorInput::Heading { .. } => {
+            counts.headings.received += 1;
+            counts.headings.rejected_not_finite += 1;
+        }
+        EstimatorInput::Position { stamp, .. } => {
+            counts.fixes.received += 1;
+            counts.fixes.rejected_not_finite += 1;
+            counts.rejected_fixes.push(RejectedFix { stamp: *stamp, reason: FixRejection::NotFinite, nis: f64::NAN });
+        }
+        EstimatorInput::Pose { .. } => {
+            counts.poses.received += 1;
+            counts.poses.rejected_not_finite += 1;
+        }
+    }
+}
+
+fn finite3(m: &Mat<3, 3>) -> bool {
+    m.iter().flatten().all(|v| v.is_finite())
+}
+
+/// Sorts the inputs stably by stamp, drops non-finite values (counted) and replaces
+/// covariances that are not positive definite by the configuration's figures (counted).
+pub(crate) fn sort_inputs(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> (Sorted, InputCounts) {
+    let mut order: Vec<usize> = (0..inputs.len()).collect();
+    order.sort_by_key(|&i| inputs[i].stamp());
+    let mut counts = InputCounts {
+        odometry: OdometryReport::default(),
+        gyro: GyroReport::default(),
+        fixes: CorrectionReport::new(2),
+        poses: CorrectionReport::new(3),
+        headings: CorrectionReport::new(1),
+        rejected_fixes: Vec::new(),
+    };
+    let mut odometry = RawOdometry { stamps: Vec::new(), poses: Vec::new(), covariances: Vec::new() };
+    let mut gyro = RawGyro { stamps: Vec::new(), rates: Vec::new(), variances: Vec::new() };
+    let mut corrections = Vec::new();
+    let fix_var = cfg.fallback_fix_sigma_m.powi(2);
+    for i in order {
+        if !sane(inputs[i].stamp()) {
+            count_insane(&inputs[i], &mut counts);
+            continue;
+        }
+        match inputs[i] {
+            EstimatorInput::Odometry { stamp, pose, covariance } => {
+                counts.odometry.received += 1;
+                if !pose.is_finite() {
+                    counts.odometry.not_finite += 1;
+                    continue;
+                }
+                if odometry.stamps.last() == Some(&stamp) {
+                    counts.odometry.duplicate_stamps += 1;
+                    continue;
+                }
+                let cov = match covariance {
+                    Some(c) if cfg.use_odometry_covariance => {
+                        if finite3(&c) && is_spd(&c) {
+                            Some(c)
+                        } else {
+                            counts.odometry.covariance_fallbacks += 1;
+                            None
+                        }
+                    }
+                    _ => None,
+                };
+                odometry.stamps.push(stamp);
+                odometry.poses.push(pose);
+                odometry.covariances.push(cov);
+            }
+            EstimatorInput::Gyro { stamp, yaw_rate, variance } => {
+                counts.gyro.received += 1;
+                if !yaw_rate.is_finite() {
+                    counts.gyro.not_finite += 1;
+                    continue;
+                }
+                if gyro.stamps.last() == Some(&stamp) {
+                    continue;
+                }
+                let var = match variance {
+                    Some(v) if v.is_finite() && v > 0.0 => v,
+                    Some(_) => {
+                        counts.gyro.variance_fallbacks += 1;
+                        cfg.gyro_rate_sigma.powi(2)
+                    }
+                    None => cfg.gyro_rate_sigma.powi(2),
+                };
+                gyro.stamps.push(stamp);
+                gyro.rates.push(yaw_rate);
+                gyro.variances.push(var);
+            }
+            EstimatorInput::Heading { stamp, yaw, variance } => {
+                counts.headings.received += 1;
+                if !yaw.is_finite() {
+                    counts.headings.rejected_not_finite += 1;
+                    continue;
+                }
+                let var = if variance.is_finite() && variance > 0.0 {
+                    variance
+                } else {
+                    counts.headings.covariance_fallbacks += 1;
+                    cfg.fallback_heading_sigma_rad.powi(2)
+                };
+                corrections.push((stamp, Correction::Heading { yaw, var }));
+            }
+            EstimatorInput::Position { stamp, enu, covariance, antenna, quality } => {
+                counts.fixes.received += 1;
+                if !(enu[0].is_finite() && enu[1].is_finite() && antenna.is_finite()) {
+                    counts.fixes.rejected_not_finite += 1;
+                    counts.rejected_fixes.push(RejectedFix { stamp, reason: FixRejection::NotFinite, nis: f64::NAN });
+                    continue;
+                }
+                let r = if is_spd(&covariance) {
+                    covariance
+                } else {
+                    counts.fixes.covariance_fallbacks += 1;
+                    [[fix_var, 0.0], [0.0, fix_var]]
+                };
+                corrections.push((stamp, Correction::Position { z: enu, r, antenna, quality }));
+            }
+            EstimatorInput::Pose { stamp, pose, covariance } => {
+                counts.poses.received += 1;
+                if !pose.is_finite() {
+                    counts.poses.rejected_not_finite += 1;
+                    continue;
+                }
+                let r = if finite3(&covariance) && is_spd(&covariance) {
+                    covariance
+                } else {
+                    counts.poses.covariance_fallbacks += 1;
+                    let (m, a) = (cfg.fallback_pose_sigma_m.powi(2), cfg.fallback_pose_sigma_rad.powi(2));
+                    [[m, 0.0, 0.0], [0.0, m, 0.0], [0.0, 0.0, a]]
+                };
+                corrections.push((stamp, Correction::Pose { z: [pose.x, pose.y, pose.theta], r }));
+            }
+        }
+    }
+    counts.odometry.used = odometry.stamps.len();
+    counts.gyro.used = gyro.stamps.len();
+    (Sorted { odometry, gyro, corrections }, counts)
+}

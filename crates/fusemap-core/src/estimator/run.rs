@@ -1,0 +1,287 @@
+//! The forward pass: the filter stepped through the log, stopping at every odometry
+//! stamp (the track's samples) and at every correction's own stamp.
+
+use super::chi2::chi_square_quantile;
+use super::config::EstimatorConfig;
+use super::error::EstimatorError;
+use super::filter::{predict, update, Gated, HeadingMotion, Motion, StepRecord, N};
+use super::init::Init;
+use super::input::{Correction, FixQuality};
+use super::linalg::{all_finite, identity, spd_inverse, Mat};
+use super::models;
+use super::report::{CorrectionReport, FixQualityCount, FixRejection, RejectedFix};
+use super::slip_fixes::FixSlipCheck;
+use super::streams::{GyroTrack, OdometryTrack, SlipDetector};
+use crate::time::Stamp;
+
+/// What the forward pass counts.
+pub(crate) struct RunCounts {
+    pub fixes: CorrectionReport,
+    pub poses: CorrectionReport,
+    pub headings: CorrectionReport,
+    pub zero_rate: CorrectionReport,
+    pub by_quality: Vec<FixQualityCount>,
+    pub rejected_fixes: Vec<RejectedFix>,
+    pub gate_resets: usize,
+    pub stationary_s: f64,
+    pub steps_without_gyro: usize,
+}
+
+/// The forward pass's result.
+pub(crate) struct RunOutput {
+    pub records: Vec<StepRecord>,
+    /// Per odometry interval: flagged as slipping.
+    pub slip: Vec<bool>,
+}
+
+/// Time constant of the odometry speed held through a slip, seconds.
+const SPEED_TIME_CONSTANT_S: f64 = 1.0;
+
+struct Gates {
+    one: f64,
+    two: f64,
+    three: f64,
+}
+
+/// Recent gate-rejected fixes in a row: (innovation, R + P_xy).
+type RejectedRun = Vec<([f64; 2], Mat<2, 2>)>;
+
+struct Filter<'a> {
+    x: [f64; N],
+    p: Mat<N, N>,
+    cfg: &'a EstimatorConfig,
+    gates: Gates,
+    counts: &'a mut RunCounts,
+    rejected_run: RejectedRun,
+}
+
+impl Filter<'_> {
+    fn correct(&mut self, stamp: Stamp, c: &Correction) {
+        match *c {
+            Correction::Position { z, r, antenna, quality } => {
+                let (nu, h) = models::position(&self.x, z, antenna);
+                let g = update(&mut self.x, &mut self.p, nu, &h, &r, self.gates.two);
+                let accepted = g.accepted || (!g.nis.is_nan() && self.reset_if_consistent(nu, &r, z, antenna));
+                record(&mut self.counts.fixes, g, accepted);
+                let q = &mut self.counts.by_quality[quality.index()];
+                if accepted {
+                    q.used += 1;
+                    self.rejected_run.clear();
+                } else {
+                    q.rejected_gate += 1;
+                    self.counts.rejected_fixes.push(RejectedFix { stamp, reason: FixRejection::Gate, nis: g.nis });
+                }
+            }
+            Correction::Heading { yaw, var } => {
+                let (nu, h) = models::heading(&self.x, yaw);
+                let g = update(&mut self.x, &mut self.p, nu, &h, &[[var]], self.gates.one);
+                record(&mut self.counts.headings, g, g.accepted);
+            }
+            Correction::Pose { z, r } => {
+                let (nu, h) = models::pose(&self.x, z);
+                let g = update(&mut self.x, &mut self.p, nu, &h, &r, self.gates.three);
+                record(&mut self.counts.poses, g, g.accepted);
+            }
+        }
+    }
+
+    /// After a rejected fix: when the last few rejected fixes in a row agree with each
+    /// other, the filter (not the fixes) is off — typically after a stretch of correlated
+    /// fix errors made it overconfident. Outliers scatter; a filter offset repeats. The
+    /// position uncertainty is then reopened by the common innovation and the fix applied.
+    fn reset_if_consistent(
+        &mut self,
+        nu: [f64; 2],
+        r: &Mat<2, 2>,
+        z: [f64; 2],
+        antenna: crate::geometry::Point2,
+    ) -> bool {
+        let m = self.cfg.gate_reset_consistent_fixes;
+        if m == 0 {
+            return false;
+        }
+        let pxy = [[self.p[0][0] + r[0][0], self.p[0][1] + r[0][1]], [self.p[1][0] + r[1][0], self.p[1][1] + r[1][1]]];
+        self.rejected_run.push((nu, pxy));
+        let run = &self.rejected_run;
+        if run.len() < m {
+            return false;
+        }
+        let last = &run[run.len() - m..];
+        let mean = [
+            last.iter().map(|(v, _)| v[0]).sum::<f64>() / m as f64,
+            last.iter().map(|(v, _)| v[1]).sum::<f64>() / m as f64,
+        ];
+        // Each innovation within the gate of the mean, and the spread small beside the
+        // mean offset: a few outliers of metres in random directions do not line up.
+        let offset = mean[0].hypot(mean[1]);
+        let consistent = last.iter().all(|(v, s)| {
+            let d = [v[0] - mean[0], v[1] - mean[1]];
+            d[0].hypot(d[1]) <= 0.25 * offset
+                && spd_inverse(s).is_some_and(|si| {
+                    d[0] * (si[0][0] * d[0] + si[0][1] * d[1]) + d[1] * (si[1][0] * d[0] + si[1][1] * d[1])
+                        <= self.gates.two
+                })
+        });
+        if !consistent {
+            return false;
+        }
+        let n2 = mean[0] * mean[0] + mean[1] * mean[1];
+        self.p[0][0] += mean[0] * mean[0] + n2;
+        self.p[0][1] += mean[0] * mean[1];
+        self.p[1][0] += mean[0] * mean[1];
+        self.p[1][1] += mean[1] * mean[1] + n2;
+        self.counts.gate_resets += 1;
+        self.rejected_run.clear();
+        let (nu, h) = models::position(&self.x, z, antenna);
+        update(&mut self.x, &mut self.p, nu, &h, r, self.gates.two).accepted
+    }
+}
+
+fn record(rep: &mut CorrectionReport, g: Gated, accepted: bool) {
+    if accepted {
+        rep.used += 1;
+    } else {
+        rep.rejected_gate += 1;
+    }
+    if g.nis.is_finite() {
+        rep.innovation.record(g.nis, g.accepted);
+    }
+}
+
+/// The motion streams and the slip checks on them.
+#[derive(Clone, Copy)]
+pub(crate) struct MotionSources<'a> {
+    pub odo: &'a OdometryTrack,
+    pub gyro: Option<&'a GyroTrack>,
+    pub slip: &'a SlipDetector,
+    pub fix_slip: &'a FixSlipCheck,
+}
+
+/// Runs the filter over the whole track.
+pub(crate) fn run(
+    motion: &MotionSources,
+    corrections: &[(Stamp, Correction)],
+    init: &Init,
+    cfg: &EstimatorConfig,
+    counts: &mut RunCounts,
+) -> Result<RunOutput, EstimatorError> {
+    let MotionSources { odo, gyro, slip, fix_slip } = *motion;
+    let p = cfg.gate_probability;
+    let q = |dof| {
+        chi_square_quantile(dof, p).ok_or_else(|| EstimatorError::Config(format!("estimator.gate_probability {p}")))
+    };
+    let gates = Gates { one: q(1)?, two: q(2)?, three: q(3)? };
+    let (t0, t_last) = odo.span();
+    let mut records = Vec::with_capacity(odo.stamps.len() + corrections.len());
+    let mut slips = vec![false; odo.intervals.len()];
+    let mut f = Filter { x: init.x, p: init.p, cfg, gates, counts, rejected_run: Vec::new() };
+    let mut j = 0;
+    let outside = |(stamp, c): &(Stamp, Correction), counts: &mut RunCounts| match c {
+        Correction::Position { .. } => {
+            counts.fixes.ignored_outside_track += 1;
+            counts.rejected_fixes.push(RejectedFix {
+                stamp: *stamp,
+                reason: FixRejection::OutsideTrack,
+                nis: f64::NAN,
+            });
+        }
+        Correction::Heading { .. } => counts.headings.ignored_outside_track += 1,
+        Correction::Pose { .. } => counts.poses.ignored_outside_track += 1,
+    };
+    while j < corrections.len() && corrections[j].0 < t0 {
+        outside(&corrections[j], f.counts);
+        j += 1;
+    }
+    while j < corrections.len() && corrections[j].0 == t0 {
+        f.correct(corrections[j].0, &corrections[j].1);
+        j += 1;
+    }
+    records.push(StepRecord { stamp: t0, x: f.x, p: f.p, x_pred: init.x, p_pred: init.p, f: identity() });
+    let mut held_speed = 0.0;
+    let mut t_cur = t0;
+    let mut odo_cur = odo.pose_at(t0);
+    for (i, iv) in odo.intervals.iter().enumerate() {
+        let t_end = odo.stamps[i + 1];
+        slips[i] = !iv.stationary && (slip.slips(i, f.x[3]) || fix_slip.slips(t_cur, t_end, odo, &f.x, &f.p));
+        let inflation = if slips[i] { cfg.slip_noise_inflation } else { 1.0 };
+        // Spinning wheels report distance the robot did not drive; its speed rarely jumps
+        // while they spin, so a slipping increment keeps the speed of the odometry before
+        // the slip (in the odometry's direction), its inflated noise covering the rest.
+        let iv_d = iv.delta.x.hypot(iv.delta.y);
+        let speed_factor = if slips[i] && cfg.slip_hold_speed && iv_d > 0.0 {
+            (held_speed * iv.dt / iv_d).clamp(0.0, 1.0)
+        } else {
+            // Standing still counts too: a robot that spins its wheels when starting off
+            // is slow, not at the speed it had before it stopped.
+            let a = (-iv.dt / SPEED_TIME_CONSTANT_S).exp();
+            held_speed = a * held_speed + (1.0 - a) * iv_d / iv.dt;
+            1.0
+        };
+        loop {
+            let t = match corrections.get(j) {
+                Some(&(tc, _)) if tc <= t_end => tc,
+                _ => t_end,
+            };
+            let dt = t.secs_since(t_cur);
+            let odo_t = odo.pose_at(t);
+            let inc = odo_cur.inverse().compose(odo_t);
+            let frac = dt / iv.dt;
+            let mut cov = iv.cov;
+            for v in cov.iter_mut().flatten() {
+                *v *= frac * inflation;
+            }
+            let gyro_angle = gyro.and_then(|g| g.integral(t_cur, t));
+            let heading = if iv.stationary {
+                HeadingMotion::Still
+            } else if let Some((angle, var)) = gyro_angle {
+                HeadingMotion::Gyro { angle, var, dt }
+            } else {
+                f.counts.steps_without_gyro += 1;
+                HeadingMotion::Odometry
+            };
+            let motion = Motion {
+                dx: inc.x * speed_factor,
+                dy: inc.y * speed_factor,
+                dtheta: inc.theta,
+                cov,
+                heading,
+                heading_noise: cfg.heading_noise_per_sqrt_s.powi(2) * dt,
+                bias_noise: cfg.gyro_bias_random_walk.powi(2) * dt,
+                scale_noise: cfg.odometry_scale_random_walk.powi(2) * inc.x.hypot(inc.y),
+            };
+            let (x_pred, p_pred, jac) = predict(&f.x, &f.p, &motion);
+            f.x = x_pred;
+            f.p = p_pred;
+            if let (true, Some((angle, var))) = (iv.stationary && dt > 0.0, gyro_angle) {
+                let (nu, h) = models::zero_rate(&f.x, angle / dt);
+                let g = update(&mut f.x, &mut f.p, nu, &h, &[[var / (dt * dt)]], f.gates.one);
+                record(&mut f.counts.zero_rate, g, g.accepted);
+                f.counts.stationary_s += dt;
+            }
+            while j < corrections.len() && corrections[j].0 == t {
+                f.correct(corrections[j].0, &corrections[j].1);
+                j += 1;
+            }
+            if !all_finite(&f.p) || !f.x.iter().all(|v| v.is_finite()) {
+                return Err(EstimatorError::Numerical { stamp: t.0 });
+            }
+            records.push(StepRecord { stamp: t, x: f.x, p: f.p, x_pred, p_pred, f: jac });
+            t_cur = t;
+            odo_cur = odo_t;
+            if t == t_end {
+                break;
+            }
+        }
+    }
+    debug_assert_eq!(t_cur, t_last);
+    while j < corrections.len() {
+        outside(&corrections[j], f.counts);
+        j += 1;
+    }
+    Ok(RunOutput { records, slip: slips })
+}
+
+/// Empty per-quality counters.
+pub(crate) fn quality_counts() -> Vec<FixQualityCount> {
+    FixQuality::ALL.iter().map(|&quality| FixQualityCount { quality, received: 0, used: 0, rejected_gate: 0 }).collect()
+}
