@@ -10,6 +10,7 @@ mod sensor;
 
 pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 
+use crate::estimator::EstimatorConfig;
 use crate::geometry::Point2;
 use crate::grid::{GridGeometry, OccupancyParams};
 use serde::{Deserialize, Serialize};
@@ -24,6 +25,9 @@ pub struct Config {
     /// The sensors, one `[[sensor]]` table each.
     #[serde(default)]
     pub sensor: Vec<SensorConfig>,
+    /// The pose estimator (EKF + RTS smoother) fusing odometry, IMU, GNSS and poses.
+    #[serde(default)]
+    pub estimator: EstimatorConfig,
     /// How robot logs are read: topics, pose source, time synchronisation.
     #[serde(default)]
     pub log: LogConfig,
@@ -31,7 +35,7 @@ pub struct Config {
 
 impl Default for Config {
     fn default() -> Self {
-        Self { map: MapConfig::default(), sensor: Vec::new(), log: LogConfig::default() }
+        Self { map: MapConfig::default(), sensor: Vec::new(), estimator: EstimatorConfig::default(), log: LogConfig::default() }
     }
 }
 
@@ -220,6 +224,8 @@ pub struct Plan {
     pub disabled_kinds: Vec<SensorKind>,
     /// How logs are read.
     pub log: LogConfig,
+    /// The pose estimator's figures.
+    pub estimator: EstimatorConfig,
 }
 
 impl Config {
@@ -298,7 +304,11 @@ impl Config {
                 listed.clone().next().is_some() && listed.all(|s| !s.enabled)
             })
             .collect();
-        Ok(Plan { geometry, occupancy, lidars, sensors, disabled_kinds, log: g.clone() })
+        self.estimator.validate().map_err(|m| {
+            let field = m.split(':').next().unwrap_or("estimator").trim().to_string();
+            err(field, m.split_once(':').map_or(m.as_str(), |x| x.1.trim()).to_string())
+        })?;
+        Ok(Plan { geometry, occupancy, lidars, sensors, disabled_kinds, log: g.clone(), estimator: self.estimator.clone() })
     }
 }
 

@@ -116,20 +116,19 @@ pub struct SensorConfig {
     #[serde(default)]
     pub max_tilt_deg: Option<f64>,
 
-    /// Wheel odometry: translation σ per metre travelled (Thrun's α₃), m/m.
+    /// Wheel odometry: translation σ after one metre, per axis, m/√m (default: the
+    /// estimator's `odometry_translation_noise`).
     #[serde(default)]
-    pub translation_noise_per_m: Option<f64>,
-    /// Wheel odometry: translation σ per radian turned (α₄), m/rad.
+    pub translation_noise_per_sqrt_m: Option<f64>,
+    /// Wheel odometry: heading σ per radian turned, rad/√rad.
     #[serde(default)]
-    pub translation_noise_per_rad: Option<f64>,
-    /// Wheel odometry: rotation σ per radian turned (α₁), rad/rad.
+    pub rotation_noise_per_sqrt_rad: Option<f64>,
+    /// Wheel odometry: heading σ per metre driven, rad/√m.
     #[serde(default)]
-    pub rotation_noise_per_rad: Option<f64>,
-    /// Wheel odometry: rotation σ per metre travelled (α₂), rad/m.
-    #[serde(default)]
-    pub rotation_noise_per_m: Option<f64>,
+    pub rotation_noise_per_sqrt_m: Option<f64>,
 
-    /// IMU: gyro rate σ, rad/s, where the message has no covariance.
+    /// IMU: gyro rate σ, rad/s, where the message has no covariance (default: the
+    /// estimator's `gyro_rate_sigma`).
     #[serde(default)]
     pub gyro_noise_rad_s: Option<f64>,
     /// IMU: use the message's orientation yaw when it provides one (REP 145).
@@ -153,7 +152,8 @@ pub struct SensorConfig {
     #[serde(default)]
     pub sigma_unknown_m: Option<f64>,
 
-    /// Pose: position σ where the message's covariance is zero or unusable, metres.
+    /// Pose: position σ where the message's covariance is zero or unusable, metres
+    /// (default: the estimator's `fallback_pose_sigma_m`).
     #[serde(default)]
     pub position_noise_m: Option<f64>,
     /// Pose: yaw σ where the message's covariance is zero or unusable, degrees.
@@ -182,10 +182,9 @@ impl SensorConfig {
             max_range: None,
             max_range_policy: None,
             max_tilt_deg: None,
-            translation_noise_per_m: None,
-            translation_noise_per_rad: None,
-            rotation_noise_per_rad: None,
-            rotation_noise_per_m: None,
+            translation_noise_per_sqrt_m: None,
+            rotation_noise_per_sqrt_rad: None,
+            rotation_noise_per_sqrt_m: None,
             gyro_noise_rad_s: None,
             use_orientation: None,
             datum: None,
@@ -213,10 +212,9 @@ impl SensorConfig {
         check(self.max_range_policy.is_some(), "max_range_policy", SensorKind::Lidar);
         check(self.max_tilt_deg.is_some(), "max_tilt_deg", SensorKind::Lidar);
         let odo = SensorKind::WheelOdometry;
-        check(self.translation_noise_per_m.is_some(), "translation_noise_per_m", odo);
-        check(self.translation_noise_per_rad.is_some(), "translation_noise_per_rad", odo);
-        check(self.rotation_noise_per_rad.is_some(), "rotation_noise_per_rad", odo);
-        check(self.rotation_noise_per_m.is_some(), "rotation_noise_per_m", odo);
+        check(self.translation_noise_per_sqrt_m.is_some(), "translation_noise_per_sqrt_m", odo);
+        check(self.rotation_noise_per_sqrt_rad.is_some(), "rotation_noise_per_sqrt_rad", odo);
+        check(self.rotation_noise_per_sqrt_m.is_some(), "rotation_noise_per_sqrt_m", odo);
         check(self.gyro_noise_rad_s.is_some(), "gyro_noise_rad_s", SensorKind::Imu);
         check(self.use_orientation.is_some(), "use_orientation", SensorKind::Imu);
         let g = SensorKind::Gnss;
@@ -231,29 +229,18 @@ impl SensorConfig {
     }
 }
 
-/// Noise figures of a wheel odometry (Thrun et al., *Probabilistic Robotics*, §5.4: the
-/// odometry motion model, its σ growing with distance and rotation).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+/// Noise figures of a wheel odometry where its messages carry none: σ growing with the
+/// square root of distance and rotation (a random walk per metre and per radian, the
+/// continuous form of Thrun et al., *Probabilistic Robotics* §5.4). `None`: the
+/// estimator's default.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct OdometryNoise {
-    /// Translation σ per metre, m/m.
-    pub translation_per_m: f64,
-    /// Translation σ per radian, m/rad.
-    pub translation_per_rad: f64,
-    /// Rotation σ per radian, rad/rad.
-    pub rotation_per_rad: f64,
-    /// Rotation σ per metre, rad/m.
-    pub rotation_per_m: f64,
-}
-
-impl OdometryNoise {
-    /// The covariance (x, y, θ in the frame of the increment's start) of an increment of
-    /// `distance` metres and `rotation` radians: σ_t = α₃·d + α₄·|Δθ|,
-    /// σ_θ = α₁·|Δθ| + α₂·d, with a floor so a standing robot's increment is not certain.
-    pub fn increment_covariance(&self, distance: f64, rotation: f64) -> [[f64; 3]; 3] {
-        let st = self.translation_per_m * distance.abs() + self.translation_per_rad * rotation.abs() + 1e-4;
-        let sr = self.rotation_per_rad * rotation.abs() + self.rotation_per_m * distance.abs() + 1e-4;
-        [[st * st, 0.0, 0.0], [0.0, st * st, 0.0], [0.0, 0.0, sr * sr]]
-    }
+    /// Translation σ after one metre, m/√m.
+    pub translation_per_sqrt_m: Option<f64>,
+    /// Heading σ per radian turned, rad/√rad.
+    pub rotation_per_sqrt_rad: Option<f64>,
+    /// Heading σ per metre driven, rad/√m.
+    pub rotation_per_sqrt_m: Option<f64>,
 }
 
 /// GNSS σ floors by fix status.
@@ -286,16 +273,16 @@ pub struct PlannedSensor {
     pub base_from_sensor: Option<Mount3>,
     /// Odometry noise (kind `wheel_odometry`).
     pub odometry: OdometryNoise,
-    /// Gyro σ, rad/s (kind `imu`).
-    pub gyro_noise_rad_s: f64,
+    /// Gyro σ, rad/s (kind `imu`; `None`: the estimator's default).
+    pub gyro_noise_rad_s: Option<f64>,
     /// Whether to use IMU orientation (kind `imu`).
     pub use_orientation: bool,
     /// The GNSS datum, if configured.
     pub datum: Option<[f64; 3]>,
     /// GNSS σ floors.
     pub gnss: GnssNoise,
-    /// Pose σ fallbacks: position m, yaw rad.
-    pub pose_noise: (f64, f64),
+    /// Pose σ fallbacks: position m, yaw rad (`None`: the estimator's defaults).
+    pub pose_noise: (Option<f64>, Option<f64>),
     /// `true` when the table was written in the config, `false` when auto-detected.
     pub explicit: bool,
 }
@@ -321,13 +308,6 @@ pub struct PlannedLidar {
     pub time_offset_s: f64,
     /// `true` when written in the config.
     pub explicit: bool,
-}
-
-fn positive(field: &str, v: f64) -> Result<f64, ConfigError> {
-    if finite(field, v)? < 0.0 {
-        return Err(err(field, format!("must be >= 0, got {v}")));
-    }
-    Ok(v)
 }
 
 /// Validates the `[[sensor]]` tables into lidars and the other sensors. `prior` is the
@@ -371,31 +351,18 @@ pub(super) fn plan_sensors(
             lidars.push(plan_lidar(i, s, name, prior)?);
             continue;
         }
-        let d = OdometryNoise {
-            translation_per_m: 0.05,
-            translation_per_rad: 0.01,
-            rotation_per_rad: 0.05,
-            rotation_per_m: 0.02,
+        let pos = |k: &str, v: Option<f64>| -> Result<Option<f64>, ConfigError> {
+            match v {
+                Some(x) if !(finite(&f(k), x)? > 0.0) => Err(err(f(k), format!("must be > 0, got {x}"))),
+                v => Ok(v),
+            }
         };
         let odometry = OdometryNoise {
-            translation_per_m: positive(
-                &f("translation_noise_per_m"),
-                s.translation_noise_per_m.unwrap_or(d.translation_per_m),
-            )?,
-            translation_per_rad: positive(
-                &f("translation_noise_per_rad"),
-                s.translation_noise_per_rad.unwrap_or(d.translation_per_rad),
-            )?,
-            rotation_per_rad: positive(
-                &f("rotation_noise_per_rad"),
-                s.rotation_noise_per_rad.unwrap_or(d.rotation_per_rad),
-            )?,
-            rotation_per_m: positive(&f("rotation_noise_per_m"), s.rotation_noise_per_m.unwrap_or(d.rotation_per_m))?,
+            translation_per_sqrt_m: pos("translation_noise_per_sqrt_m", s.translation_noise_per_sqrt_m)?,
+            rotation_per_sqrt_rad: pos("rotation_noise_per_sqrt_rad", s.rotation_noise_per_sqrt_rad)?,
+            rotation_per_sqrt_m: pos("rotation_noise_per_sqrt_m", s.rotation_noise_per_sqrt_m)?,
         };
-        let gyro = s.gyro_noise_rad_s.unwrap_or(0.005);
-        if !(finite(&f("gyro_noise_rad_s"), gyro)? > 0.0) {
-            return Err(err(f("gyro_noise_rad_s"), format!("must be > 0, got {gyro}")));
-        }
+        let gyro = pos("gyro_noise_rad_s", s.gyro_noise_rad_s)?;
         if let Some([lat, lon, alt]) = s.datum {
             for v in [lat, lon, alt] {
                 finite(&f("datum"), v)?;
@@ -423,13 +390,10 @@ pub(super) fn plan_sensors(
                 return Err(err(f(k), format!("must be > 0 metres, got {v}")));
             }
         }
-        let pos = s.position_noise_m.unwrap_or(0.1);
-        let yaw = s.yaw_noise_deg.unwrap_or(2.0);
-        for (k, v) in [("position_noise_m", pos), ("yaw_noise_deg", yaw)] {
-            if !(finite(&f(k), v)? > 0.0) {
-                return Err(err(f(k), format!("must be > 0, got {v}")));
-            }
-        }
+        let pose_noise = (
+            pos("position_noise_m", s.position_noise_m)?,
+            pos("yaw_noise_deg", s.yaw_noise_deg)?.map(f64::to_radians),
+        );
         if let Some(m) = &s.base_from_sensor {
             for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", m.yaw)] {
                 finite(&f(&format!("base_from_sensor.{k}")), v)?;
@@ -447,7 +411,7 @@ pub(super) fn plan_sensors(
             use_orientation: s.use_orientation.unwrap_or(true),
             datum: s.datum,
             gnss,
-            pose_noise: (pos, yaw.to_radians()),
+            pose_noise,
             explicit: true,
         });
     }

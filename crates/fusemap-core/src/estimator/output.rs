@@ -126,3 +126,22 @@ mod tests {
         }
     }
 }
+
+impl crate::time::PoseTrack for Estimate {
+    /// The smoothed track, always interpolated (it is dense: one sample per filter step).
+    fn pose_at(&self, t: Stamp, _mode: crate::time::SyncMode) -> Result<Pose2, NoPose> {
+        Estimate::pose_at(self, t).map(|p| p.0)
+    }
+
+    fn covariance_at(&self, t: Stamp) -> Option<[[f64; 3]; 3]> {
+        Estimate::pose_at(self, t).ok().map(|p| p.1)
+    }
+
+    fn span(&self) -> Option<(Stamp, Stamp)> {
+        Some((self.smoothed.first()?.stamp, self.smoothed.last()?.stamp))
+    }
+
+    fn samples(&self) -> Vec<(Stamp, Pose2)> {
+        self.smoothed.iter().map(|s| (s.stamp, s.pose)).collect()
+    }
+}
