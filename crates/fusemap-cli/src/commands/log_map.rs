@@ -83,6 +83,7 @@ pub fn load(path: &Path) -> Result<LoadedLog> {
             LogMessage::Odometry(o) => log.odom.entry(o.topic.clone()).or_default().push(o),
             LogMessage::Tf(t) => tf.push(t),
             LogMessage::Imu(i) => *log.imu.entry(i.topic).or_default() += 1,
+            LogMessage::Gnss(_) | LogMessage::Pose(_) => {}
         }
     }
     log.stats = reader.stats().clone();
