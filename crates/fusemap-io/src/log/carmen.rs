@@ -369,6 +369,7 @@ impl<R: BufRead> Iterator for CarmenReader<R> {
 }
 
 /// What one line is.
+#[allow(clippy::large_enum_variant)] // Returned once per line and unpacked at once (see LogMessage).
 enum Parsed<'a> {
     /// Blank, comment or `PARAM`.
     Ignored,
