@@ -79,7 +79,61 @@ impl Error {
     pub fn format(path: &Path, location: Location, message: impl Into<String>) -> Self {
         Error::Format { path: path.to_path_buf(), location, message: message.into() }
     }
+
+    /// True when the error concerns one message of a log and a caller that wants the
+    /// rest of the log may count it and read on: the [`crate::log::LogReader`] that
+    /// returned it has consumed the message and its next call yields the message after.
+    ///
+    /// Only an [`Error::Format`] at [`Location::Message`] is skippable: a payload that
+    /// does not decode (truncated, a length that overruns it, bytes left over, a
+    /// big-endian CDR encapsulation, a per-message zstd frame that does not decompress).
+    /// Its container framing was sound, so the reader knows where the next message starts.
+    ///
+    /// Everything else ends the read, for a reason:
+    /// - [`Error::Io`]: the operating system failed; reading on would repeat it or
+    ///   silently lose data.
+    /// - [`Error::Format`] at [`Location::File`] or [`Location::Offset`]: the container
+    ///   itself is damaged (not a log, a truncated or corrupt chunk or record, a gzip
+    ///   stream that ends early, a connection whose MD5 sum differs from the standard
+    ///   definition), so where the next message starts is unknown, or every message of
+    ///   that connection would be misread.
+    /// - [`Error::Format`] at [`Location::Line`], [`Location::LineField`] or
+    ///   [`Location::Field`]: a config, world or map file is wrong and running on would
+    ///   use a default the user did not choose; a CARMEN reader returns line errors only
+    ///   in strict mode, where the user asked for a malformed line to stop the read (the
+    ///   lenient mode already skips and counts those lines in
+    ///   [`crate::log::ReadStats::malformed`]).
+    /// - [`Error::WouldOverwriteInput`]: never to be worked around.
+    pub fn is_skippable(&self) -> bool {
+        matches!(self, Error::Format { location: Location::Message { .. }, .. })
+    }
 }
 
 /// fusemap-io's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(location: Location) -> Error {
+        Error::format(Path::new("run.bag"), location, "bad")
+    }
+
+    #[test]
+    fn only_a_message_that_does_not_decode_is_skippable() {
+        assert!(at(Location::Message { index: 3, topic: "/fix".into() }).is_skippable());
+        for location in [
+            Location::File,
+            Location::Line(4),
+            Location::LineField(4, "x".into()),
+            Location::Offset(4096),
+            Location::Field("resolution".into()),
+        ] {
+            assert!(!at(location.clone()).is_skippable(), "{location:?}");
+        }
+        let os = Error::io(Path::new("run.bag"), std::io::Error::other("disk on fire"));
+        assert!(!os.is_skippable());
+        assert!(!Error::WouldOverwriteInput { path: "map.pgm".into() }.is_skippable());
+    }
+}

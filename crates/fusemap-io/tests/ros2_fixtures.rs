@@ -47,7 +47,9 @@ fn read(path: &Path) -> Decoded {
             LogMessage::Odometry(o) => d.odometry.push(o),
             LogMessage::Tf(t) if t.is_static => d.tf_static.push(t),
             LogMessage::Tf(t) => d.tf.push(t),
-            LogMessage::Imu(_) => panic!("{}: no IMU was written", path.display()),
+            LogMessage::Imu(_) | LogMessage::Gnss(_) | LogMessage::Pose(_) => {
+                panic!("{}: only scans, odometry and transforms were written", path.display())
+            }
         }
     }
     assert!(reader.stats().skipped_by_type.is_empty(), "{:?}", reader.stats());

@@ -10,7 +10,9 @@
 
 use fusemap_core::geometry::Pose2;
 use fusemap_core::time::Stamp;
-use fusemap_io::log::{ImuMessage, LogFormat, LogMessage, OdomMessage, ReadStats, ScanMessage, Transform};
+use fusemap_io::log::{
+    GnssMessage, ImuMessage, LogFormat, LogMessage, OdomMessage, PoseMessage, ReadStats, ScanMessage, Transform,
+};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -51,6 +53,10 @@ pub struct Inventory {
     pub odom: BTreeMap<String, Vec<OdomMessage>>,
     /// IMU messages by topic, in log order.
     pub imu: BTreeMap<String, Vec<ImuMessage>>,
+    /// GNSS fixes by topic, in log order.
+    pub gnss: BTreeMap<String, Vec<GnssMessage>>,
+    /// Absolute poses by topic, in log order.
+    pub poses: BTreeMap<String, Vec<PoseMessage>>,
     /// Static transforms (`/tf_static`), in log order.
     pub tf_static: Vec<Transform>,
     /// Dynamic transforms (`/tf`), in log order.
@@ -72,15 +78,10 @@ fn next(
             Ok(m) => return Some(Ok(m)),
             // One message that does not decode (a corrupt payload, a big-endian CDR
             // message) is skipped and counted: a user wants the rest of the log.
-            Err(e) if is_skippable(&e) => undecodable.malformed(e.to_string()),
+            Err(e) if e.is_skippable() => undecodable.malformed(e.to_string()),
             Err(e) => return Some(Err(e)),
         }
     }
-}
-
-/// Whether a read error concerns one message only, so the rest of the log can be read.
-fn is_skippable(e: &fusemap_io::Error) -> bool {
-    matches!(e, fusemap_io::Error::Format { location: fusemap_io::Location::Message { .. }, .. })
 }
 
 /// Merges the reader's own counters with the undecodable messages.
@@ -105,6 +106,8 @@ impl Inventory {
             scans: BTreeMap::new(),
             odom: BTreeMap::new(),
             imu: BTreeMap::new(),
+            gnss: BTreeMap::new(),
+            poses: BTreeMap::new(),
             tf_static: Vec::new(),
             tf_dynamic: Vec::new(),
             stats: ReadStats::default(),
@@ -130,6 +133,8 @@ impl Inventory {
                 }
                 LogMessage::Odometry(o) => inv.odom.entry(o.topic.clone()).or_default().push(o),
                 LogMessage::Imu(i) => inv.imu.entry(i.topic.clone()).or_default().push(i),
+                LogMessage::Gnss(g) => inv.gnss.entry(g.topic.clone()).or_default().push(g),
+                LogMessage::Pose(p) => inv.poses.entry(p.topic.clone()).or_default().push(p),
                 LogMessage::Tf(t) => tf.push(t),
             }
         }
@@ -141,6 +146,12 @@ impl Inventory {
                 v.sort_by_key(|m| m.receive_stamp);
             }
             for v in inv.imu.values_mut() {
+                v.sort_by_key(|m| m.receive_stamp);
+            }
+            for v in inv.gnss.values_mut() {
+                v.sort_by_key(|m| m.receive_stamp);
+            }
+            for v in inv.poses.values_mut() {
                 v.sort_by_key(|m| m.receive_stamp);
             }
             tf.sort_by_key(|m| m.receive_stamp);

@@ -82,6 +82,12 @@ pub fn topics_by_kind(inv: &Inventory) -> BTreeMap<SensorKind, BTreeMap<String, 
     for (t, v) in &inv.imu {
         m.entry(SensorKind::Imu).or_default().insert(t.clone(), v.len() as u64);
     }
+    for (t, v) in &inv.gnss {
+        m.entry(SensorKind::Gnss).or_default().insert(t.clone(), v.len() as u64);
+    }
+    for (t, v) in &inv.poses {
+        m.entry(SensorKind::Pose).or_default().insert(t.clone(), v.len() as u64);
+    }
     m
 }
 

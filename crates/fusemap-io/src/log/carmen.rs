@@ -9,7 +9,7 @@
 //! | `RLASER …` (the rear laser, same layout as `FLASER`) | [`LogMessage::Scan`] |
 //! | `ROBOTLASER1 type start_angle fov res max_range accuracy remission_mode n r1..rn m rem1..remm laser_x laser_y laser_theta robot_x robot_y robot_theta tv rv forward_safety side_safety turn_axis ipc_ts host logger_ts` | [`LogMessage::Scan`] |
 //! | `RAWLASER1`…`RAWLASER4 type start_angle fov res max_range accuracy remission_mode n r1..rn m rem1..remm ipc_ts host logger_ts` | [`LogMessage::Scan`] |
-//! | `ODOM x y theta tv rv accel ipc_ts host logger_ts` | [`LogMessage::Odometry`] |
+//! | `ODOM x y theta tv rv accel ipc_ts host logger_ts` | [`LogMessage::Odometry`] (twist `[tv, 0, 0, 0, 0, rv]`, covariances zero: unknown) |
 //! | `PARAM name value …` | kept in [`CarmenReader::params`] |
 //! | `#…` comments and blank lines | ignored |
 //! | any other message type (`NEFF`, `TRUEPOS`, `SYNC`, …) | counted in [`ReadStats::skipped_by_type`] |
@@ -369,6 +369,7 @@ impl<R: BufRead> Iterator for CarmenReader<R> {
 }
 
 /// What one line is.
+#[allow(clippy::large_enum_variant)] // Returned once per line and unpacked at once (see LogMessage).
 enum Parsed<'a> {
     /// Blank, comment or `PARAM`.
     Ignored,
@@ -663,9 +664,9 @@ fn parse_odom(text: &str) -> Result<Option<LogMessage>, String> {
     let mut f = Fields::new(text);
     f.expect_total(10, &[], "ODOM")?;
     let pose = f.pose(["x", "y", "theta"])?;
-    for what in ["tv", "rv", "accel"] {
-        f.f64(what)?;
-    }
+    let tv = f.f64("tv")?;
+    let rv = f.f64("rv")?;
+    f.f64("accel")?;
     let stamp = f.stamp("ipc_timestamp")?;
     f.next("ipc_hostname")?;
     let receive = f.stamp("logger_timestamp")?;
@@ -676,6 +677,10 @@ fn parse_odom(text: &str) -> Result<Option<LogMessage>, String> {
         frame_id: "odom".to_string(),
         child_frame_id: "base_link".to_string(),
         pose,
+        // CARMEN logs no covariances: zeros, ROS's "unknown".
+        pose_covariance: [0.0; 36],
+        twist: [tv, 0.0, 0.0, 0.0, 0.0, rv],
+        twist_covariance: [0.0; 36],
     })))
 }
 

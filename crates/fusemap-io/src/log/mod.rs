@@ -3,9 +3,10 @@
 //!
 //! Readers decode; they do not decide. Stamps are passed on as written (header stamp and,
 //! where the container has one, the receive/log time) so that time synchronisation and
-//! the log doctor can judge them. A record that cannot be decoded is an error naming file
-//! and record; a record of a type fusemap does not use is counted in
-//! [`ReadStats::skipped_by_type`] and skipped.
+//! the log doctor can judge them; so are NaN fields and covariances (all zeros: unknown,
+//! as in ROS). A record that cannot be decoded is an error naming file and record (one
+//! message's payload: [`crate::Error::is_skippable`], the reader goes on); a record of a
+//! type fusemap does not use is counted in [`ReadStats::skipped_by_type`] and skipped.
 
 pub mod carmen;
 mod open;
@@ -14,7 +15,7 @@ pub mod ros2;
 
 pub use open::{detect, open_log, LogFormat, OpenedLog};
 
-use fusemap_core::geometry::Pose2;
+use fusemap_core::geometry::{quaternion_yaw, Pose2};
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::Stamp;
 use std::collections::BTreeMap;
@@ -63,8 +64,19 @@ pub struct OdomMessage {
     pub frame_id: String,
     /// `child_frame_id` (usually `base_link`).
     pub child_frame_id: String,
-    /// The planar pose (yaw from the quaternion).
+    /// The planar pose (yaw from the quaternion, see [`planar_pose`]): NaN heading for a
+    /// zero or non-finite quaternion, never a silent identity.
     pub pose: Pose2,
+    /// Row-major 6×6 covariance of the pose over (x, y, z, roll, pitch, yaw), as ROS
+    /// writes it (`pose.covariance`). All zeros means unknown (REP 103 leaves it to the
+    /// publisher; CARMEN has none).
+    pub pose_covariance: [f64; 36],
+    /// Velocity of the child frame, expressed in the child frame (`twist.twist`): linear
+    /// x, y, z (m/s) then angular x, y, z (rad/s). For CARMEN `ODOM`, `tv` and `rv`
+    /// (translational and rotational velocity) as `[tv, 0, 0, 0, 0, rv]`.
+    pub twist: [f64; 6],
+    /// Row-major 6×6 covariance of `twist`; all zeros means unknown.
+    pub twist_covariance: [f64; 36],
 }
 
 /// One transform of a `tf2_msgs/TFMessage`.
@@ -110,12 +122,155 @@ pub struct ImuMessage {
     pub orientation: [f64; 4],
     /// Angular velocity, rad/s.
     pub angular_velocity: [f64; 3],
-    /// Linear acceleration, m/s².
+    /// Linear acceleration, m/s² (gravity included).
     pub linear_acceleration: [f64; 3],
+    /// Row-major 3×3 covariance of the orientation about x, y, z (rad²). REP 145: element
+    /// 0 equal to -1 means the IMU gives no orientation (see
+    /// [`ImuMessage::has_orientation`]); all zeros means the covariance is unknown.
+    pub orientation_covariance: [f64; 9],
+    /// Row-major 3×3 covariance of `angular_velocity`; -1 at element 0: not measured.
+    pub angular_velocity_covariance: [f64; 9],
+    /// Row-major 3×3 covariance of `linear_acceleration`; -1 at element 0: not measured.
+    pub linear_acceleration_covariance: [f64; 9],
 }
 
-/// One decoded message of a log.
+impl ImuMessage {
+    /// False when the IMU says it gives no orientation (REP 145 and the
+    /// `sensor_msgs/Imu` definition: `orientation_covariance[0] == -1`), so that
+    /// `orientation` must not be used.
+    pub fn has_orientation(&self) -> bool {
+        self.orientation_covariance[0] != -1.0
+    }
+}
+
+/// A satellite navigation fix (`sensor_msgs/NavSatFix`): WGS 84 latitude, longitude and
+/// altitude of the antenna with the receiver's covariance.
+///
+/// Passed on as written: a NaN field or a `STATUS_NO_FIX` status is for the estimator to
+/// judge, not the reader.
 #[derive(Clone, Debug, PartialEq)]
+pub struct GnssMessage {
+    /// Topic.
+    pub topic: String,
+    /// `header.stamp`: when the fix was valid.
+    pub stamp: Stamp,
+    /// Log/receive time, if the format has one.
+    pub receive_stamp: Option<Stamp>,
+    /// `header.frame_id`: the antenna's frame (its mount on the robot).
+    pub frame_id: String,
+    /// `status.status`: one of the `STATUS_*` constants (other values as written).
+    pub status: i8,
+    /// `status.service`: a bit set of the `SERVICE_*` constants.
+    pub service: u16,
+    /// Latitude, degrees, positive north of the equator.
+    pub latitude: f64,
+    /// Longitude, degrees, positive east of the prime meridian.
+    pub longitude: f64,
+    /// Altitude above the WGS 84 ellipsoid, metres (NaN when the receiver has none).
+    pub altitude: f64,
+    /// Row-major 3×3 covariance of the position in the local East-North-Up tangent
+    /// plane at the fix, m².
+    pub position_covariance: [f64; 9],
+    /// How much of `position_covariance` is known: one of the `COVARIANCE_TYPE_*`
+    /// constants.
+    pub position_covariance_type: u8,
+}
+
+impl GnssMessage {
+    /// `status`: no fix; the position must not be used.
+    pub const STATUS_NO_FIX: i8 = -1;
+    /// `status`: an unaugmented fix.
+    pub const STATUS_FIX: i8 = 0;
+    /// `status`: a fix with satellite-based augmentation (WAAS, EGNOS).
+    pub const STATUS_SBAS_FIX: i8 = 1;
+    /// `status`: a fix with ground-based augmentation (RTK, DGPS).
+    pub const STATUS_GBAS_FIX: i8 = 2;
+    /// `service` bit: GPS.
+    pub const SERVICE_GPS: u16 = 1;
+    /// `service` bit: GLONASS.
+    pub const SERVICE_GLONASS: u16 = 2;
+    /// `service` bit: COMPASS / BeiDou.
+    pub const SERVICE_COMPASS: u16 = 4;
+    /// `service` bit: Galileo.
+    pub const SERVICE_GALILEO: u16 = 8;
+    /// `position_covariance_type`: nothing is known of the covariance.
+    pub const COVARIANCE_TYPE_UNKNOWN: u8 = 0;
+    /// `position_covariance_type`: approximated (e.g. from dilution of precision).
+    pub const COVARIANCE_TYPE_APPROXIMATED: u8 = 1;
+    /// `position_covariance_type`: the diagonal is known, off-diagonal terms are not.
+    pub const COVARIANCE_TYPE_DIAGONAL_KNOWN: u8 = 2;
+    /// `position_covariance_type`: the full matrix is known.
+    pub const COVARIANCE_TYPE_KNOWN: u8 = 3;
+
+    /// True when the receiver reports a fix (`status >= STATUS_FIX`).
+    pub fn has_fix(&self) -> bool {
+        self.status >= Self::STATUS_FIX
+    }
+}
+
+/// A pose estimate with its uncertainty (`geometry_msgs/PoseWithCovarianceStamped`, as
+/// published by AMCL on `/amcl_pose`, by a motion-capture system or by another
+/// localiser): the pose of the robot in `frame_id`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PoseMessage {
+    /// Topic.
+    pub topic: String,
+    /// `header.stamp`.
+    pub stamp: Stamp,
+    /// Log/receive time, if the format has one.
+    pub receive_stamp: Option<Stamp>,
+    /// `header.frame_id`: the frame the pose is given in (`map`, `world`).
+    pub frame_id: String,
+    /// Position x, y, z, metres.
+    pub position: [f64; 3],
+    /// Orientation quaternion x, y, z, w, as written (not normalised).
+    pub orientation: [f64; 4],
+    /// Row-major 6×6 covariance over (x, y, z, roll, pitch, yaw); all zeros: unknown.
+    pub covariance: [f64; 36],
+}
+
+impl PoseMessage {
+    /// The planar pose ([`planar_pose`]): NaN heading for a zero or non-finite quaternion.
+    pub fn pose2(&self) -> Pose2 {
+        planar_pose(self.position, self.orientation)
+    }
+}
+
+/// The planar pose of a 3D position and quaternion `(x, y, z, w)`: `(x, y)` and the yaw
+/// of the quaternion's x axis projected on the x-y plane (REP 103: z up).
+///
+/// A zero or non-finite quaternion has no rotation to take the yaw of: the heading is NaN
+/// (so that [`Pose2::is_finite`] is false and the consumer rejects it), never the
+/// identity a naive `atan2(0, 0)` would give.
+///
+/// [`quaternion_yaw`]'s `atan2(2(wz + xy), 1 − 2(y² + z²))` holds for a unit quaternion
+/// only; a quaternion whose squared norm is further than [`UNIT_QUATERNION_TOLERANCE`]
+/// from 1 (float32-rounded, or written scaled: it is the same rotation) is normalised
+/// first. One that is unit up to float64 rounding is used as written, so its yaw is
+/// exactly what it was before.
+pub fn planar_pose(position: [f64; 3], orientation: [f64; 4]) -> Pose2 {
+    let n2: f64 = orientation.iter().map(|c| c * c).sum();
+    let q = if (n2 - 1.0).abs() <= UNIT_QUATERNION_TOLERANCE || !(n2.is_finite() && n2 > 0.0) {
+        orientation
+    } else {
+        let n = n2.sqrt();
+        orientation.map(|c| c / n)
+    };
+    Pose2::new(position[0], position[1], quaternion_yaw(q))
+}
+
+/// How far a quaternion's squared norm may be from 1 for [`planar_pose`] to use it
+/// without normalising: the yaw error of doing so is of the same order, 1e-12 rad.
+pub const UNIT_QUATERNION_TOLERANCE: f64 = 1e-12;
+
+/// One decoded message of a log.
+///
+/// The covariances make the odometry variant some 750 bytes, and so every message; they
+/// are kept inline rather than boxed because a message is moved once, from the reader
+/// to the consumer's own per-type collection, which costs a copy of that size against a
+/// heap allocation per message, and because the field types stay those of ROS.
+#[derive(Clone, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)]
 pub enum LogMessage {
     /// A laser scan.
     Scan(ScanMessage),
@@ -125,6 +280,49 @@ pub enum LogMessage {
     Tf(TfMessage),
     /// An IMU reading.
     Imu(ImuMessage),
+    /// A satellite navigation fix.
+    Gnss(GnssMessage),
+    /// A pose estimate with covariance.
+    Pose(PoseMessage),
+}
+
+impl LogMessage {
+    /// The topic (ROS) or message type (CARMEN) the message came on.
+    pub fn topic(&self) -> &str {
+        match self {
+            LogMessage::Scan(m) => &m.topic,
+            LogMessage::Odometry(m) => &m.topic,
+            LogMessage::Tf(m) => &m.topic,
+            LogMessage::Imu(m) => &m.topic,
+            LogMessage::Gnss(m) => &m.topic,
+            LogMessage::Pose(m) => &m.topic,
+        }
+    }
+
+    /// The header stamp: when the data was taken. For a TF message the first
+    /// transform's (each transform has its own); `None` for one with no transforms.
+    pub fn stamp(&self) -> Option<Stamp> {
+        match self {
+            LogMessage::Scan(m) => Some(m.scan.stamp),
+            LogMessage::Odometry(m) => Some(m.stamp),
+            LogMessage::Tf(m) => m.transforms.first().map(|t| t.stamp),
+            LogMessage::Imu(m) => Some(m.stamp),
+            LogMessage::Gnss(m) => Some(m.stamp),
+            LogMessage::Pose(m) => Some(m.stamp),
+        }
+    }
+
+    /// When the log recorded the message, if its format has such a time.
+    pub fn receive_stamp(&self) -> Option<Stamp> {
+        match self {
+            LogMessage::Scan(m) => m.receive_stamp,
+            LogMessage::Odometry(m) => m.receive_stamp,
+            LogMessage::Tf(m) => m.receive_stamp,
+            LogMessage::Imu(m) => m.receive_stamp,
+            LogMessage::Gnss(m) => m.receive_stamp,
+            LogMessage::Pose(m) => m.receive_stamp,
+        }
+    }
 }
 
 /// What a reader saw besides the messages it returned.
@@ -164,4 +362,136 @@ pub trait LogReader {
 
     /// What was skipped so far.
     fn stats(&self) -> &ReadStats;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::f64::consts::PI;
+
+    fn transform(stamp: i64) -> Transform {
+        Transform {
+            stamp: Stamp(stamp),
+            parent: "odom".into(),
+            child: "base_link".into(),
+            translation: [0.0; 3],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+        }
+    }
+
+    #[test]
+    fn topic_and_stamps_of_every_kind() {
+        let receive = Some(Stamp(99));
+        let messages = [
+            LogMessage::Scan(ScanMessage {
+                topic: "/scan".into(),
+                frame_id: "laser".into(),
+                receive_stamp: receive,
+                scan: LaserScan { stamp: Stamp(1), angle_min: 0.0, angle_increment: 0.1, ranges: vec![] },
+                time_increment: 0.0,
+                scan_time: 0.0,
+                range_min: 0.0,
+                range_max: 10.0,
+                pose: None,
+                odom_pose: None,
+                laser_pose: None,
+            }),
+            LogMessage::Odometry(OdomMessage {
+                topic: "/odom".into(),
+                stamp: Stamp(2),
+                receive_stamp: receive,
+                frame_id: "odom".into(),
+                child_frame_id: "base_link".into(),
+                pose: Pose2::IDENTITY,
+                pose_covariance: [0.0; 36],
+                twist: [0.0; 6],
+                twist_covariance: [0.0; 36],
+            }),
+            LogMessage::Tf(TfMessage {
+                topic: "/tf".into(),
+                is_static: false,
+                receive_stamp: receive,
+                transforms: vec![transform(3), transform(30)],
+            }),
+            LogMessage::Imu(ImuMessage {
+                topic: "/imu".into(),
+                stamp: Stamp(4),
+                receive_stamp: receive,
+                frame_id: "imu".into(),
+                orientation: [0.0, 0.0, 0.0, 1.0],
+                angular_velocity: [0.0; 3],
+                linear_acceleration: [0.0; 3],
+                orientation_covariance: [-1.0; 9],
+                angular_velocity_covariance: [0.0; 9],
+                linear_acceleration_covariance: [0.0; 9],
+            }),
+            LogMessage::Gnss(GnssMessage {
+                topic: "/fix".into(),
+                stamp: Stamp(5),
+                receive_stamp: receive,
+                frame_id: "gps".into(),
+                status: GnssMessage::STATUS_FIX,
+                service: GnssMessage::SERVICE_GPS,
+                latitude: 0.0,
+                longitude: 0.0,
+                altitude: 0.0,
+                position_covariance: [0.0; 9],
+                position_covariance_type: GnssMessage::COVARIANCE_TYPE_UNKNOWN,
+            }),
+            LogMessage::Pose(PoseMessage {
+                topic: "/amcl_pose".into(),
+                stamp: Stamp(6),
+                receive_stamp: receive,
+                frame_id: "map".into(),
+                position: [0.0; 3],
+                orientation: [0.0, 0.0, 0.0, 1.0],
+                covariance: [0.0; 36],
+            }),
+        ];
+        let topics: Vec<&str> = messages.iter().map(LogMessage::topic).collect();
+        assert_eq!(topics, ["/scan", "/odom", "/tf", "/imu", "/fix", "/amcl_pose"]);
+        let stamps: Vec<Option<Stamp>> = messages.iter().map(LogMessage::stamp).collect();
+        assert_eq!(stamps, [1, 2, 3, 4, 5, 6].map(|s| Some(Stamp(s))));
+        assert!(messages.iter().all(|m| m.receive_stamp() == receive));
+
+        let empty =
+            LogMessage::Tf(TfMessage { topic: "/tf".into(), is_static: true, receive_stamp: None, transforms: vec![] });
+        assert_eq!((empty.stamp(), empty.receive_stamp()), (None, None));
+    }
+
+    #[test]
+    fn a_degenerate_quaternion_gives_a_nan_heading_not_the_identity() {
+        for q in [[0.0; 4], [f64::NAN, 0.0, 0.0, 1.0], [0.0, 0.0, f64::INFINITY, 1.0], [0.0, 0.0, 0.0, f64::NAN]] {
+            let p = planar_pose([1.0, 2.0, 3.0], q);
+            assert!(p.theta.is_nan(), "{q:?}: {p:?}");
+            assert_eq!((p.x, p.y), (1.0, 2.0));
+            assert!(!p.is_finite());
+        }
+    }
+
+    proptest! {
+        /// A rotation about z by `yaw`, at any positive scale, gives back `yaw` (the ROS
+        /// quaternion of a planar heading, as `tf2::Quaternion::setRPY(0, 0, yaw)` makes it).
+        #[test]
+        fn planar_pose_recovers_the_yaw_of_any_scaled_z_rotation(
+            yaw in -(PI - 1e-6)..(PI - 1e-6),
+            scale in 1e-3f64..1e3,
+            x in -1e6f64..1e6,
+            y in -1e6f64..1e6,
+        ) {
+            let q = [0.0, 0.0, scale * (yaw / 2.0).sin(), scale * (yaw / 2.0).cos()];
+            let p = planar_pose([x, y, 0.0], q);
+            prop_assert_eq!((p.x, p.y), (x, y));
+            prop_assert!((p.theta - yaw).abs() < 1e-9, "{} vs {}", p.theta, yaw);
+        }
+
+        /// A quaternion that is unit up to rounding gives exactly what
+        /// `quaternion_yaw` gives (what every reader gave before it normalised).
+        #[test]
+        fn a_unit_quaternion_is_used_as_written(yaw in -(PI - 1e-6)..(PI - 1e-6)) {
+            let q = [0.0, 0.0, (yaw / 2.0).sin(), (yaw / 2.0).cos()];
+            prop_assert_eq!(planar_pose([0.0; 3], q).theta.to_bits(), quaternion_yaw(q).to_bits());
+        }
+    }
 }

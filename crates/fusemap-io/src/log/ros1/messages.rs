@@ -8,8 +8,9 @@
 //! differs are refused.
 
 use super::cursor::{Cursor, Malformed};
-use crate::log::{ImuMessage, LogMessage, OdomMessage, ScanMessage, TfMessage, Transform};
-use fusemap_core::geometry::{quaternion_yaw, Pose2};
+use crate::log::{
+    planar_pose, GnssMessage, ImuMessage, LogMessage, OdomMessage, PoseMessage, ScanMessage, TfMessage, Transform,
+};
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::Stamp;
 
@@ -24,6 +25,10 @@ pub(super) enum Kind {
     Tf,
     /// `sensor_msgs/Imu`.
     Imu,
+    /// `sensor_msgs/NavSatFix`.
+    NavSatFix,
+    /// `geometry_msgs/PoseWithCovarianceStamped`.
+    PoseWithCovarianceStamped,
 }
 
 impl Kind {
@@ -36,6 +41,10 @@ impl Kind {
             b"nav_msgs/Odometry" => (Kind::Odometry, "cd5e73d190d741a2f92e81eda573aca7"),
             b"tf2_msgs/TFMessage" | b"tf/tfMessage" => (Kind::Tf, "94810edda583a504dfda3829e70d7eec"),
             b"sensor_msgs/Imu" => (Kind::Imu, "6a62c6daae103f4ff57a132d6f95cec2"),
+            b"sensor_msgs/NavSatFix" => (Kind::NavSatFix, "2d3a8cd499b9b4a0249fb98fd05cfa48"),
+            b"geometry_msgs/PoseWithCovarianceStamped" => {
+                (Kind::PoseWithCovarianceStamped, "953b798c0f514ff060a53a3498ce6246")
+            }
             _ => return None,
         })
     }
@@ -47,6 +56,8 @@ impl Kind {
             Kind::Odometry => "Odometry",
             Kind::Tf => "TFMessage",
             Kind::Imu => "Imu",
+            Kind::NavSatFix => "NavSatFix",
+            Kind::PoseWithCovarianceStamped => "PoseWithCovarianceStamped",
         }
     }
 }
@@ -64,6 +75,8 @@ pub(super) fn decode(kind: Kind, topic: &str, receive: Stamp, payload: &[u8]) ->
         Kind::Odometry => odometry(&mut c, topic, receive_stamp).map(LogMessage::Odometry),
         Kind::Tf => tf(&mut c, topic, receive_stamp).map(LogMessage::Tf),
         Kind::Imu => imu(&mut c, topic, receive_stamp).map(LogMessage::Imu),
+        Kind::NavSatFix => nav_sat_fix(&mut c, topic, receive_stamp).map(LogMessage::Gnss),
+        Kind::PoseWithCovarianceStamped => pose_with_covariance(&mut c, topic, receive_stamp).map(LogMessage::Pose),
     }
     .map_err(|e| e.context(kind.name()))?;
     if !c.is_empty() {
@@ -114,17 +127,21 @@ fn scan(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result
 fn odometry(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<OdomMessage, Malformed> {
     let (stamp, frame_id) = header(c)?;
     let child_frame_id = c.string("child_frame_id")?;
-    let [x, y, _z] = c.f64s::<3>("pose.pose.position")?;
-    let q = c.f64s::<4>("pose.pose.orientation")?;
-    // pose.covariance (36), twist.twist (6), twist.covariance (36).
-    c.take((36 + 6 + 36) * 8, "pose.covariance and twist")?;
+    let position = c.f64s::<3>("pose.pose.position")?;
+    let orientation = c.f64s::<4>("pose.pose.orientation")?;
+    let pose_covariance = c.f64s::<36>("pose.covariance")?;
+    let twist = c.f64s::<6>("twist.twist")?;
+    let twist_covariance = c.f64s::<36>("twist.covariance")?;
     Ok(OdomMessage {
         topic: topic.to_string(),
         stamp,
         receive_stamp,
         frame_id,
         child_frame_id,
-        pose: Pose2::new(x, y, quaternion_yaw(q)),
+        pose: planar_pose(position, orientation),
+        pose_covariance,
+        twist,
+        twist_covariance,
     })
 }
 
@@ -150,11 +167,11 @@ fn transform(c: &mut Cursor<'_>) -> Result<Transform, Malformed> {
 fn imu(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<ImuMessage, Malformed> {
     let (stamp, frame_id) = header(c)?;
     let orientation = c.f64s::<4>("orientation")?;
-    c.take(9 * 8, "orientation_covariance")?;
+    let orientation_covariance = c.f64s::<9>("orientation_covariance")?;
     let angular_velocity = c.f64s::<3>("angular_velocity")?;
-    c.take(9 * 8, "angular_velocity_covariance")?;
+    let angular_velocity_covariance = c.f64s::<9>("angular_velocity_covariance")?;
     let linear_acceleration = c.f64s::<3>("linear_acceleration")?;
-    c.take(9 * 8, "linear_acceleration_covariance")?;
+    let linear_acceleration_covariance = c.f64s::<9>("linear_acceleration_covariance")?;
     Ok(ImuMessage {
         topic: topic.to_string(),
         stamp,
@@ -163,5 +180,47 @@ fn imu(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<
         orientation,
         angular_velocity,
         linear_acceleration,
+        orientation_covariance,
+        angular_velocity_covariance,
+        linear_acceleration_covariance,
     })
+}
+
+/// `sensor_msgs/NavSatFix`: header; `NavSatStatus status` (`int8 status`, `uint16
+/// service`); latitude, longitude, altitude; `float64[9] position_covariance`; `uint8
+/// position_covariance_type`. Values are passed on as written, NaN included.
+fn nav_sat_fix(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<GnssMessage, Malformed> {
+    let (stamp, frame_id) = header(c)?;
+    let status = i8::from_le_bytes(c.array::<1>("status.status")?);
+    let service = u16::from_le_bytes(c.array::<2>("status.service")?);
+    let [latitude, longitude, altitude] = c.f64s::<3>("latitude, longitude and altitude")?;
+    let position_covariance = c.f64s::<9>("position_covariance")?;
+    let [position_covariance_type] = c.array::<1>("position_covariance_type")?;
+    Ok(GnssMessage {
+        topic: topic.to_string(),
+        stamp,
+        receive_stamp,
+        frame_id,
+        status,
+        service,
+        latitude,
+        longitude,
+        altitude,
+        position_covariance,
+        position_covariance_type,
+    })
+}
+
+/// `geometry_msgs/PoseWithCovarianceStamped`: header; `PoseWithCovariance pose`
+/// (`Pose pose` = position, orientation; `float64[36] covariance`).
+fn pose_with_covariance(
+    c: &mut Cursor<'_>,
+    topic: &str,
+    receive_stamp: Option<Stamp>,
+) -> Result<PoseMessage, Malformed> {
+    let (stamp, frame_id) = header(c)?;
+    let position = c.f64s::<3>("pose.pose.position")?;
+    let orientation = c.f64s::<4>("pose.pose.orientation")?;
+    let covariance = c.f64s::<36>("pose.covariance")?;
+    Ok(PoseMessage { topic: topic.to_string(), stamp, receive_stamp, frame_id, position, orientation, covariance })
 }

@@ -12,6 +12,8 @@
 //! | `nav_msgs/Odometry` | [`LogMessage::Odometry`] (yaw from the quaternion) |
 //! | `tf2_msgs/TFMessage`, `tf/tfMessage` | [`LogMessage::Tf`], static on `/tf_static` |
 //! | `sensor_msgs/Imu` | [`LogMessage::Imu`] |
+//! | `sensor_msgs/NavSatFix` | [`LogMessage::Gnss`] |
+//! | `geometry_msgs/PoseWithCovarianceStamped` | [`LogMessage::Pose`] |
 //! | anything else | skipped, counted in [`ReadStats::skipped_by_type`] |
 //!
 //! Chunks may be stored uncompressed or compressed with `bz2` or `lz4` (the LZ4 frame
@@ -22,7 +24,9 @@
 //! ([`Location::Offset`]) for the container (not a bag, a truncated record, an unknown
 //! compression, a chunk that does not decompress to its stated size), at the message
 //! ([`Location::Message`], 1-based among all message records of the file, with its
-//! topic) for a payload that does not decode. A truncated file ends in an error, not a
+//! topic) for a payload that does not decode; the record was read whole, so such an
+//! error is [skippable](Error::is_skippable) and the next call reads the message after
+//! it. Any other error ends the read. A truncated file ends in an error, not a
 //! silent short read: the bag header says where the index starts and how many chunks
 //! it lists. Nothing in the input can make the reader panic, and memory follows what
 //! the file holds: one record's bytes and one chunk's declared uncompressed size.
@@ -493,7 +497,9 @@ impl<R: Read> LogReader for BagReader<R> {
                 None
             }
             Err(e) => {
-                self.finished = true;
+                // A message whose payload does not decode was consumed whole (its record
+                // length was sound): the next record can still be read.
+                self.finished = !e.is_skippable();
                 Some(Err(e))
             }
         }

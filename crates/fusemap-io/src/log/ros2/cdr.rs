@@ -223,6 +223,21 @@ impl<'a> CdrReader<'a> {
         Ok(out)
     }
 
+    /// An `int8` (no alignment).
+    pub fn i8(&mut self, field: &str) -> Result<i8, CdrError> {
+        self.array(field).map(i8::from_le_bytes)
+    }
+
+    /// A `uint8` (no alignment).
+    pub fn u8(&mut self, field: &str) -> Result<u8, CdrError> {
+        self.array(field).map(u8::from_le_bytes)
+    }
+
+    /// A `uint16` (aligned to 2).
+    pub fn u16(&mut self, field: &str) -> Result<u16, CdrError> {
+        self.array(field).map(u16::from_le_bytes)
+    }
+
     /// An `int32`.
     pub fn i32(&mut self, field: &str) -> Result<i32, CdrError> {
         self.array(field).map(i32::from_le_bytes)

@@ -4,12 +4,13 @@
 //! The containers (MCAP files, SQLite `.db3` files, [`rosbag2`] directories of either)
 //! yield raw messages with their topic, type name, encoding and log time; one
 //! [`Ros2Reader`] decodes those fusemap uses (`sensor_msgs/msg/LaserScan`,
-//! `nav_msgs/msg/Odometry`, `tf2_msgs/msg/TFMessage`, `sensor_msgs/msg/Imu`; see
+//! `nav_msgs/msg/Odometry`, `tf2_msgs/msg/TFMessage`, `sensor_msgs/msg/Imu`,
+//! `sensor_msgs/msg/NavSatFix`, `geometry_msgs/msg/PoseWithCovarianceStamped`; see
 //! [`cdr`] and [`msgs`]) into [`LogMessage`]s and counts the rest in
 //! [`ReadStats::skipped_by_type`]. A message whose payload does not decode is an
 //! [`Error::Format`] at [`Location::Message`] (file, 1-based index in the log, topic),
-//! and reading can go on with the next one; a container error (a truncated or corrupt
-//! file) ends the log.
+//! and reading can go on with the next one ([`Error::is_skippable`]); a container error
+//! (a truncated or corrupt file) ends the log.
 //!
 //! Every message gets its container's log time as `receive_stamp` (MCAP `log_time`,
 //! `.db3` `timestamp`); the header stamp is passed on as written.
@@ -38,9 +39,11 @@ pub mod rosbag2;
 pub mod writer;
 
 use crate::error::{Error, Location, Result};
-use crate::log::{ImuMessage, LogMessage, LogReader, OdomMessage, ReadStats, ScanMessage, TfMessage, Transform};
+use crate::log::{
+    planar_pose, GnssMessage, ImuMessage, LogMessage, LogReader, OdomMessage, PoseMessage, ReadStats, ScanMessage,
+    TfMessage, Transform,
+};
 use cdr::{decode_cdr, CdrError};
-use fusemap_core::geometry::{quaternion_yaw, Pose2};
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::Stamp;
 use std::collections::VecDeque;
@@ -80,11 +83,22 @@ pub enum KnownType {
     TfMessage,
     /// `sensor_msgs/msg/Imu`.
     Imu,
+    /// `sensor_msgs/msg/NavSatFix`.
+    NavSatFix,
+    /// `geometry_msgs/msg/PoseWithCovarianceStamped`.
+    PoseWithCovarianceStamped,
 }
 
 impl KnownType {
     /// All of them, for tests and fuzzing.
-    pub const ALL: [KnownType; 4] = [KnownType::LaserScan, KnownType::Odometry, KnownType::TfMessage, KnownType::Imu];
+    pub const ALL: [KnownType; 6] = [
+        KnownType::LaserScan,
+        KnownType::Odometry,
+        KnownType::TfMessage,
+        KnownType::Imu,
+        KnownType::NavSatFix,
+        KnownType::PoseWithCovarianceStamped,
+    ];
 
     /// The type from its ROS 2 name (`sensor_msgs/msg/LaserScan`); the ROS 1 spelling
     /// without `/msg/` is accepted too. `None` for types fusemap does not use.
@@ -94,6 +108,10 @@ impl KnownType {
             "nav_msgs/msg/Odometry" | "nav_msgs/Odometry" => Some(KnownType::Odometry),
             "tf2_msgs/msg/TFMessage" | "tf2_msgs/TFMessage" => Some(KnownType::TfMessage),
             "sensor_msgs/msg/Imu" | "sensor_msgs/Imu" => Some(KnownType::Imu),
+            "sensor_msgs/msg/NavSatFix" | "sensor_msgs/NavSatFix" => Some(KnownType::NavSatFix),
+            "geometry_msgs/msg/PoseWithCovarianceStamped" | "geometry_msgs/PoseWithCovarianceStamped" => {
+                Some(KnownType::PoseWithCovarianceStamped)
+            }
             _ => None,
         }
     }
@@ -105,6 +123,8 @@ impl KnownType {
             KnownType::Odometry => "nav_msgs/msg/Odometry",
             KnownType::TfMessage => "tf2_msgs/msg/TFMessage",
             KnownType::Imu => "sensor_msgs/msg/Imu",
+            KnownType::NavSatFix => "sensor_msgs/msg/NavSatFix",
+            KnownType::PoseWithCovarianceStamped => "geometry_msgs/msg/PoseWithCovarianceStamped",
         }
     }
 }
@@ -117,7 +137,7 @@ pub fn decode_known(
     receive_stamp: Option<Stamp>,
     payload: &[u8],
 ) -> std::result::Result<LogMessage, CdrError> {
-    use msgs::{nav_msgs, sensor_msgs, tf2_msgs};
+    use msgs::{geometry_msgs, nav_msgs, sensor_msgs, tf2_msgs};
     Ok(match kind {
         KnownType::LaserScan => {
             let m: sensor_msgs::LaserScan = decode_cdr(payload)?;
@@ -143,13 +163,17 @@ pub fn decode_known(
         KnownType::Odometry => {
             let m: nav_msgs::Odometry = decode_cdr(payload)?;
             let p = m.pose.pose;
+            let t = m.twist.twist;
             LogMessage::Odometry(OdomMessage {
                 topic: topic.to_owned(),
                 stamp: m.header.stamp.to_stamp(),
                 receive_stamp,
                 frame_id: m.header.frame_id,
                 child_frame_id: m.child_frame_id,
-                pose: Pose2::new(p.position.x, p.position.y, quaternion_yaw(p.orientation.to_array())),
+                pose: planar_pose([p.position.x, p.position.y, p.position.z], p.orientation.to_array()),
+                pose_covariance: m.pose.covariance,
+                twist: [t.linear.x, t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z],
+                twist_covariance: m.twist.covariance,
             })
         }
         KnownType::TfMessage => {
@@ -181,6 +205,38 @@ pub fn decode_known(
                 orientation: m.orientation.to_array(),
                 angular_velocity: m.angular_velocity.to_array(),
                 linear_acceleration: m.linear_acceleration.to_array(),
+                orientation_covariance: m.orientation_covariance,
+                angular_velocity_covariance: m.angular_velocity_covariance,
+                linear_acceleration_covariance: m.linear_acceleration_covariance,
+            })
+        }
+        KnownType::NavSatFix => {
+            let m: sensor_msgs::NavSatFix = decode_cdr(payload)?;
+            LogMessage::Gnss(GnssMessage {
+                topic: topic.to_owned(),
+                stamp: m.header.stamp.to_stamp(),
+                receive_stamp,
+                frame_id: m.header.frame_id,
+                status: m.status.status,
+                service: m.status.service,
+                latitude: m.latitude,
+                longitude: m.longitude,
+                altitude: m.altitude,
+                position_covariance: m.position_covariance,
+                position_covariance_type: m.position_covariance_type,
+            })
+        }
+        KnownType::PoseWithCovarianceStamped => {
+            let m: geometry_msgs::PoseWithCovarianceStamped = decode_cdr(payload)?;
+            let p = m.pose.pose;
+            LogMessage::Pose(PoseMessage {
+                topic: topic.to_owned(),
+                stamp: m.header.stamp.to_stamp(),
+                receive_stamp,
+                frame_id: m.header.frame_id,
+                position: [p.position.x, p.position.y, p.position.z],
+                orientation: p.orientation.to_array(),
+                covariance: m.pose.covariance,
             })
         }
     })

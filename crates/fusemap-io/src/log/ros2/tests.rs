@@ -8,6 +8,8 @@ use super::*;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+mod pose_sensors;
+
 /// A little-endian CDR writer for tests. Padding is 0xAA, so a decoder that reads
 /// padding as data gets visibly wrong values.
 struct W {
@@ -235,6 +237,11 @@ fn all_payloads() -> Vec<(KnownType, Vec<u8>)> {
         (KnownType::Odometry, odom_payload(1, "odom", "base_link", 1.0, 2.0, 0.3)),
         (KnownType::TfMessage, tf_payload(&[("a", "bb", [1.0; 3]), ("ccc", "d", [2.0; 3])])),
         (KnownType::Imu, imu_payload()),
+        (KnownType::NavSatFix, pose_sensors::nav_sat_fix_payload(&pose_sensors::Fix::sample())),
+        (
+            KnownType::PoseWithCovarianceStamped,
+            pose_sensors::pose_payload("map", [1.0, 2.0, 3.0], [0.0, 0.0, 0.0, 1.0]),
+        ),
     ]
 }
 
@@ -393,6 +400,8 @@ fn check_sample(messages: Vec<Result<LogMessage>>, stats: &ReadStats) {
             LogMessage::Odometry(_) => "odom",
             LogMessage::Tf(_) => "tf",
             LogMessage::Imu(_) => "imu",
+            LogMessage::Gnss(_) => "gnss",
+            LogMessage::Pose(_) => "pose",
         })
         .collect();
     assert_eq!(kinds, ["tf", "scan", "odom", "imu", "scan"]);

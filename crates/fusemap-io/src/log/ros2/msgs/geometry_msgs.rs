@@ -77,6 +77,16 @@ pub struct PoseWithCovariance {
     pub covariance: [f64; 36],
 }
 
+/// `geometry_msgs/msg/PoseWithCovarianceStamped`: a stamped pose estimate (AMCL's
+/// `/amcl_pose`, an external localiser) in `header.frame_id`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PoseWithCovarianceStamped {
+    /// Stamp and the frame the pose is given in.
+    pub header: Header,
+    /// The estimate and its covariance.
+    pub pose: PoseWithCovariance,
+}
+
 /// `geometry_msgs/msg/Twist`: a velocity split into linear and angular parts.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Twist {
@@ -143,6 +153,12 @@ impl CdrDecode for Pose {
 impl CdrDecode for PoseWithCovariance {
     fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
         Ok(Self { pose: r.decode_field("pose")?, covariance: r.f64_array("covariance")? })
+    }
+}
+
+impl CdrDecode for PoseWithCovarianceStamped {
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        Ok(Self { header: r.decode_field("header")?, pose: r.decode_field("pose")? })
     }
 }
 

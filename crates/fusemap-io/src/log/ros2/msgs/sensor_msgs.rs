@@ -1,4 +1,4 @@
-//! `sensor_msgs`: planar laser scans and inertial measurements.
+//! `sensor_msgs`: planar laser scans, inertial measurements and satellite navigation fixes.
 
 use super::geometry_msgs::{Quaternion, Vector3};
 use super::std_msgs::Header;
@@ -84,6 +84,55 @@ impl CdrDecode for Imu {
             angular_velocity_covariance: r.f64_array("angular_velocity_covariance")?,
             linear_acceleration: r.decode_field("linear_acceleration")?,
             linear_acceleration_covariance: r.f64_array("linear_acceleration_covariance")?,
+        })
+    }
+}
+
+/// `sensor_msgs/msg/NavSatStatus`: whether the receiver has a fix, and from which
+/// satellite systems.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NavSatStatus {
+    /// -1 no fix, 0 fix, 1 SBAS-augmented fix, 2 GBAS-augmented fix.
+    pub status: i8,
+    /// Bit set: 1 GPS, 2 GLONASS, 4 COMPASS, 8 Galileo.
+    pub service: u16,
+}
+
+/// `sensor_msgs/msg/NavSatFix`: a WGS 84 position from a satellite navigation receiver.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NavSatFix {
+    /// Stamp and the antenna's frame.
+    pub header: Header,
+    /// Fix status and services.
+    pub status: NavSatStatus,
+    /// Latitude, degrees (north positive).
+    pub latitude: f64,
+    /// Longitude, degrees (east positive).
+    pub longitude: f64,
+    /// Altitude above the WGS 84 ellipsoid, m.
+    pub altitude: f64,
+    /// Row-major 3×3 covariance in the East-North-Up tangent plane, m².
+    pub position_covariance: [f64; 9],
+    /// 0 unknown, 1 approximated, 2 diagonal known, 3 known.
+    pub position_covariance_type: u8,
+}
+
+impl CdrDecode for NavSatStatus {
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        Ok(Self { status: r.i8("status")?, service: r.u16("service")? })
+    }
+}
+
+impl CdrDecode for NavSatFix {
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        Ok(Self {
+            header: r.decode_field("header")?,
+            status: r.decode_field("status")?,
+            latitude: r.f64("latitude")?,
+            longitude: r.f64("longitude")?,
+            altitude: r.f64("altitude")?,
+            position_covariance: r.f64_array("position_covariance")?,
+            position_covariance_type: r.u8("position_covariance_type")?,
         })
     }
 }
