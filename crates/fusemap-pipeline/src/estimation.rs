@@ -1,12 +1,320 @@
-//! The estimator's inputs from log messages.
+//! The estimator's inputs from a log's messages, and its track.
+//!
+//! Every pose sensor enters the one estimator (`fusemap_core::estimator`):
+//! * wheel odometry as `odom_from_base` samples (a zero quaternion arrives as a NaN pose and
+//!   is counted by the estimator, never a panic);
+//! * the IMU's gyro, rotated from the IMU's frame into `base_link` with its mount (TF or
+//!   config), as the yaw rate; its orientation only when the message provides one (REP 145:
+//!   `orientation_covariance[0] = -1` means none) and the sensor table allows it;
+//! * GNSS fixes converted exactly (WGS84 → ECEF → ENU) into one local map frame around the
+//!   datum — configured, or the first good fix — x east, y north, never UTM zones (whose
+//!   borders make robot_localization's UTM track jump); `NO_FIX` ignored; the covariance by
+//!   `position_covariance_type`, floored per fix status (an RTK fixed solution earns a
+//!   tighter floor than a plain fix); the antenna's lever arm from TF or config;
+//! * absolute poses (`PoseWithCovarianceStamped`) with their covariance.
+//!
+//! Each sensor's `time_offset_s` is added to its stamps. What is not used is counted by
+//! reason in the report, beside the estimator's own figures.
 
+use crate::extrinsics::{frame_tree, from_tf};
 use crate::recording::Inventory;
-use crate::sensors::Bound;
-use crate::track::ChosenTrack;
+use crate::sensors::{Bound, BoundSensor};
+use crate::track::{ChosenTrack, Track, TrackCounts};
 use crate::PipelineError;
-use fusemap_core::config::Plan;
+use fusemap_core::config::{Plan, PoseSource, SensorKind};
+use fusemap_core::estimator::{estimate, EstimatorConfig, EstimatorInput, FixQuality};
+use fusemap_core::frames::FrameTree;
+use fusemap_core::geometry::{geodetic::Datum, quaternion_yaw, Mount3, Point2, Pose2};
+use fusemap_core::time::Stamp;
+use fusemap_io::log::GnssMessage;
+use serde::Serialize;
+use std::collections::BTreeMap;
 
-/// Builds the estimator's track.
-pub fn estimator_track(_plan: &Plan, _inv: &Inventory, _bound: &Bound) -> Result<ChosenTrack, PipelineError> {
-    Err(PipelineError::Refused("the estimator is not available".into()))
+/// What the pipeline did with the GNSS fixes before the estimator saw them.
+#[derive(Debug, Default, Clone, Serialize)]
+pub struct GnssInputReport {
+    /// Fixes read.
+    pub read: u64,
+    /// Given to the estimator.
+    pub passed: u64,
+    /// `STATUS_NO_FIX`: ignored.
+    pub no_fix: u64,
+    /// NaN or infinite latitude, longitude or altitude.
+    pub not_finite: u64,
+    /// The datum `[lat°, lon°, alt m]` of the map frame (ENU at it).
+    pub datum: Option<[f64; 3]>,
+    /// `config` or `first good fix`.
+    pub datum_source: String,
+    /// Fixes whose σ was raised to the floor of their status.
+    pub floored: u64,
+    /// Fixes with covariance type UNKNOWN (given the configured σ).
+    pub unknown_covariance: u64,
+    /// The antenna's lever arm `base_from_antenna` (x, y), metres, and where it came from.
+    pub lever_arm: Option<[f64; 2]>,
+}
+
+/// The estimator's inputs from `inv`.
+pub struct Inputs {
+    /// Time-ordered inputs.
+    pub inputs: Vec<EstimatorInput>,
+    /// The GNSS part of the report.
+    pub gnss: Option<GnssInputReport>,
+    /// The estimator's config with the sensor tables' noise figures applied.
+    pub config: EstimatorConfig,
+    /// Facts a user should know.
+    pub notes: Vec<String>,
+}
+
+fn offset(t: Stamp, s: &BoundSensor) -> Stamp {
+    Stamp(t.0.saturating_add(crate::offset_ns(s.sensor.time_offset_s)))
+}
+
+/// The sensor's mount: config, else TF of `frame`, else identity.
+fn mount(s: &BoundSensor, tree: &FrameTree, base: &str, frame: &str, stamp: Option<Stamp>) -> (Mount3, &'static str) {
+    if let Some(m) = s.sensor.base_from_sensor {
+        return (m, "config");
+    }
+    from_tf(tree, base, frame, stamp).unwrap_or((Mount3::default(), "identity"))
+}
+
+/// A 3 × 3 block (x, y, yaw) of a ROS 6 × 6 row-major covariance, `None` when it is not a
+/// usable covariance (zero, NaN, negative variances).
+fn planar_cov(c: &[f64; 36]) -> Option<[[f64; 3]; 3]> {
+    let idx = [0, 1, 5];
+    let mut m = [[0.0; 3]; 3];
+    for (r, &i) in idx.iter().enumerate() {
+        for (k, &j) in idx.iter().enumerate() {
+            m[r][k] = c[i * 6 + j];
+        }
+    }
+    let ok = m.iter().flatten().all(|v| v.is_finite()) && (0..3).all(|i| m[i][i] > 0.0);
+    ok.then_some(m)
+}
+
+/// The quality of a fix, for the report and the floor.
+fn quality(f: &GnssMessage) -> FixQuality {
+    match f.status {
+        GnssMessage::STATUS_GBAS_FIX => FixQuality::RtkFixed,
+        GnssMessage::STATUS_SBAS_FIX => FixQuality::Sbas,
+        GnssMessage::STATUS_FIX => FixQuality::Fix,
+        _ => FixQuality::Unknown,
+    }
+}
+
+/// Builds the estimator's inputs from the bound pose sensors.
+pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, PipelineError> {
+    let cfg = &plan.log;
+    let (tree, _) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
+    let mut est = plan.estimator.clone();
+    let mut notes = Vec::new();
+    let mut out = Vec::new();
+    let mut gnss_report = None;
+    for s in &bound.sensors {
+        match s.sensor.kind {
+            SensorKind::WheelOdometry => {
+                let n = &s.sensor.odometry;
+                if let Some(v) = n.translation_per_sqrt_m {
+                    est.odometry_translation_noise = v;
+                }
+                if let Some(v) = n.rotation_per_sqrt_rad {
+                    est.odometry_rotation_noise_per_rad = v;
+                }
+                if let Some(v) = n.rotation_per_sqrt_m {
+                    est.odometry_rotation_noise_per_m = v;
+                }
+                for m in &inv.odom[&s.topic] {
+                    out.push(EstimatorInput::Odometry {
+                        stamp: offset(m.stamp, s),
+                        pose: m.pose,
+                        covariance: planar_cov(&m.pose_covariance),
+                    });
+                }
+            }
+            SensorKind::Imu => {
+                if let Some(v) = s.sensor.gyro_noise_rad_s {
+                    est.gyro_rate_sigma = v;
+                }
+                let msgs = &inv.imu[&s.topic];
+                let frame =
+                    s.sensor.frame.clone().or_else(|| msgs.first().map(|m| m.frame_id.clone())).unwrap_or_default();
+                let (m3, _) = mount(s, &tree, &cfg.base_frame, &frame, msgs.first().map(|m| m.stamp));
+                let r = m3.rotation();
+                let q_mount = m3.quaternion();
+                for m in msgs {
+                    let w = m.angular_velocity;
+                    // The z component of R · ω: the yaw rate of base_link.
+                    let yaw_rate = r[2][0] * w[0] + r[2][1] * w[1] + r[2][2] * w[2];
+                    let var = m.angular_velocity_covariance[8];
+                    let variance = (var.is_finite() && var > 0.0).then_some(var);
+                    let stamp = offset(m.stamp, s);
+                    out.push(EstimatorInput::Gyro { stamp, yaw_rate, variance });
+                    if s.sensor.use_orientation && m.has_orientation() {
+                        // world_from_base = world_from_imu · (base_from_imu)⁻¹.
+                        let q = qmul(m.orientation, qconj(q_mount));
+                        let var = m.orientation_covariance[8];
+                        let yaw = quaternion_yaw(q);
+                        if yaw.is_finite() && var.is_finite() && var > 0.0 {
+                            out.push(EstimatorInput::Heading { stamp, yaw, variance: var });
+                        }
+                    }
+                }
+            }
+            SensorKind::Gnss => {
+                let (inputs, report, n) = gnss_inputs(s, inv, &tree, &cfg.base_frame)?;
+                out.extend(inputs);
+                notes.extend(n);
+                gnss_report = Some(report);
+            }
+            SensorKind::Pose => {
+                let (ps, yaw) = s.sensor.pose_noise;
+                if let Some(v) = ps {
+                    est.fallback_pose_sigma_m = v;
+                }
+                if let Some(v) = yaw {
+                    est.fallback_pose_sigma_rad = v;
+                }
+                for m in &inv.poses[&s.topic] {
+                    let cov = planar_cov(&m.covariance).unwrap_or([[0.0; 3]; 3]);
+                    out.push(EstimatorInput::Pose { stamp: offset(m.stamp, s), pose: m.pose2(), covariance: cov });
+                }
+            }
+            SensorKind::Lidar => {}
+        }
+    }
+    Ok(Inputs { inputs: out, gnss: gnss_report, config: est, notes })
+}
+
+fn gnss_inputs(
+    s: &BoundSensor,
+    inv: &Inventory,
+    tree: &FrameTree,
+    base: &str,
+) -> Result<(Vec<EstimatorInput>, GnssInputReport, Vec<String>), PipelineError> {
+    let msgs = &inv.gnss[&s.topic];
+    let mut r = GnssInputReport { read: msgs.len() as u64, ..Default::default() };
+    let mut notes = Vec::new();
+    let good = |f: &&GnssMessage| {
+        f.status != GnssMessage::STATUS_NO_FIX
+            && f.latitude.is_finite()
+            && f.longitude.is_finite()
+            && f.altitude.is_finite()
+    };
+    let datum = match s.sensor.datum {
+        Some([lat, lon, alt]) => {
+            r.datum_source = "config".into();
+            Some((lat, lon, alt))
+        }
+        None => msgs.iter().find(good).map(|f| {
+            r.datum_source = "first good fix".into();
+            (f.latitude, f.longitude, f.altitude)
+        }),
+    };
+    let Some((lat0, lon0, alt0)) = datum else {
+        notes.push(format!(
+            "GNSS `{}`: {} messages but no usable fix and no datum configured: the fixes are not used",
+            s.topic,
+            msgs.len()
+        ));
+        r.no_fix = msgs.iter().filter(|f| f.status == GnssMessage::STATUS_NO_FIX).count() as u64;
+        return Ok((Vec::new(), r, notes));
+    };
+    let datum =
+        Datum::new(lat0, lon0, alt0).map_err(|e| PipelineError::Refused(format!("GNSS `{}`: datum: {e}", s.topic)))?;
+    r.datum = Some([lat0, lon0, alt0]);
+    let frame = s.sensor.frame.clone().or_else(|| msgs.first().map(|m| m.frame_id.clone())).unwrap_or_default();
+    let (lever, _) = mount(s, tree, base, &frame, msgs.first().map(|m| m.stamp));
+    r.lever_arm = Some([lever.x, lever.y]);
+    let floors = s.sensor.gnss;
+    let mut out = Vec::new();
+    for f in msgs {
+        if f.status == GnssMessage::STATUS_NO_FIX {
+            r.no_fix += 1;
+            continue;
+        }
+        if !good(&f) {
+            r.not_finite += 1;
+            continue;
+        }
+        let enu = datum.to_enu(f.latitude, f.longitude, f.altitude);
+        let q = quality(f);
+        let floor = match q {
+            FixQuality::RtkFixed => floors.floor_rtk_m,
+            FixQuality::Sbas => floors.floor_sbas_m,
+            _ => floors.floor_fix_m,
+        };
+        let c = &f.position_covariance;
+        // NavSatFix's covariance is ENU (east, north, up), m².
+        let mut cov = if f.position_covariance_type == GnssMessage::COVARIANCE_TYPE_UNKNOWN
+            || !(c[0].is_finite() && c[4].is_finite() && c[1].is_finite() && c[0] > 0.0 && c[4] > 0.0)
+        {
+            r.unknown_covariance += 1;
+            let v = floors.unknown_m.max(floor).powi(2);
+            [[v, 0.0], [0.0, v]]
+        } else if f.position_covariance_type == GnssMessage::COVARIANCE_TYPE_KNOWN {
+            [[c[0], c[1]], [c[3], c[4]]]
+        } else {
+            [[c[0], 0.0], [0.0, c[4]]]
+        };
+        let f2 = floor * floor;
+        if cov[0][0] < f2 || cov[1][1] < f2 {
+            r.floored += 1;
+            cov[0][0] = cov[0][0].max(f2);
+            cov[1][1] = cov[1][1].max(f2);
+        }
+        r.passed += 1;
+        out.push(EstimatorInput::Position {
+            stamp: offset(f.stamp, s),
+            enu: [enu[0], enu[1]],
+            covariance: cov,
+            antenna: Point2::new(lever.x, lever.y),
+            quality: q,
+        });
+    }
+    Ok((out, r, notes))
+}
+
+fn qconj(q: [f64; 4]) -> [f64; 4] {
+    [-q[0], -q[1], -q[2], q[3]]
+}
+
+fn qmul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    let [ax, ay, az, aw] = a;
+    let [bx, by, bz, bw] = b;
+    [
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ]
+}
+
+/// Runs the estimator and its smoother over the log's pose sensors.
+pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<ChosenTrack, PipelineError> {
+    let Inputs { inputs, gnss, config, notes } = inputs(plan, inv, bound)?;
+    let e = estimate(&inputs, &config).map_err(|e| PipelineError::Refused(format!("pose estimator: {e}")))?;
+    let odom = bound.first(SensorKind::WheelOdometry);
+    let names: Vec<String> =
+        bound.sensors.iter().map(|s| format!("{} `{}`", s.sensor.kind.as_str().replace('_', " "), s.topic)).collect();
+    let mut report: BTreeMap<&str, serde_json::Value> = BTreeMap::new();
+    report.insert("estimator", serde_json::to_value(&e.report).unwrap_or_default());
+    report.insert("gnss_input", serde_json::to_value(&gnss).unwrap_or_default());
+    report.insert("inputs", serde_json::Value::from(inputs.len()));
+    let stamps: Vec<Stamp> = odom.map(|o| inv.odom[&o.topic].iter().map(|m| m.stamp).collect()).unwrap_or_default();
+    let receive = odom.map(|o| inv.odom[&o.topic].iter().map(|m| m.receive_stamp).collect()).unwrap_or_default();
+    let counts = TrackCounts { samples: inputs.len() as u64, used: e.smoothed.len() as u64, ..Default::default() };
+    Ok(ChosenTrack {
+        source: PoseSource::Estimator,
+        track: Track::Timed(Box::new(e)),
+        name: format!("estimator ({})", names.join(", ")),
+        counts,
+        stamps,
+        receive,
+        estimator: serde_json::to_value(report).ok(),
+        notes,
+    })
+}
+
+/// The planar pose of a ROS pose, for callers that need one without the estimator.
+pub fn planar(position: [f64; 3], orientation: [f64; 4]) -> Pose2 {
+    fusemap_io::log::planar_pose(position, orientation)
 }

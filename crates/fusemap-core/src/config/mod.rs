@@ -35,7 +35,12 @@ pub struct Config {
 
 impl Default for Config {
     fn default() -> Self {
-        Self { map: MapConfig::default(), sensor: Vec::new(), estimator: EstimatorConfig::default(), log: LogConfig::default() }
+        Self {
+            map: MapConfig::default(),
+            sensor: Vec::new(),
+            estimator: EstimatorConfig::default(),
+            log: LogConfig::default(),
+        }
     }
 }
 
@@ -308,7 +313,15 @@ impl Config {
             let field = m.split(':').next().unwrap_or("estimator").trim().to_string();
             err(field, m.split_once(':').map_or(m.as_str(), |x| x.1.trim()).to_string())
         })?;
-        Ok(Plan { geometry, occupancy, lidars, sensors, disabled_kinds, log: g.clone(), estimator: self.estimator.clone() })
+        Ok(Plan {
+            geometry,
+            occupancy,
+            lidars,
+            sensors,
+            disabled_kinds,
+            log: g.clone(),
+            estimator: self.estimator.clone(),
+        })
     }
 }
 

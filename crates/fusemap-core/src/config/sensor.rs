@@ -390,10 +390,8 @@ pub(super) fn plan_sensors(
                 return Err(err(f(k), format!("must be > 0 metres, got {v}")));
             }
         }
-        let pose_noise = (
-            pos("position_noise_m", s.position_noise_m)?,
-            pos("yaw_noise_deg", s.yaw_noise_deg)?.map(f64::to_radians),
-        );
+        let pose_noise =
+            (pos("position_noise_m", s.position_noise_m)?, pos("yaw_noise_deg", s.yaw_noise_deg)?.map(f64::to_radians));
         if let Some(m) = &s.base_from_sensor {
             for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", m.yaw)] {
                 finite(&f(&format!("base_from_sensor.{k}")), v)?;

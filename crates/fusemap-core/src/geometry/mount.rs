@@ -52,6 +52,20 @@ pub enum MountError {
 }
 
 impl Mount3 {
+    /// The rotation as a unit quaternion `(x, y, z, w)`: `q = q_z(yaw) · q_y(pitch) ·
+    /// q_x(roll)`, the same fixed-axis RPY as [`Mount3::rotation`].
+    pub fn quaternion(&self) -> [f64; 4] {
+        let (sr, cr) = (self.roll / 2.0).sin_cos();
+        let (sp, cp) = (self.pitch / 2.0).sin_cos();
+        let (sy, cy) = (self.yaw / 2.0).sin_cos();
+        [
+            sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy,
+            cr * cp * cy + sr * sp * sy,
+        ]
+    }
+
     /// A mount from a translation and a unit quaternion `(x, y, z, w)` (as ROS
     /// `geometry_msgs/Transform` carries it). The quaternion is normalised first; a zero
     /// or non-finite quaternion gives NaN angles, which [`Mount3::to_planar`] refuses.
@@ -158,6 +172,15 @@ impl PlanarMount {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quaternion_round_trips_through_rpy() {
+        let m = Mount3 { x: 0.1, y: -0.2, z: 0.3, roll: 0.3, pitch: -0.4, yaw: 2.5 };
+        let back = Mount3::from_translation_quaternion([m.x, m.y, m.z], m.quaternion());
+        for (a, b) in [(m.roll, back.roll), (m.pitch, back.pitch), (m.yaw, back.yaw)] {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+    }
     use std::f64::consts::{FRAC_PI_2, PI};
 
     #[test]
