@@ -32,7 +32,7 @@ pub mod run;
 pub mod sensors;
 pub mod track;
 
-pub use run::{map_inventory, map_log, MapRun, Progress};
+pub use run::{map_inventory, map_log, map_with_track, MapRun, Progress};
 
 pub(crate) use run::offset_ns;
 

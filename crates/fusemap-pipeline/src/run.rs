@@ -148,8 +148,21 @@ pub fn map_inventory(
     inv: &Inventory,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MapRun, PipelineError> {
-    let cfg = &plan.log;
     let (bound, chosen, track_s) = prepare(plan, inv)?;
+    map_with_track(plan, inv, &bound, chosen, track_s, progress)
+}
+
+/// Maps a recording whose first pass is done with a given pose track (a calibration
+/// search, or a comparison of tracks on one log, maps the same scans with several).
+pub fn map_with_track(
+    plan: &Plan,
+    inv: &Inventory,
+    bound: &Bound,
+    chosen: ChosenTrack,
+    track_s: f64,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<MapRun, PipelineError> {
+    let cfg = &plan.log;
     let mut notes = bound.notes.clone();
     if bound.lidars.is_empty() {
         return Err(PipelineError::Refused("no lidar to map: every [[sensor]] of kind lidar is disabled".into()));

@@ -60,6 +60,22 @@ pub struct ChosenTrack {
     pub notes: Vec<String>,
 }
 
+impl ChosenTrack {
+    /// A track given by the caller (e.g. ground truth, or odometry placed in the map frame).
+    pub fn given(name: impl Into<String>, track: Box<dyn PoseTrack>) -> Self {
+        ChosenTrack {
+            source: PoseSource::Auto,
+            track: Track::Timed(track),
+            name: name.into(),
+            counts: TrackCounts::default(),
+            stamps: Vec::new(),
+            receive: Vec::new(),
+            estimator: None,
+            notes: Vec::new(),
+        }
+    }
+}
+
 /// How many of `stamps` (in log order) come after a later stamp.
 pub fn count_reordered(stamps: impl IntoIterator<Item = Stamp>) -> u64 {
     let mut latest: Option<Stamp> = None;

@@ -309,9 +309,10 @@ impl Config {
                 listed.clone().next().is_some() && listed.all(|s| !s.enabled)
             })
             .collect();
-        self.estimator.validate().map_err(|m| {
-            let field = m.split(':').next().unwrap_or("estimator").trim().to_string();
-            err(field, m.split_once(':').map_or(m.as_str(), |x| x.1.trim()).to_string())
+        // The estimator names the field first: `estimator.gate_probability must be …`.
+        self.estimator.validate().map_err(|m| match m.split_once(' ') {
+            Some((field, rest)) if field.starts_with("estimator.") => err(field, rest),
+            _ => err("estimator", m),
         })?;
         Ok(Plan {
             geometry,
@@ -413,6 +414,9 @@ mod tests {
         let mut c = Config::default();
         c.log.base_frame = " ".into();
         assert_eq!(field_of(c), "log.base_frame");
+        let mut c = Config::default();
+        c.estimator.gate_probability = 1.5;
+        assert_eq!(field_of(c), "estimator.gate_probability");
         let mut c = Config::default();
         c.log.gap_bridge_motion_m = -1.0;
         assert_eq!(field_of(c), "log.gap_bridge_motion_m");

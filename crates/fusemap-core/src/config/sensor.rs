@@ -377,7 +377,7 @@ pub(super) fn plan_sensors(
         let gnss = GnssNoise {
             floor_rtk_m: s.sigma_floor_rtk_m.unwrap_or(0.02),
             floor_sbas_m: s.sigma_floor_sbas_m.unwrap_or(0.5),
-            floor_fix_m: s.sigma_floor_fix_m.unwrap_or(1.0),
+            floor_fix_m: s.sigma_floor_fix_m.unwrap_or(0.5),
             unknown_m: s.sigma_unknown_m.unwrap_or(3.0),
         };
         for (k, v) in [

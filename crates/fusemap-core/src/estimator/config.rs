@@ -100,6 +100,20 @@ pub struct EstimatorConfig {
     pub gate_reset_consistent_fixes: usize,
     /// `pose_at` refuses to interpolate across samples further apart than this, seconds.
     pub max_sample_gap_s: f64,
+    /// Correlation time of the position error of non-RTK fixes (multipath, atmosphere),
+    /// seconds. Fixes arriving faster than this are not independent: counting each at its
+    /// own σ would let a few seconds of a 0.5 m bias outweigh the odometry (the design
+    /// document's §2.4: correlated observations must not be counted as independent). Each
+    /// fix's update covariance is therefore scaled by `correlation_time / interval` (at
+    /// least 1), so one correlation time of fixes carries the weight of one fix; the
+    /// outlier gate still uses the fix's own σ. 0 treats every fix as independent.
+    pub fix_correlation_time_s: f64,
+    /// The same for RTK fixed solutions (`STATUS_GBAS_FIX`), whose centimetre errors are
+    /// close to white, seconds.
+    pub rtk_fix_correlation_time_s: f64,
+    /// Test every accepted fix again against the smoothed track and, if any fails the
+    /// gate, run the estimate once more without them.
+    pub smoothed_fix_gate: bool,
 }
 
 impl Default for EstimatorConfig {
@@ -140,6 +154,9 @@ impl Default for EstimatorConfig {
             stationary_min_s: 0.5,
             gate_reset_consistent_fixes: 3,
             max_sample_gap_s: 1.0,
+            fix_correlation_time_s: 10.0,
+            rtk_fix_correlation_time_s: 0.0,
+            smoothed_fix_gate: true,
         }
     }
 }
@@ -186,6 +203,8 @@ impl EstimatorConfig {
             ("slip_merge_gap_s", self.slip_merge_gap_s),
             ("stationary_max_speed_mps", self.stationary_max_speed_mps),
             ("stationary_max_rate", self.stationary_max_rate),
+            ("fix_correlation_time_s", self.fix_correlation_time_s),
+            ("rtk_fix_correlation_time_s", self.rtk_fix_correlation_time_s),
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {

@@ -123,15 +123,33 @@ pub(crate) fn update<const M: usize>(
     r: &Mat<M, M>,
     gate: f64,
 ) -> Gated {
+    update_weighted(x, p, nu, h, r, r, gate)
+}
+
+/// [`update`] gated with the measurement's own covariance `r_gate` but applied with
+/// `r`: a correlated measurement is tested for being an outlier at its own σ, and weighted
+/// as the share of an independent one it is.
+pub(crate) fn update_weighted<const M: usize>(
+    x: &mut [f64; N],
+    p: &mut Mat<N, N>,
+    nu: [f64; M],
+    h: &Mat<M, N>,
+    r_gate: &Mat<M, M>,
+    r: &Mat<M, M>,
+    gate: f64,
+) -> Gated {
     let ht = transpose(h);
+    let Some(g_inv) = spd_inverse(&add(&sandwich(h, p), r_gate)) else {
+        return Gated { nis: f64::NAN, accepted: false };
+    };
+    let nis: f64 = (0..M).map(|i| (0..M).map(|j| nu[i] * g_inv[i][j] * nu[j]).sum::<f64>()).sum();
+    if nis.is_nan() || nis > gate {
+        return Gated { nis, accepted: false };
+    }
     let s = add(&sandwich(h, p), r);
     let Some(s_inv) = spd_inverse(&s) else {
         return Gated { nis: f64::NAN, accepted: false };
     };
-    let nis: f64 = (0..M).map(|i| (0..M).map(|j| nu[i] * s_inv[i][j] * nu[j]).sum::<f64>()).sum();
-    if nis.is_nan() || nis > gate {
-        return Gated { nis, accepted: false };
-    }
     let k = mul(&mul(p, &ht), &s_inv);
     let dx = mul_vec(&k, &nu);
     for i in 0..N {

@@ -62,6 +62,7 @@ mod models;
 mod output;
 mod report;
 mod run;
+mod second_pass;
 mod slip_fixes;
 mod smoother;
 mod streams;
@@ -92,7 +93,15 @@ use streams::{GyroTrack, OdometryTrack, SlipDetector};
 /// The track spans the wheel odometry: corrections outside it are counted and ignored.
 /// Non-finite inputs are counted and skipped; covariances that are not positive definite
 /// are replaced by the configuration's figures (counted).
+///
+/// With `smoothed_fix_gate`, accepted fixes that fail the gate against the smoothed track
+/// are removed and the estimate is run once more (see `second_pass`).
 pub fn estimate(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> Result<Estimate, EstimatorError> {
+    second_pass::estimate_with_hindsight(inputs, cfg)
+}
+
+/// One forward filter and backward smoother over `inputs`.
+pub(crate) fn estimate_once(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> Result<Estimate, EstimatorError> {
     cfg.validate().map_err(EstimatorError::Config)?;
     if inputs.is_empty() {
         return Err(EstimatorError::NoInputs);

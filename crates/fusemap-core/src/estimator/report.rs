@@ -55,6 +55,8 @@ pub struct CorrectionReport {
     pub used: usize,
     /// Rejected by the Mahalanobis gate.
     pub rejected_gate: usize,
+    /// Accepted by the filter, then rejected against the smoothed track (fixes only).
+    pub rejected_smoothed_gate: usize,
     /// Rejected because a value (or the stamp) was NaN, infinite or absurd.
     pub rejected_not_finite: usize,
     /// Ignored because they fall outside the odometry's time span (the track).
@@ -181,6 +183,9 @@ pub enum FixRejection {
     NotFinite,
     /// Outside the odometry's time span.
     OutsideTrack,
+    /// Accepted by the filter but above the gate against the smoothed track: removed and
+    /// the estimate run again.
+    SmoothedGate,
 }
 
 /// One fix that was not used.

@@ -4,7 +4,7 @@
 use super::chi2::chi_square_quantile;
 use super::config::EstimatorConfig;
 use super::error::EstimatorError;
-use super::filter::{predict, update, Gated, HeadingMotion, Motion, StepRecord, N};
+use super::filter::{predict, update, update_weighted, Gated, HeadingMotion, Motion, StepRecord, N};
 use super::init::Init;
 use super::input::{Correction, FixQuality};
 use super::linalg::{all_finite, identity, spd_inverse, Mat};
@@ -53,6 +53,7 @@ struct Filter<'a> {
     gates: Gates,
     counts: &'a mut RunCounts,
     rejected_run: RejectedRun,
+    last_fix: Option<Stamp>,
 }
 
 impl Filter<'_> {
@@ -60,7 +61,15 @@ impl Filter<'_> {
         match *c {
             Correction::Position { z, r, antenna, quality } => {
                 let (nu, h) = models::position(&self.x, z, antenna);
-                let g = update(&mut self.x, &mut self.p, nu, &h, &r, self.gates.two);
+                let tau = match quality {
+                    FixQuality::RtkFixed => self.cfg.rtk_fix_correlation_time_s,
+                    _ => self.cfg.fix_correlation_time_s,
+                };
+                let interval = self.last_fix.map_or(f64::INFINITY, |l| stamp.secs_since(l));
+                self.last_fix = Some(stamp);
+                let k = if interval > 0.0 { (tau / interval).max(1.0) } else { tau.max(1.0) };
+                let r_w = [[r[0][0] * k, r[0][1] * k], [r[1][0] * k, r[1][1] * k]];
+                let g = update_weighted(&mut self.x, &mut self.p, nu, &h, &r, &r_w, self.gates.two);
                 let accepted = g.accepted || (!g.nis.is_nan() && self.reset_if_consistent(nu, &r, z, antenna));
                 record(&mut self.counts.fixes, g, accepted);
                 let q = &mut self.counts.by_quality[quality.index()];
@@ -174,7 +183,7 @@ pub(crate) fn run(
     let (t0, t_last) = odo.span();
     let mut records = Vec::with_capacity(odo.stamps.len() + corrections.len());
     let mut slips = vec![false; odo.intervals.len()];
-    let mut f = Filter { x: init.x, p: init.p, cfg, gates, counts, rejected_run: Vec::new() };
+    let mut f = Filter { x: init.x, p: init.p, cfg, gates, counts, rejected_run: Vec::new(), last_fix: None };
     let mut j = 0;
     let outside = |(stamp, c): &(Stamp, Correction), counts: &mut RunCounts| match c {
         Correction::Position { .. } => {

@@ -5,4 +5,4 @@ mod entropy;
 mod scores;
 
 pub use entropy::{binary_entropy, map_entropy, EntropyReport};
-pub use scores::Confusion;
+pub use scores::{Confusion, TolerantScore};
