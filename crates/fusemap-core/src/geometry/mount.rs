@@ -128,14 +128,14 @@ pub fn quaternion_to_rpy(q: [f64; 4]) -> (f64, f64, f64) {
 /// x-y plane (what a planar robot's odometry orientation means). NaN for a zero or
 /// non-finite quaternion.
 pub fn quaternion_yaw(q: [f64; 4]) -> f64 {
-    let [x, y, z, w] = q;
-    let yaw = (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z));
-    let n2 = x * x + y * y + z * z + w * w;
-    if n2.is_finite() && n2 > 0.0 {
-        yaw
-    } else {
-        f64::NAN
+    let n2 = q.iter().map(|v| v * v).sum::<f64>();
+    if !(n2.is_finite() && n2 > 0.0) {
+        return f64::NAN;
     }
+    // The formula below holds for unit quaternions only; a scaled one (a driver that
+    // does not normalise) is normalised first. Unit ones are left bit for bit as they are.
+    let [x, y, z, w] = if (n2 - 1.0).abs() > 1e-12 { q.map(|v| v / n2.sqrt()) } else { q };
+    (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z))
 }
 
 /// A sensor mount reduced to the plane of the grid.
@@ -172,6 +172,14 @@ impl PlanarMount {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn yaw_of_a_scaled_quaternion_is_its_rotation() {
+        let h = 0.7f64 / 2.0;
+        let q = [0.0, 0.0, 3.0 * h.sin(), 3.0 * h.cos()];
+        assert!((quaternion_yaw(q) - 0.7).abs() < 1e-12);
+        assert!(quaternion_yaw([0.0; 4]).is_nan());
+    }
 
     #[test]
     fn quaternion_round_trips_through_rpy() {
