@@ -6,5 +6,6 @@ mod demo;
 mod doctor;
 mod formats;
 mod real_logs;
+mod simulate;
 mod sync;
 mod util;
