@@ -1,0 +1,110 @@
+//! Broken pose-sensor messages in a real bag: NavSatFix with NaN coordinates, a zero
+//! covariance or `NO_FIX`, an IMU with NaN rates, odometry with a zero quaternion, a TF
+//! loop, and a GNSS topic with no fix at all. Each is counted with its reason; the run
+//! still maps, and never panics.
+
+use fusemap_core::config::{Config, SensorConfig, SensorKind};
+use fusemap_core::sim::production::{simulate, Scenario, SimMessage, SimRecording, SimStaticTransform};
+use fusemap_pipeline::map_log;
+
+fn short_run() -> SimRecording {
+    let mut s = Scenario::default();
+    s.robot.duration_s = 40.0;
+    simulate(&s).expect("a 40 s scenario simulates")
+}
+
+fn map(rec: &SimRecording, tag: &str, cfg: &Config) -> Result<fusemap_pipeline::MapRun, fusemap_pipeline::PipelineError> {
+    let dir = fusemap_io::testdata::temp_dir(tag);
+    let bag = dir.join("bag");
+    fusemap_io::simulation::write_bag(rec, &bag, true).expect("the bag is written");
+    let plan = cfg.validate().expect("valid config");
+    map_log(&plan, &bag, &mut |_| {})
+}
+
+#[test]
+fn broken_messages_are_counted_and_the_log_still_maps() {
+    let mut rec = short_run();
+    let (mut fixes, mut imus, mut odoms) = (0, 0, 0);
+    for m in &mut rec.messages {
+        match m {
+            SimMessage::Fix(f) => {
+                fixes += 1;
+                match fixes % 10 {
+                    1 => f.latitude = f64::NAN,
+                    2 => f.position_covariance = [0.0; 9],
+                    3 => f.status = -1,
+                    _ => {}
+                }
+            }
+            SimMessage::Imu(i) => {
+                imus += 1;
+                if imus % 50 == 0 {
+                    i.angular_velocity = [f64::NAN; 3];
+                }
+            }
+            SimMessage::Odometry(o) => {
+                odoms += 1;
+                if odoms % 100 == 0 {
+                    o.orientation = [0.0; 4];
+                }
+            }
+            _ => {}
+        }
+    }
+    // A loop in the frame tree: laser → a → laser.
+    let t = rec.messages[0].stamp();
+    for (parent, child) in [("laser", "loop_a"), ("loop_a", "laser")] {
+        rec.messages.insert(
+            0,
+            SimMessage::StaticTransform(SimStaticTransform {
+                stamp: t,
+                topic: "/tf_static".into(),
+                frame_id: parent.into(),
+                child_frame_id: child.into(),
+                translation: [0.1, 0.0, 0.0],
+                rotation: [0.0, 0.0, 0.0, 1.0],
+            }),
+        );
+    }
+    let run = map(&rec, "bad-pose-sensors", &Config::default()).expect("the log still maps");
+    let l = serde_json::to_value(&run.report).unwrap();
+    let g = &l["estimator"]["gnss_input"];
+    println!("gnss input: {g}");
+    assert_eq!(g["not_finite"], fixes / 10 + u64::from(fixes % 10 >= 1));
+    assert_eq!(g["no_fix"], fixes / 10 + u64::from(fixes % 10 >= 3));
+    assert!(g["unknown_covariance"].as_u64().unwrap() >= fixes / 10, "a zero covariance is not trusted: {g}");
+    let e = &l["estimator"]["estimator"];
+    println!("odometry: {}, gyro: {}", e["odometry"], e["gyro"]);
+    assert!(e["odometry"]["not_finite"].as_u64().unwrap() >= odoms / 100, "{}", e["odometry"]);
+    assert!(e["gyro"]["not_finite"].as_u64().unwrap() >= imus / 50, "{}", e["gyro"]);
+    assert!(l["frames"]["rejected"]["loops"].as_u64().unwrap() >= 1, "{}", l["frames"]["rejected"]);
+    assert!(run.notes.iter().any(|n| n.contains("refused by the frame tree")), "{:?}", run.notes);
+    assert!(l["scans_used"].as_u64().unwrap() > 350, "{}", l["scans_used"]);
+}
+
+#[test]
+fn a_gnss_topic_without_a_fix_says_so_and_maps_on_odometry_and_gyro() {
+    let mut rec = short_run();
+    for m in &mut rec.messages {
+        if let SimMessage::Fix(f) = m {
+            f.status = -1;
+            f.latitude = f64::NAN;
+        }
+    }
+    let run = map(&rec, "gnss-no-fix", &Config::default()).expect("maps without fixes");
+    assert!(
+        run.notes.iter().any(|n| n.contains("no usable fix and no datum configured")),
+        "{:?}",
+        run.notes
+    );
+    assert!(run.report.pose_source.starts_with("estimator"), "{}", run.report.pose_source);
+    assert!(run.report.scans_used > 350);
+
+    // With a datum configured the fixes are still all NO_FIX: counted, none used.
+    let mut cfg = Config::default();
+    cfg.sensor.push(SensorConfig { datum: Some([48.1, 11.5, 500.0]), ..SensorConfig::new(SensorKind::Gnss) });
+    let run = map(&rec, "gnss-no-fix-datum", &cfg).expect("maps");
+    let l = serde_json::to_value(&run.report).unwrap();
+    assert_eq!(l["estimator"]["gnss_input"]["passed"], 0);
+    assert!(l["estimator"]["gnss_input"]["no_fix"].as_u64().unwrap() > 100);
+}
