@@ -98,6 +98,16 @@ pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
         let r: Vec<Option<Stamp>> = odom.iter().map(|o| o.receive_stamp).collect();
         rows.push((topic.clone(), "odometry", timing(&h, &r, limits)));
     }
+    for (topic, fixes) in &log.gnss {
+        let h: Vec<Stamp> = fixes.iter().map(|o| o.stamp).collect();
+        let r: Vec<Option<Stamp>> = fixes.iter().map(|o| o.receive_stamp).collect();
+        rows.push((topic.clone(), "gnss", timing(&h, &r, limits)));
+    }
+    for (topic, poses) in &log.poses {
+        let h: Vec<Stamp> = poses.iter().map(|o| o.stamp).collect();
+        let r: Vec<Option<Stamp>> = poses.iter().map(|o| o.receive_stamp).collect();
+        rows.push((topic.clone(), "pose", timing(&h, &r, limits)));
+    }
     for (topic, imu) in &log.imu {
         let h: Vec<Stamp> = imu.iter().map(|o| o.stamp).collect();
         let r: Vec<Option<Stamp>> = imu.iter().map(|o| o.receive_stamp).collect();
@@ -209,6 +219,9 @@ pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
         }
         Err(e) => findings.push(format!("cannot be mapped: {e}")),
     }
+
+    crate::pose_sensors_report::gnss_quality(&log, &mut out, &mut findings)?;
+    crate::pose_sensors_report::odometry_vs_gyro(&log, &mut out, &mut findings)?;
 
     if log.stats.malformed > 0 {
         // The same words as `fusemap map`'s note: the reader skipped these records.

@@ -19,6 +19,7 @@
 //! | the mapping pass | [`run`] |
 //! | the run report | [`report`] |
 //! | the log doctor's figures | [`doctor`] |
+//! | GNSS quality over time, odometry against the gyro | [`pose_sensors_report`] |
 
 #![warn(missing_docs)]
 
@@ -26,6 +27,7 @@ pub mod doctor;
 pub mod estimation;
 pub mod extrinsics;
 pub mod merge;
+pub mod pose_sensors_report;
 pub mod recording;
 pub mod report;
 pub mod run;

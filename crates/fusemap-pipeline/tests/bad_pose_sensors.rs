@@ -13,7 +13,11 @@ fn short_run() -> SimRecording {
     simulate(&s).expect("a 40 s scenario simulates")
 }
 
-fn map(rec: &SimRecording, tag: &str, cfg: &Config) -> Result<fusemap_pipeline::MapRun, fusemap_pipeline::PipelineError> {
+fn map(
+    rec: &SimRecording,
+    tag: &str,
+    cfg: &Config,
+) -> Result<fusemap_pipeline::MapRun, fusemap_pipeline::PipelineError> {
     let dir = fusemap_io::testdata::temp_dir(tag);
     let bag = dir.join("bag");
     fusemap_io::simulation::write_bag(rec, &bag, true).expect("the bag is written");
@@ -92,11 +96,7 @@ fn a_gnss_topic_without_a_fix_says_so_and_maps_on_odometry_and_gyro() {
         }
     }
     let run = map(&rec, "gnss-no-fix", &Config::default()).expect("maps without fixes");
-    assert!(
-        run.notes.iter().any(|n| n.contains("no usable fix and no datum configured")),
-        "{:?}",
-        run.notes
-    );
+    assert!(run.notes.iter().any(|n| n.contains("no usable fix and no datum configured")), "{:?}", run.notes);
     assert!(run.report.pose_source.starts_with("estimator"), "{}", run.report.pose_source);
     assert!(run.report.scans_used > 350);
 
