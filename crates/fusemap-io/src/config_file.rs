@@ -295,7 +295,7 @@ mod tests {
         let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/example.toml");
         let c = load_config(&p).unwrap();
         let d = Config::default();
-        assert_eq!((c.map, &c.log), (d.map, &d.log));
+        assert_eq!((c.map, &c.log, &c.estimator), (d.map, &d.log, &d.estimator));
         // Its one sensor table is the default lidar, written out.
         assert_eq!(c.sensor.len(), 1);
         let (plan, default) = (c.validate().unwrap(), d.validate().unwrap());

@@ -17,7 +17,7 @@
 //! reason in the report, beside the estimator's own figures.
 
 use crate::extrinsics::{frame_tree, from_tf};
-use crate::recording::Inventory;
+use crate::recording::{planar_covariance, Inventory};
 use crate::sensors::{Bound, BoundSensor};
 use crate::track::{ChosenTrack, Track, TrackCounts};
 use crate::PipelineError;
@@ -77,20 +77,6 @@ fn mount(s: &BoundSensor, tree: &FrameTree, base: &str, frame: &str, stamp: Opti
     from_tf(tree, base, frame, stamp).unwrap_or((Mount3::default(), "identity"))
 }
 
-/// A 3 × 3 block (x, y, yaw) of a ROS 6 × 6 row-major covariance, `None` when it is not a
-/// usable covariance (zero, NaN, negative variances).
-fn planar_cov(c: &[f64; 36]) -> Option<[[f64; 3]; 3]> {
-    let idx = [0, 1, 5];
-    let mut m = [[0.0; 3]; 3];
-    for (r, &i) in idx.iter().enumerate() {
-        for (k, &j) in idx.iter().enumerate() {
-            m[r][k] = c[i * 6 + j];
-        }
-    }
-    let ok = m.iter().flatten().all(|v| v.is_finite()) && (0..3).all(|i| m[i][i] > 0.0);
-    ok.then_some(m)
-}
-
 /// The quality of a fix, for the report and the floor.
 fn quality(f: &GnssMessage) -> FixQuality {
     match f.status {
@@ -126,7 +112,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                     out.push(EstimatorInput::Odometry {
                         stamp: offset(m.stamp, s),
                         pose: m.pose,
-                        covariance: planar_cov(&m.pose_covariance),
+                        covariance: m.covariance,
                     });
                 }
             }
@@ -135,8 +121,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                     est.gyro_rate_sigma = v;
                 }
                 let msgs = &inv.imu[&s.topic];
-                let frame =
-                    s.sensor.frame.clone().or_else(|| msgs.first().map(|m| m.frame_id.clone())).unwrap_or_default();
+                let frame = s.sensor.frame.clone().or_else(|| inv.frames.get(&s.topic).cloned()).unwrap_or_default();
                 let (m3, _) = mount(s, &tree, &cfg.base_frame, &frame, msgs.first().map(|m| m.stamp));
                 let r = m3.rotation();
                 let q_mount = m3.quaternion();
@@ -144,14 +129,13 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                     let w = m.angular_velocity;
                     // The z component of R · ω: the yaw rate of base_link.
                     let yaw_rate = r[2][0] * w[0] + r[2][1] * w[1] + r[2][2] * w[2];
-                    let var = m.angular_velocity_covariance[8];
+                    let var = m.rate_variance;
                     let variance = (var.is_finite() && var > 0.0).then_some(var);
                     let stamp = offset(m.stamp, s);
                     out.push(EstimatorInput::Gyro { stamp, yaw_rate, variance });
-                    if s.sensor.use_orientation && m.has_orientation() {
+                    if let Some((orientation, var)) = m.orientation.filter(|_| s.sensor.use_orientation) {
                         // world_from_base = world_from_imu · (base_from_imu)⁻¹.
-                        let q = qmul(m.orientation, qconj(q_mount));
-                        let var = m.orientation_covariance[8];
+                        let q = qmul(orientation, qconj(q_mount));
                         let yaw = quaternion_yaw(q);
                         if yaw.is_finite() && var.is_finite() && var > 0.0 {
                             out.push(EstimatorInput::Heading { stamp, yaw, variance: var });
@@ -174,7 +158,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                     est.fallback_pose_sigma_rad = v;
                 }
                 for m in &inv.poses[&s.topic] {
-                    let cov = planar_cov(&m.covariance).unwrap_or([[0.0; 3]; 3]);
+                    let cov = planar_covariance(&m.covariance).unwrap_or([[0.0; 3]; 3]);
                     out.push(EstimatorInput::Pose { stamp: offset(m.stamp, s), pose: m.pose2(), covariance: cov });
                 }
             }

@@ -40,6 +40,73 @@ impl ScanTopic {
     }
 }
 
+/// One odometry message as the pipeline keeps it: what the pose track and the estimator
+/// need, not the whole message (a ten-minute log at 50 Hz is 30,000 of these).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OdomSample {
+    /// Header stamp.
+    pub stamp: Stamp,
+    /// Log/receive time.
+    pub receive_stamp: Option<Stamp>,
+    /// `odom_from_base` (NaN when the quaternion was zero or not finite).
+    pub pose: Pose2,
+    /// The (x, y, yaw) block of the message's pose covariance, when usable.
+    pub covariance: Option<[[f64; 3]; 3]>,
+}
+
+/// One IMU message as the pipeline keeps it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuSample {
+    /// Header stamp.
+    pub stamp: Stamp,
+    /// Log/receive time.
+    pub receive_stamp: Option<Stamp>,
+    /// Angular velocity in the IMU's frame, rad/s.
+    pub angular_velocity: [f64; 3],
+    /// `angular_velocity_covariance[8]` (z variance), as the message gives it.
+    pub rate_variance: f64,
+    /// The orientation and `orientation_covariance[8]` (yaw variance), when the message
+    /// provides one (REP 145).
+    pub orientation: Option<([f64; 4], f64)>,
+}
+
+/// A ROS 6 × 6 row-major covariance's (x, y, yaw) block; `None` when it is not usable
+/// (zero, NaN or negative variances).
+pub fn planar_covariance(c: &[f64; 36]) -> Option<[[f64; 3]; 3]> {
+    let idx = [0, 1, 5];
+    let mut m = [[0.0; 3]; 3];
+    for (r, &i) in idx.iter().enumerate() {
+        for (k, &j) in idx.iter().enumerate() {
+            m[r][k] = c[i * 6 + j];
+        }
+    }
+    let ok = m.iter().flatten().all(|v| v.is_finite()) && (0..3).all(|i| m[i][i] > 0.0);
+    ok.then_some(m)
+}
+
+impl From<&OdomMessage> for OdomSample {
+    fn from(m: &OdomMessage) -> Self {
+        Self {
+            stamp: m.stamp,
+            receive_stamp: m.receive_stamp,
+            pose: m.pose,
+            covariance: planar_covariance(&m.pose_covariance),
+        }
+    }
+}
+
+impl From<&ImuMessage> for ImuSample {
+    fn from(m: &ImuMessage) -> Self {
+        Self {
+            stamp: m.stamp,
+            receive_stamp: m.receive_stamp,
+            angular_velocity: m.angular_velocity,
+            rate_variance: m.angular_velocity_covariance[8],
+            orientation: m.has_orientation().then_some((m.orientation, m.orientation_covariance[8])),
+        }
+    }
+}
+
 /// The first pass over a recording: every pose sensor's messages, and an inventory of the
 /// range sensors.
 pub struct Inventory {
@@ -50,9 +117,11 @@ pub struct Inventory {
     /// Scan topics.
     pub scans: BTreeMap<String, ScanTopic>,
     /// Odometry by topic, in log order.
-    pub odom: BTreeMap<String, Vec<OdomMessage>>,
-    /// IMU messages by topic, in log order.
-    pub imu: BTreeMap<String, Vec<ImuMessage>>,
+    pub odom: BTreeMap<String, Vec<OdomSample>>,
+    /// IMU samples by topic, in log order.
+    pub imu: BTreeMap<String, Vec<ImuSample>>,
+    /// The frame id of each pose-sensor topic (its first message's).
+    pub frames: BTreeMap<String, String>,
     /// GNSS fixes by topic, in log order.
     pub gnss: BTreeMap<String, Vec<GnssMessage>>,
     /// Absolute poses by topic, in log order.
@@ -106,6 +175,7 @@ impl Inventory {
             scans: BTreeMap::new(),
             odom: BTreeMap::new(),
             imu: BTreeMap::new(),
+            frames: BTreeMap::new(),
             gnss: BTreeMap::new(),
             poses: BTreeMap::new(),
             tf_static: Vec::new(),
@@ -131,8 +201,14 @@ impl Inventory {
                         }
                     }
                 }
-                LogMessage::Odometry(o) => inv.odom.entry(o.topic.clone()).or_default().push(o),
-                LogMessage::Imu(i) => inv.imu.entry(i.topic.clone()).or_default().push(i),
+                LogMessage::Odometry(o) => {
+                    inv.frames.entry(o.topic.clone()).or_insert_with(|| o.frame_id.clone());
+                    inv.odom.entry(o.topic.clone()).or_default().push(OdomSample::from(&o));
+                }
+                LogMessage::Imu(i) => {
+                    inv.frames.entry(i.topic.clone()).or_insert_with(|| i.frame_id.clone());
+                    inv.imu.entry(i.topic.clone()).or_default().push(ImuSample::from(&i));
+                }
                 LogMessage::Gnss(g) => inv.gnss.entry(g.topic.clone()).or_default().push(g),
                 LogMessage::Pose(p) => inv.poses.entry(p.topic.clone()).or_default().push(p),
                 LogMessage::Tf(t) => tf.push(t),
