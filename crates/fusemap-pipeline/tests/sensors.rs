@@ -1,0 +1,118 @@
+//! `[[sensor]]` tables against a real bag: every lidar listed is mapped, a listed topic the
+//! log lacks is refused by name, disabled kinds are not auto-detected, and a lidar's
+//! `time_offset_s` moves its scans in time.
+
+use fusemap_core::config::{Config, PoseSource, SensorConfig, SensorKind};
+use fusemap_core::sim::production::{simulate, Scenario, SimMessage};
+use fusemap_pipeline::{map_log, PipelineError};
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+/// A 30 s production-line bag whose scans are also published on `/scan_copy`.
+fn bag() -> &'static PathBuf {
+    static B: OnceLock<PathBuf> = OnceLock::new();
+    B.get_or_init(|| {
+        let mut s = Scenario::default();
+        s.robot.duration_s = 30.0;
+        let mut rec = simulate(&s).expect("simulates");
+        let copies: Vec<SimMessage> = rec
+            .messages
+            .iter()
+            .filter_map(|m| match m {
+                SimMessage::Scan(s) => {
+                    let mut c = s.clone();
+                    c.topic = "/scan_copy".into();
+                    Some(SimMessage::Scan(c))
+                }
+                _ => None,
+            })
+            .collect();
+        rec.messages.extend(copies);
+        rec.messages.sort_by_key(|m| m.stamp());
+        let dir = fusemap_io::testdata::temp_dir("sensor-tables");
+        let bag = dir.join("bag");
+        fusemap_io::simulation::write_bag(&rec, &bag, true).expect("written");
+        bag
+    })
+}
+
+fn lidar(topic: &str) -> SensorConfig {
+    SensorConfig {
+        topic: Some(topic.into()),
+        name: Some(topic.trim_start_matches('/').into()),
+        ..SensorConfig::new(SensorKind::Lidar)
+    }
+}
+
+fn run(cfg: Config) -> Result<fusemap_pipeline::MapRun, PipelineError> {
+    map_log(&cfg.validate().expect("valid"), bag(), &mut |_| {})
+}
+
+#[test]
+fn every_listed_lidar_is_mapped() {
+    let mut cfg = Config::default();
+    cfg.sensor = vec![lidar("/scan"), lidar("/scan_copy")];
+    let r = run(cfg).unwrap();
+    assert_eq!(r.report.lidars.len(), 2);
+    for l in &r.report.lidars {
+        assert_eq!(l.scans_read, 300, "{}", l.topic);
+        assert!(l.scans_used > 280, "{}: {}", l.topic, l.scans_used);
+    }
+    let per_sensor: Vec<u64> = r.engine.sensor_stats().map(|s| s.scans).collect();
+    assert_eq!(per_sensor.len(), 2);
+    assert_eq!(per_sensor[0], per_sensor[1]);
+    assert_eq!(r.report.merge.len(), 2, "both topics go through the merge");
+
+    // Without a lidar table the log's `/scan` is mapped and the other topic is named.
+    let r = run(Config::default()).unwrap();
+    assert_eq!(r.report.lidars.len(), 1);
+    assert!(r.notes.iter().any(|n| n.contains("/scan_copy")), "{:?}", r.notes);
+}
+
+#[test]
+fn a_listed_topic_the_log_lacks_is_refused_by_name() {
+    let mut cfg = Config::default();
+    cfg.sensor = vec![lidar("/scan"), lidar("/scan_rear")];
+    let e = run(cfg).err().expect("refused").to_string();
+    assert!(e.contains("/scan_rear") && e.contains("/scan_copy"), "{e}");
+    let mut cfg = Config::default();
+    cfg.sensor = vec![SensorConfig { topic: Some("/gps".into()), ..SensorConfig::new(SensorKind::Gnss) }];
+    let e = run(cfg).err().expect("refused").to_string();
+    assert!(e.contains("/gps") && e.contains("/gnss/fix"), "{e}");
+}
+
+#[test]
+fn disabled_kinds_are_not_auto_detected() {
+    let mut cfg = Config::default();
+    cfg.sensor = vec![
+        lidar("/scan"),
+        SensorConfig { enabled: false, ..SensorConfig::new(SensorKind::Imu) },
+        SensorConfig { enabled: false, ..SensorConfig::new(SensorKind::Gnss) },
+    ];
+    let r = run(cfg).unwrap();
+    assert!(r.report.pose_source.starts_with("odometry"), "{}", r.report.pose_source);
+    assert!(
+        !r.report.sensors.values().any(|v| v.starts_with("imu") || v.starts_with("gnss")),
+        "{:?}",
+        r.report.sensors
+    );
+}
+
+#[test]
+fn a_lidar_time_offset_moves_its_scans() {
+    let mut cfg = Config::default();
+    cfg.log.pose_source = PoseSource::Odometry;
+    cfg.sensor = vec![lidar("/scan")];
+    let base = run(cfg.clone()).unwrap();
+    // 10 s later: the last third of the scans fall after the end of the odometry.
+    cfg.sensor[0].time_offset_s = 10.0;
+    let shifted = run(cfg).unwrap();
+    let (a, b) = (&base.report.lidars[0], &shifted.report.lidars[0]);
+    assert_eq!(b.time_offset_s, 10.0);
+    assert!(
+        b.scans_skipped.after_last_pose >= 95 && a.scans_skipped.after_last_pose <= 1,
+        "{:?} / {:?}",
+        a.scans_skipped,
+        b.scans_skipped
+    );
+}
