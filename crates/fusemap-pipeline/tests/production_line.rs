@@ -123,7 +123,7 @@ fn outlier_fixes_are_rejected_and_good_ones_kept() {
     let injected: HashSet<Stamp> = f.rec.injected_outliers.iter().copied().collect();
     let rejected: HashSet<Stamp> = e.report.rejected_fixes.iter().map(|r| r.stamp).collect();
     let caught = injected.iter().filter(|t| rejected.contains(t)).count();
-    let good = e.report.fixes.received as usize - injected.len();
+    let good = e.report.fixes.received - injected.len();
     let good_rejected = rejected.iter().filter(|t| !injected.contains(t)).count();
     println!(
         "outliers rejected {caught}/{} ({:.1} %), good fixes rejected {good_rejected}/{good} ({:.2} %)",

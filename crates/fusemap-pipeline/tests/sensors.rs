@@ -44,14 +44,17 @@ fn lidar(topic: &str) -> SensorConfig {
     }
 }
 
+fn with(sensor: Vec<SensorConfig>) -> Config {
+    Config { sensor, ..Default::default() }
+}
+
 fn run(cfg: Config) -> Result<fusemap_pipeline::MapRun, PipelineError> {
     map_log(&cfg.validate().expect("valid"), bag(), &mut |_| {})
 }
 
 #[test]
 fn every_listed_lidar_is_mapped() {
-    let mut cfg = Config::default();
-    cfg.sensor = vec![lidar("/scan"), lidar("/scan_copy")];
+    let cfg = with(vec![lidar("/scan"), lidar("/scan_copy")]);
     let r = run(cfg).unwrap();
     assert_eq!(r.report.lidars.len(), 2);
     for l in &r.report.lidars {
@@ -71,24 +74,21 @@ fn every_listed_lidar_is_mapped() {
 
 #[test]
 fn a_listed_topic_the_log_lacks_is_refused_by_name() {
-    let mut cfg = Config::default();
-    cfg.sensor = vec![lidar("/scan"), lidar("/scan_rear")];
+    let cfg = with(vec![lidar("/scan"), lidar("/scan_rear")]);
     let e = run(cfg).err().expect("refused").to_string();
     assert!(e.contains("/scan_rear") && e.contains("/scan_copy"), "{e}");
-    let mut cfg = Config::default();
-    cfg.sensor = vec![SensorConfig { topic: Some("/gps".into()), ..SensorConfig::new(SensorKind::Gnss) }];
+    let cfg = with(vec![SensorConfig { topic: Some("/gps".into()), ..SensorConfig::new(SensorKind::Gnss) }]);
     let e = run(cfg).err().expect("refused").to_string();
     assert!(e.contains("/gps") && e.contains("/gnss/fix"), "{e}");
 }
 
 #[test]
 fn disabled_kinds_are_not_auto_detected() {
-    let mut cfg = Config::default();
-    cfg.sensor = vec![
+    let cfg = with(vec![
         lidar("/scan"),
         SensorConfig { enabled: false, ..SensorConfig::new(SensorKind::Imu) },
         SensorConfig { enabled: false, ..SensorConfig::new(SensorKind::Gnss) },
-    ];
+    ]);
     let r = run(cfg).unwrap();
     assert!(r.report.pose_source.starts_with("odometry"), "{}", r.report.pose_source);
     assert!(

@@ -16,7 +16,7 @@ use crate::grid::{GridGeometry, OccupancyParams};
 use serde::{Deserialize, Serialize};
 
 /// The whole configuration.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Config {
     /// The map.
@@ -31,17 +31,6 @@ pub struct Config {
     /// How robot logs are read: topics, pose source, time synchronisation.
     #[serde(default)]
     pub log: LogConfig,
-}
-
-impl Default for Config {
-    fn default() -> Self {
-        Self {
-            map: MapConfig::default(),
-            sensor: Vec::new(),
-            estimator: EstimatorConfig::default(),
-            log: LogConfig::default(),
-        }
-    }
 }
 
 /// Where a log's scans get their poses.
@@ -296,7 +285,7 @@ impl Config {
                 return Err(err(name, format!("must be > 0, got {v}")));
             }
         }
-        if !(finite("log.reorder_window_s", g.reorder_window_s)? >= 0.0) {
+        if finite("log.reorder_window_s", g.reorder_window_s)? < 0.0 {
             return Err(err("log.reorder_window_s", format!("must be >= 0, got {}", g.reorder_window_s)));
         }
         if g.base_frame.trim().is_empty() {
@@ -337,11 +326,13 @@ mod tests {
         assert_eq!(p.lidars.len(), 1);
         assert!(!p.lidars[0].explicit && p.lidars[0].topic.is_none());
         assert!(p.sensors.is_empty());
-        let mut c = Config::default();
-        c.sensor = vec![
-            SensorConfig { enabled: false, ..SensorConfig::new(SensorKind::Lidar) },
-            SensorConfig { topic: Some("/wheels".into()), ..SensorConfig::new(SensorKind::WheelOdometry) },
-        ];
+        let c = Config {
+            sensor: vec![
+                SensorConfig { enabled: false, ..SensorConfig::new(SensorKind::Lidar) },
+                SensorConfig { topic: Some("/wheels".into()), ..SensorConfig::new(SensorKind::WheelOdometry) },
+            ],
+            ..Default::default()
+        };
         let p = c.validate().unwrap();
         assert!(p.lidars.is_empty());
         assert_eq!(p.sensors.len(), 1);
@@ -401,12 +392,16 @@ mod tests {
         let mut c = Config::default();
         c.map.free_threshold = 0.7;
         assert_eq!(field_of(c), "map.free_threshold");
-        let mut c = Config::default();
-        c.sensor = vec![SensorConfig::new(SensorKind::Lidar), SensorConfig::new(SensorKind::Lidar)];
+        let mut c = Config {
+            sensor: vec![SensorConfig::new(SensorKind::Lidar), SensorConfig::new(SensorKind::Lidar)],
+            ..Default::default()
+        };
         c.sensor[1].name = Some("laser".into());
         assert_eq!(field_of(c), "sensor[1].name");
-        let mut c = Config::default();
-        c.sensor = vec![SensorConfig { datum: Some([91.0, 0.0, 0.0]), ..SensorConfig::new(SensorKind::Gnss) }];
+        let c = Config {
+            sensor: vec![SensorConfig { datum: Some([91.0, 0.0, 0.0]), ..SensorConfig::new(SensorKind::Gnss) }],
+            ..Default::default()
+        };
         assert_eq!(field_of(c), "sensor[0].datum");
         let mut c = Config::default();
         c.log.max_pose_gap_s = 0.0;

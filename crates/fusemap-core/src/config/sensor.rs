@@ -353,7 +353,7 @@ pub(super) fn plan_sensors(
         }
         let pos = |k: &str, v: Option<f64>| -> Result<Option<f64>, ConfigError> {
             match v {
-                Some(x) if !(finite(&f(k), x)? > 0.0) => Err(err(f(k), format!("must be > 0, got {x}"))),
+                Some(x) if finite(&f(k), x)? <= 0.0 => Err(err(f(k), format!("must be > 0, got {x}"))),
                 v => Ok(v),
             }
         };
@@ -386,7 +386,7 @@ pub(super) fn plan_sensors(
             ("sigma_floor_fix_m", gnss.floor_fix_m),
             ("sigma_unknown_m", gnss.unknown_m),
         ] {
-            if !(finite(&f(k), v)? > 0.0) {
+            if finite(&f(k), v)? <= 0.0 {
                 return Err(err(f(k), format!("must be > 0 metres, got {v}")));
             }
         }

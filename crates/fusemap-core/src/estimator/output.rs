@@ -79,6 +79,25 @@ fn lookup(samples: &[StateSample], t: Stamp, max_gap_s: f64) -> Result<(Pose2, [
     Ok((a.pose.interpolate(b.pose, f), cov))
 }
 
+impl crate::time::PoseTrack for Estimate {
+    /// The smoothed track, always interpolated (it is dense: one sample per filter step).
+    fn pose_at(&self, t: Stamp, _mode: crate::time::SyncMode) -> Result<Pose2, NoPose> {
+        Estimate::pose_at(self, t).map(|p| p.0)
+    }
+
+    fn covariance_at(&self, t: Stamp) -> Option<[[f64; 3]; 3]> {
+        Estimate::pose_at(self, t).ok().map(|p| p.1)
+    }
+
+    fn span(&self) -> Option<(Stamp, Stamp)> {
+        Some((self.smoothed.first()?.stamp, self.smoothed.last()?.stamp))
+    }
+
+    fn samples(&self) -> Vec<(Stamp, Pose2)> {
+        self.smoothed.iter().map(|s| (s.stamp, s.pose)).collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -124,24 +143,5 @@ mod tests {
                 Err(_) => prop_assert!(!(0.0..=3.0).contains(&t)),
             }
         }
-    }
-}
-
-impl crate::time::PoseTrack for Estimate {
-    /// The smoothed track, always interpolated (it is dense: one sample per filter step).
-    fn pose_at(&self, t: Stamp, _mode: crate::time::SyncMode) -> Result<Pose2, NoPose> {
-        Estimate::pose_at(self, t).map(|p| p.0)
-    }
-
-    fn covariance_at(&self, t: Stamp) -> Option<[[f64; 3]; 3]> {
-        Estimate::pose_at(self, t).ok().map(|p| p.1)
-    }
-
-    fn span(&self) -> Option<(Stamp, Stamp)> {
-        Some((self.smoothed.first()?.stamp, self.smoothed.last()?.stamp))
-    }
-
-    fn samples(&self) -> Vec<(Stamp, Pose2)> {
-        self.smoothed.iter().map(|s| (s.stamp, s.pose)).collect()
     }
 }
