@@ -66,6 +66,8 @@ pub(crate) fn estimate_with_hindsight(
     if flagged.is_empty() {
         return Ok(first);
     }
+    // The first estimate is not needed any more: free it before the second is built.
+    drop(first);
     let drop: HashSet<Stamp> = flagged.iter().map(|f| f.0).collect();
     let kept: Vec<EstimatorInput> = inputs
         .iter()
