@@ -340,3 +340,93 @@ mod tests {
         assert!(e.insert_scan(SensorId(9), &scan(5), Pose2::IDENTITY).is_err());
     }
 }
+
+#[cfg(test)]
+mod observed_tests {
+    use super::*;
+    use crate::geometry::{PlanarMount, Point2};
+    use crate::grid::{GridGeometry, OccupancyParams};
+    use crate::measurement::Ray;
+    use crate::sensor::LidarParams;
+
+    fn engine() -> (Engine, SensorId, SensorId) {
+        let grid = OccupancyGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
+        let mut e = Engine::new(grid);
+        let lidar = e.add_lidar("laser", LidarModel::new(LidarParams::default(), PlanarMount::default()));
+        let camera = e.add_sensor("camera", SensorModel::External(SensorKind::Camera));
+        (e, lidar, camera)
+    }
+
+    fn scan(t: i64) -> LaserScan {
+        LaserScan { stamp: Stamp(t), angle_min: 0.0, angle_increment: 0.1, ranges: vec![1.0, 2.0, f32::NAN] }
+    }
+
+    fn frame(sensor: SensorId, t: i64) -> RangeData {
+        let rays = vec![Ray { origin: Point2::new(0.0, 0.0), end: Point2::new(0.0, 1.0), hit: true }];
+        RangeData { stamp: Stamp(t), sensor, rays, evidence: Evidence { p_hit: 0.7, p_miss: 0.45 } }
+    }
+
+    #[test]
+    fn an_id_shared_by_two_sensors_of_one_instant_is_counted() {
+        let (mut e, lidar, camera) = engine();
+        let p = |_| Pose2::IDENTITY;
+        e.insert_scan_observed(lidar, ObservationId(1), &scan(10), f32::NAN, f32::NAN, p).unwrap();
+        e.insert_range_data_observed(ObservationId(1), &frame(camera, 10)).unwrap();
+        assert_eq!(e.stats().shared_ids, 1);
+        // Another id at the same instant is not shared; the same id at a later instant is
+        // a new instant's observation.
+        e.insert_range_data_observed(ObservationId(2), &frame(camera, 10)).unwrap();
+        e.insert_scan_observed(lidar, ObservationId(1), &scan(11), f32::NAN, f32::NAN, p).unwrap();
+        assert_eq!(e.stats().shared_ids, 1);
+        e.insert_range_data_observed(ObservationId(1), &frame(camera, 11)).unwrap();
+        // Observations without an id never count as shared.
+        e.insert_scan(lidar, &scan(11), Pose2::IDENTITY).unwrap();
+        e.insert_range_data(&frame(camera, 11)).unwrap();
+        assert_eq!(e.stats().shared_ids, 2);
+        let s: Vec<_> = e.sensor_stats().cloned().collect();
+        assert_eq!((s[0].shared_ids, s[1].shared_ids), (0, 2));
+        // Both were still inserted as observations of their own.
+        assert_eq!(e.stats().measurements, 7);
+        assert_eq!(e.grid().observations(), 7);
+    }
+
+    #[test]
+    fn per_sensor_counters_on_every_insert_path() {
+        let (mut e, lidar, camera) = engine();
+        let p = |_| Pose2::IDENTITY;
+        e.insert_scan(lidar, &scan(1), Pose2::IDENTITY).unwrap();
+        e.insert_scan_with(lidar, &scan(2), p).unwrap();
+        e.insert_scan_limited(lidar, &scan(3), 0.0, 1.5, p).unwrap();
+        e.insert_scan_observed(lidar, ObservationId(4), &scan(4), f32::NAN, f32::NAN, p).unwrap();
+        e.insert_range_data(&frame(camera, 5)).unwrap();
+        e.insert_range_data_observed(ObservationId(6), &frame(camera, 6)).unwrap();
+        // Refusals: out of order on both paths, and a camera has no lidar model.
+        assert!(matches!(e.insert_scan(lidar, &scan(0), Pose2::IDENTITY), Err(EngineError::OutOfOrder { .. })));
+        assert!(matches!(e.insert_range_data(&frame(camera, 0)), Err(EngineError::OutOfOrder { .. })));
+        assert!(matches!(e.insert_scan(camera, &scan(9), Pose2::IDENTITY), Err(EngineError::WrongModel { .. })));
+        assert!(matches!(e.insert_range_data(&frame(SensorId(5), 9)), Err(EngineError::UnknownSensor(_))));
+        let s: Vec<_> = e.sensor_stats().cloned().collect();
+        assert_eq!((s[0].scans, s[1].scans), (4, 2));
+        assert_eq!((s[0].out_of_order, s[1].out_of_order), (1, 1));
+        assert_eq!((s[0].maps_fed, s[1].maps_fed), (4, 2));
+        // Four scans of three beams: two valid each, but range 2.0 is a no-return under
+        // the stated range_max of 1.5; one NaN each.
+        assert_eq!(s[0].returns.valid, 7);
+        assert_eq!(s[0].returns.no_return, 1);
+        assert_eq!(s[0].returns.nan, 4);
+        assert_eq!(s[0].insert.rays, 7);
+        assert_eq!(s[1].insert.rays, 2);
+        assert_eq!(s[1].insert.hit_updates, 2);
+        assert_eq!(s[1].kind, SensorKind::Camera);
+        // The sensors' counters add up to the engine's.
+        let mut sum = InsertStats::default();
+        sum.add(&s[0].insert);
+        sum.add(&s[1].insert);
+        assert_eq!(sum, e.stats().insert);
+        assert_eq!(e.stats().measurements, 6);
+        assert_eq!(e.stats().out_of_order, 2);
+        assert_eq!(e.stats().unknown_sensor, 2);
+        assert_eq!(e.sensor_kind(camera), Some(SensorKind::Camera));
+        assert!(e.lidar_model(camera).is_none() && e.lidar_model(lidar).is_some());
+    }
+}

@@ -158,3 +158,156 @@ impl MapSet {
         (total, fed)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fusion::{Engine, SensorModel};
+    use crate::geometry::{PlanarMount, Pose2};
+    use crate::grid::{GridGeometry, OccupancyParams, TileKey, TILE_CELLS};
+    use crate::measurement::{ObservationId, SensorKind};
+    use crate::sensor::{LaserScan, LidarModel, LidarParams, ReturnCounts};
+    use crate::sim::SimulatedRun;
+
+    fn grid() -> OccupancyGrid {
+        OccupancyGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default())
+    }
+
+    /// Every stored value of a map, as bits, with its tile key.
+    fn cells(g: &OccupancyGrid) -> Vec<(TileKey, Vec<Option<u32>>)> {
+        g.tiles().map(|(k, t)| (k, (0..TILE_CELLS).map(|o| t.log_odds(o).map(f32::to_bits)).collect())).collect()
+    }
+
+    fn same_map(a: &OccupancyGrid, b: &OccupancyGrid) -> bool {
+        a.observations() == b.observations() && a.known_box() == b.known_box() && cells(a) == cells(b)
+    }
+
+    /// Three sensors seeing the corridor at each instant: a front lidar, a second lidar
+    /// with other evidence and a shorter range, and a camera whose range evidence (every
+    /// fourth beam, weaker) comes from a model outside the engine.
+    struct Rig {
+        run: SimulatedRun,
+        front: LidarModel,
+        rear: LidarModel,
+        camera_model: LidarModel,
+    }
+
+    const FRONT: SensorId = SensorId(0);
+    const REAR: SensorId = SensorId(1);
+    const CAMERA: SensorId = SensorId(2);
+
+    impl Rig {
+        fn new() -> Self {
+            let p = LidarParams::default();
+            Rig {
+                run: SimulatedRun::document_corridor(),
+                front: LidarModel::new(p, PlanarMount::default()),
+                rear: LidarModel::new(
+                    LidarParams { p_occ: 0.7, p_free: 0.45, max_range: 3.0, ..p },
+                    PlanarMount::default(),
+                ),
+                camera_model: LidarModel::new(LidarParams { p_occ: 0.6, p_free: 0.48, ..p }, PlanarMount::default()),
+            }
+        }
+
+        fn engine(&self, maps: MapSet) -> Engine {
+            let mut e = Engine::with_maps(maps);
+            assert_eq!(e.add_lidar("front", self.front), FRONT);
+            assert_eq!(e.add_lidar("rear", self.rear), REAR);
+            assert_eq!(e.add_sensor("camera", SensorModel::External(SensorKind::Camera)), CAMERA);
+            e
+        }
+
+        fn camera_data(&self, scan: &LaserScan, pose: Pose2) -> RangeData {
+            let sparse = LaserScan {
+                stamp: scan.stamp,
+                angle_min: scan.angle_min,
+                angle_increment: scan.angle_increment * 4.0,
+                ranges: scan.ranges.iter().step_by(4).copied().collect(),
+            };
+            let mut out = RangeData::empty(CAMERA, self.camera_model.evidence());
+            self.camera_model.scan_to_range_data(CAMERA, &sparse, pose, &mut out, &mut ReturnCounts::default());
+            out
+        }
+
+        /// Feeds every observation of the sensors in `only`, in time order, each instant's
+        /// observations sharing the instant's id.
+        fn feed(&self, e: &mut Engine, only: &[SensorId]) {
+            for (i, (scan, pose)) in self.run.scans.iter().zip(&self.run.poses).enumerate() {
+                let id = ObservationId(i as u64);
+                if only.contains(&FRONT) {
+                    e.insert_scan_observed(FRONT, id, scan, f32::NAN, f32::NAN, |_| *pose).unwrap();
+                }
+                if only.contains(&REAR) {
+                    e.insert_scan_observed(REAR, id, scan, f32::NAN, f32::NAN, |_| *pose).unwrap();
+                }
+                if only.contains(&CAMERA) {
+                    e.insert_range_data_observed(id, &self.camera_data(scan, *pose)).unwrap();
+                }
+            }
+        }
+
+        /// A separate single-map run with only the sensors in `only`.
+        fn alone(&self, only: &[SensorId]) -> OccupancyGrid {
+            let mut e = self.engine(MapSet::new("alone", SensorSelection::All, grid()));
+            self.feed(&mut e, only);
+            e.into_grid()
+        }
+    }
+
+    #[test]
+    fn maps_of_one_pass_equal_separate_runs_bit_for_bit() {
+        let rig = Rig::new();
+        let maps = MapSet::new("M1", SensorSelection::Kinds(vec![SensorKind::Lidar]), grid())
+            .with("M2", SensorSelection::Kinds(vec![SensorKind::Camera]), grid())
+            .with("M3", SensorSelection::All, grid())
+            .with("rear+camera", SensorSelection::Sensors(vec![REAR, CAMERA]), grid());
+        let mut e = rig.engine(maps);
+        rig.feed(&mut e, &[FRONT, REAR, CAMERA]);
+        let maps = e.maps();
+        assert_eq!(maps.len(), 4);
+        let m1 = rig.alone(&[FRONT, REAR]);
+        let m2 = rig.alone(&[CAMERA]);
+        let m3 = rig.alone(&[FRONT, REAR, CAMERA]);
+        let rc = rig.alone(&[REAR, CAMERA]);
+        assert!(same_map(maps.by_name("M1").unwrap().grid(), &m1));
+        assert!(same_map(maps.by_name("M2").unwrap().grid(), &m2));
+        assert!(same_map(maps.by_name("M3").unwrap().grid(), &m3));
+        assert!(same_map(maps.get(3).unwrap().grid(), &rc));
+        // The maps do differ from one another, so the equalities above say something.
+        assert!(!same_map(&m1, &m3) && !same_map(&m2, &m3) && !same_map(&m1, &rc));
+        assert_eq!(maps.by_name("M1").unwrap().grid().observations(), 80);
+        assert_eq!(maps.by_name("M2").unwrap().grid().observations(), 40);
+        assert_eq!(maps.by_name("M3").unwrap().grid().observations(), 120);
+        // The engine's primary map is M1.
+        assert!(same_map(e.grid(), &m1));
+        // Per-sensor map insertions: front feeds M1 and M3, rear M1, M3 and rear+camera.
+        let s: Vec<_> = e.sensor_stats().cloned().collect();
+        assert_eq!((s[0].maps_fed, s[1].maps_fed, s[2].maps_fed), (80, 120, 120));
+        assert_eq!(s[2].kind, SensorKind::Camera);
+        // Per-map counters add up to the engine's.
+        let mut sum = crate::grid::InsertStats::default();
+        for m in maps.iter() {
+            sum.add(m.stats());
+        }
+        assert_eq!(&sum, &e.stats().insert);
+    }
+
+    #[test]
+    fn selection_by_kind_and_by_sensor() {
+        let lidar = SensorSelection::Kinds(vec![SensorKind::Lidar]);
+        assert!(lidar.includes(SensorId(7), SensorKind::Lidar));
+        assert!(!lidar.includes(SensorId(7), SensorKind::Camera));
+        let some = SensorSelection::Sensors(vec![SensorId(1)]);
+        assert!(some.includes(SensorId(1), SensorKind::Camera));
+        assert!(!some.includes(SensorId(2), SensorKind::Lidar));
+        assert!(SensorSelection::All.includes(SensorId(9), SensorKind::Camera));
+        let set = MapSet::new("a", SensorSelection::All, grid()).with("b", some, grid());
+        assert_eq!(set.len(), 2);
+        assert!(!set.is_empty());
+        assert_eq!(set.get(1).map(|m| m.name()), Some("b"));
+        assert!(set.get(2).is_none());
+        let names: Vec<_> = set.into_entries().into_iter().map(|m| m.name().to_string()).collect();
+        assert_eq!(names, ["a", "b"]);
+    }
+}
