@@ -102,6 +102,7 @@ impl InsertStats {
 /// calling `visitor` per cell by the two-pass rule of the module docs, and grows `known`
 /// to hold every cell reached. `obs` must differ from every earlier observation's number
 /// on these tiles (the mark is reset by a change of number).
+#[inline]
 pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
     tiles: &mut TileMap<T>,
     geometry: &GridGeometry,
@@ -141,11 +142,12 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
         let n = walk.len_cells();
         stats.rays += 1;
         stats.cell_visits += n;
-        let ray_box = CellBox {
-            min: CellIndex::new(ca.x.min(cb.x), ca.y.min(cb.y)),
-            max: CellIndex::new(ca.x.max(cb.x), ca.y.max(cb.y)),
-        };
-        known_box = Some(known_box.map_or(ray_box, |k| k.union(ray_box)));
+        // The union with the known box, written out so that it inlines into the loop.
+        let (lo, hi) = known_box.map_or((ca, ca), |k| (k.min, k.max));
+        known_box = Some(CellBox {
+            min: CellIndex::new(lo.x.min(ca.x).min(cb.x), lo.y.min(ca.y).min(cb.y)),
+            max: CellIndex::new(hi.x.max(ca.x).max(cb.x), hi.y.max(ca.y).max(cb.y)),
+        });
 
         // Walk inside one tile with a local offset; resolve a tile (one hash lookup)
         // only when the walk crosses into the next one.
