@@ -5,6 +5,11 @@
 //! rays in the map frame, the grid needs nothing else to know about the sensor. A 2D
 //! lidar scan, a CARMEN `FLASER` line, a depth-camera column or a simulated scan all
 //! become a [`RangeData`] before they touch the grid.
+//!
+//! Every observation is named by an [`ObservationId`] the caller supplies: a lidar scan
+//! and a camera frame of the same instant may carry the same id, so that the engine can
+//! tell they are one instant of the world (it counts such reuse today, so that their
+//! evidence can be counted once later) rather than two independent observations.
 
 use crate::geometry::Point2;
 use crate::time::Stamp;
@@ -12,6 +17,23 @@ use crate::time::Stamp;
 /// Identifies the sensor a measurement came from (an index into the engine's sensors).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 pub struct SensorId(pub u16);
+
+/// The kind of a sensor, which decides its model and which maps take its observations.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SensorKind {
+    /// A 2D range scanner ([`LidarModel`](crate::sensor::LidarModel)).
+    #[default]
+    Lidar,
+    /// A camera (its semantic model comes next; its range evidence uses [`RangeData`]).
+    Camera,
+}
+
+/// Names one observation of the world, supplied by the caller (a message sequence number,
+/// a frame counter, the stamp in nanoseconds). Observations of the same instant by
+/// different sensors may share one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default, serde::Serialize, serde::Deserialize)]
+pub struct ObservationId(pub u64);
 
 /// One ray in the map frame.
 #[derive(Clone, Copy, Debug, PartialEq)]

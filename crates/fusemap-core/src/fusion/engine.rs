@@ -1,18 +1,34 @@
-//! The engine that feeds time-ordered measurements from any number of sensors into the
-//! map's layers.
+//! The engine that feeds time-ordered observations from any number of sensors into one or
+//! several maps.
 //!
-//! Sensors are registered with their models; each measurement names its sensor. The
-//! engine keeps the per-sensor counters a user needs to judge a run (how many returns of
-//! each kind, how many scans), and refuses a measurement older than the last one it took:
-//! updates must be applied in time order for the result not to depend on who delivered
-//! first (the role of Cartographer's `OrderedMultiQueue`, which sorts upstream).
+//! Sensors are registered by kind with their models ([`SensorModel`]); each observation
+//! names its sensor and, on the `*_observed` paths, carries an [`ObservationId`] the
+//! caller supplies. The engine keeps per-sensor counters on every insert path (how many
+//! observations, returns of each kind, refusals, shared ids, what the insertions did), and
+//! refuses an observation older than the last one it took: updates must be applied in
+//! time order for the result not to depend on who delivered first (the role of
+//! Cartographer's `OrderedMultiQueue`, which sorts upstream).
+//!
+//! **One pass, several maps.** The engine writes a [`MapSet`]: each observation is turned
+//! into rays once by its sensor's model and inserted into every map whose
+//! [`SensorSelection`](super::SensorSelection) takes its sensor. [`Engine::new`] is the
+//! single map taking every sensor.
+//!
+//! **Shared observation ids.** Two observations of the same instant (equal stamps) that
+//! carry the same id — a lidar scan and a camera frame taken together — are recorded in
+//! the counters ([`EngineStats::shared_ids`], [`SensorStats::shared_ids`]). Today each is
+//! still inserted as its own observation; the id is what will let a later version count
+//! them once. Ids are compared within one instant only, so the memory this takes is
+//! bounded by the observations of one stamp.
 
+use super::sensors::SensorSlot;
+use super::{MapSet, SensorModel, SensorSelection, SensorStats};
 use crate::geometry::Pose2;
 use crate::grid::{InsertStats, OccupancyGrid};
-use crate::measurement::{RangeData, SensorId};
-use crate::sensor::{LaserScan, LidarModel, ReturnCounts};
+use crate::measurement::{Evidence, ObservationId, RangeData, SensorId, SensorKind};
+use crate::sensor::{LaserScan, LidarModel};
 use crate::time::Stamp;
-use serde::Serialize;
+use std::collections::HashSet;
 
 /// Why the engine refused a measurement.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -30,17 +46,15 @@ pub enum EngineError {
         /// The newest stamp applied so far.
         last: Stamp,
     },
-}
-
-/// Per-sensor counters.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct SensorStats {
-    /// The sensor's name (its frame id).
-    pub name: String,
-    /// Scans inserted.
-    pub scans: u64,
-    /// Beams by kind of return.
-    pub returns: ReturnCounts,
+    /// The sensor's registered model cannot read this kind of measurement (a lidar scan
+    /// for a sensor whose model runs outside the engine).
+    #[error("sensor {sensor:?} is a {kind:?} sensor without a lidar model in the engine")]
+    WrongModel {
+        /// The sensor.
+        sensor: SensorId,
+        /// Its registered kind.
+        kind: SensorKind,
+    },
 }
 
 /// Counters of a whole run.
@@ -50,52 +64,77 @@ pub struct EngineStats {
     pub measurements: u64,
     /// Measurements refused for being out of time order.
     pub out_of_order: u64,
-    /// What the insertions did.
+    /// Measurements refused because their sensor was not registered (or its model cannot
+    /// read them).
+    pub unknown_sensor: u64,
+    /// Measurements whose observation id an earlier measurement of the same instant
+    /// already carried.
+    pub shared_ids: u64,
+    /// What the insertions did, summed over the maps that took them (with one map, that
+    /// map's counts).
     pub insert: InsertStats,
-}
-
-struct LidarSlot {
-    model: LidarModel,
-    stats: SensorStats,
 }
 
 /// The fusion engine.
 pub struct Engine {
-    grid: OccupancyGrid,
-    lidars: Vec<LidarSlot>,
+    maps: MapSet,
+    sensors: Vec<SensorSlot>,
     scratch: RangeData,
     last: Option<Stamp>,
+    /// Observation ids applied at stamp `last`.
+    ids_at_last: HashSet<ObservationId>,
     stats: EngineStats,
 }
 
 impl Engine {
-    /// An engine writing into `grid`.
+    /// An engine writing into `grid`, which takes every sensor.
     pub fn new(grid: OccupancyGrid) -> Self {
-        let evidence = crate::measurement::Evidence { p_hit: 0.5, p_miss: 0.5 };
+        Self::with_maps(MapSet::new("map", SensorSelection::All, grid))
+    }
+
+    /// An engine writing into several maps in one pass (see the module docs).
+    pub fn with_maps(maps: MapSet) -> Self {
+        let evidence = Evidence { p_hit: 0.5, p_miss: 0.5 };
         Self {
-            grid,
-            lidars: Vec::new(),
+            maps,
+            sensors: Vec::new(),
             scratch: RangeData::empty(SensorId(0), evidence),
             last: None,
+            ids_at_last: HashSet::new(),
             stats: EngineStats::default(),
         }
     }
 
-    /// Registers a lidar and returns its id.
-    pub fn add_lidar(&mut self, name: impl Into<String>, model: LidarModel) -> SensorId {
-        let id = SensorId(self.lidars.len() as u16);
-        self.lidars.push(LidarSlot { model, stats: SensorStats { name: name.into(), ..Default::default() } });
+    /// Registers a sensor with its model and returns its id.
+    pub fn add_sensor(&mut self, name: impl Into<String>, model: SensorModel) -> SensorId {
+        let id = SensorId(self.sensors.len() as u16);
+        self.sensors.push(SensorSlot::new(name.into(), model));
         id
     }
 
-    /// The map.
-    pub fn grid(&self) -> &OccupancyGrid {
-        &self.grid
+    /// Registers a lidar and returns its id.
+    pub fn add_lidar(&mut self, name: impl Into<String>, model: LidarModel) -> SensorId {
+        self.add_sensor(name, SensorModel::Lidar(model))
     }
 
-    /// Consumes the engine, returning the map.
+    /// The primary map.
+    pub fn grid(&self) -> &OccupancyGrid {
+        self.maps.primary().grid()
+    }
+
+    /// Consumes the engine, returning the primary map.
     pub fn into_grid(self) -> OccupancyGrid {
-        self.grid
+        self.maps.into_primary()
+    }
+
+    /// Every map the engine writes, primary first.
+    pub fn maps(&self) -> &MapSet {
+        &self.maps
+    }
+
+    /// Consumes the engine, returning its maps.
+    pub fn into_maps(self) -> MapSet {
+        self.maps
     }
 
     /// Run counters.
@@ -105,17 +144,46 @@ impl Engine {
 
     /// Per-sensor counters, in registration order.
     pub fn sensor_stats(&self) -> impl Iterator<Item = &SensorStats> {
-        self.lidars.iter().map(|s| &s.stats)
+        self.sensors.iter().map(|s| &s.stats)
     }
 
-    fn check_order(&mut self, sensor: SensorId, stamp: Stamp) -> Result<(), EngineError> {
+    /// The model registered for `sensor`, if it is a lidar.
+    pub fn lidar_model(&self, sensor: SensorId) -> Option<&LidarModel> {
+        match self.sensors.get(sensor.0 as usize).map(|s| &s.model) {
+            Some(SensorModel::Lidar(m)) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// The kind of a registered sensor.
+    pub fn sensor_kind(&self, sensor: SensorId) -> Option<SensorKind> {
+        self.sensors.get(sensor.0 as usize).map(|s| s.model.kind())
+    }
+
+    /// Checks that `sensor` is registered and `stamp` is not older than the last applied,
+    /// and records the observation id. Counts every refusal.
+    fn admit(&mut self, sensor: SensorId, stamp: Stamp, id: Option<ObservationId>) -> Result<(), EngineError> {
+        let Some(slot) = self.sensors.get_mut(sensor.0 as usize) else {
+            self.stats.unknown_sensor += 1;
+            return Err(EngineError::UnknownSensor(sensor));
+        };
         if let Some(last) = self.last {
             if stamp < last {
                 self.stats.out_of_order += 1;
+                slot.stats.out_of_order += 1;
                 return Err(EngineError::OutOfOrder { sensor, stamp, last });
+            }
+            if stamp > last {
+                self.ids_at_last.clear();
             }
         }
         self.last = Some(stamp);
+        if let Some(id) = id {
+            if !self.ids_at_last.insert(id) {
+                self.stats.shared_ids += 1;
+                slot.stats.shared_ids += 1;
+            }
+        }
         Ok(())
     }
 
@@ -150,34 +218,88 @@ impl Engine {
         range_max: f32,
         pose_of_beam: impl FnMut(usize) -> Pose2,
     ) -> Result<InsertStats, EngineError> {
-        if self.lidars.get(sensor.0 as usize).is_none() {
-            return Err(EngineError::UnknownSensor(sensor));
-        }
-        self.check_order(sensor, scan.stamp)?;
-        let slot = &mut self.lidars[sensor.0 as usize];
-        let model = slot.model.limited_to(range_min, range_max);
+        self.scan(sensor, None, scan, range_min, range_max, pose_of_beam)
+    }
+
+    /// Inserts a lidar scan named by the caller's observation id, with the sensor's stated
+    /// range limits (NaN: not stated) and the robot pose per beam.
+    pub fn insert_scan_observed(
+        &mut self,
+        sensor: SensorId,
+        id: ObservationId,
+        scan: &LaserScan,
+        range_min: f32,
+        range_max: f32,
+        pose_of_beam: impl FnMut(usize) -> Pose2,
+    ) -> Result<InsertStats, EngineError> {
+        self.scan(sensor, Some(id), scan, range_min, range_max, pose_of_beam)
+    }
+
+    fn scan(
+        &mut self,
+        sensor: SensorId,
+        id: Option<ObservationId>,
+        scan: &LaserScan,
+        range_min: f32,
+        range_max: f32,
+        pose_of_beam: impl FnMut(usize) -> Pose2,
+    ) -> Result<InsertStats, EngineError> {
+        let model = match self.sensors.get(sensor.0 as usize).map(|s| s.model) {
+            Some(SensorModel::Lidar(m)) => m,
+            Some(other) => {
+                self.stats.unknown_sensor += 1;
+                return Err(EngineError::WrongModel { sensor, kind: other.kind() });
+            }
+            None => {
+                self.stats.unknown_sensor += 1;
+                return Err(EngineError::UnknownSensor(sensor));
+            }
+        };
+        self.admit(sensor, scan.stamp, id)?;
+        let slot = &mut self.sensors[sensor.0 as usize];
+        let model = model.limited_to(range_min, range_max);
         model.scan_to_range_data_with(sensor, scan, pose_of_beam, &mut self.scratch, &mut slot.stats.returns);
-        slot.stats.scans += 1;
-        Ok(apply(&mut self.grid, &mut self.stats, &self.scratch))
+        let (maps, stats, slot) = (&mut self.maps, &mut self.stats, &mut slot.stats);
+        Ok(apply(maps, stats, slot, SensorKind::Lidar, &self.scratch))
     }
 
-    /// The model registered for `sensor`.
-    pub fn lidar_model(&self, sensor: SensorId) -> Option<&LidarModel> {
-        self.lidars.get(sensor.0 as usize).map(|s| &s.model)
-    }
-
-    /// Inserts range data a sensor model outside the engine produced.
+    /// Inserts range data a sensor model outside the engine produced. Its sensor must be
+    /// registered (its kind decides which maps take it).
     pub fn insert_range_data(&mut self, data: &RangeData) -> Result<InsertStats, EngineError> {
-        self.check_order(data.sensor, data.stamp)?;
-        Ok(apply(&mut self.grid, &mut self.stats, data))
+        self.range_data(None, data)
+    }
+
+    /// Inserts range data named by the caller's observation id.
+    pub fn insert_range_data_observed(
+        &mut self,
+        id: ObservationId,
+        data: &RangeData,
+    ) -> Result<InsertStats, EngineError> {
+        self.range_data(Some(id), data)
+    }
+
+    fn range_data(&mut self, id: Option<ObservationId>, data: &RangeData) -> Result<InsertStats, EngineError> {
+        self.admit(data.sensor, data.stamp, id)?;
+        let slot = &mut self.sensors[data.sensor.0 as usize];
+        let kind = slot.model.kind();
+        Ok(apply(&mut self.maps, &mut self.stats, &mut slot.stats, kind, data))
     }
 }
 
-/// Inserts one observation into the grid and counts it.
-fn apply(grid: &mut OccupancyGrid, stats: &mut EngineStats, data: &RangeData) -> InsertStats {
-    let s = grid.insert(data);
+/// Inserts one observation into every map that takes it and counts it.
+fn apply(
+    maps: &mut MapSet,
+    stats: &mut EngineStats,
+    sensor: &mut SensorStats,
+    kind: SensorKind,
+    data: &RangeData,
+) -> InsertStats {
+    let (s, fed) = maps.insert(kind, data);
     stats.measurements += 1;
     stats.insert.add(&s);
+    sensor.scans += 1;
+    sensor.maps_fed += fed;
+    sensor.insert.add(&s);
     s
 }
 
@@ -216,5 +338,95 @@ mod tests {
         assert_eq!(s[1].scans, 1);
         assert_eq!(s[1].name, "rear");
         assert!(e.insert_scan(SensorId(9), &scan(5), Pose2::IDENTITY).is_err());
+    }
+}
+
+#[cfg(test)]
+mod observed_tests {
+    use super::*;
+    use crate::geometry::{PlanarMount, Point2};
+    use crate::grid::{GridGeometry, OccupancyParams};
+    use crate::measurement::Ray;
+    use crate::sensor::LidarParams;
+
+    fn engine() -> (Engine, SensorId, SensorId) {
+        let grid = OccupancyGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
+        let mut e = Engine::new(grid);
+        let lidar = e.add_lidar("laser", LidarModel::new(LidarParams::default(), PlanarMount::default()));
+        let camera = e.add_sensor("camera", SensorModel::External(SensorKind::Camera));
+        (e, lidar, camera)
+    }
+
+    fn scan(t: i64) -> LaserScan {
+        LaserScan { stamp: Stamp(t), angle_min: 0.0, angle_increment: 0.1, ranges: vec![1.0, 2.0, f32::NAN] }
+    }
+
+    fn frame(sensor: SensorId, t: i64) -> RangeData {
+        let rays = vec![Ray { origin: Point2::new(0.0, 0.0), end: Point2::new(0.0, 1.0), hit: true }];
+        RangeData { stamp: Stamp(t), sensor, rays, evidence: Evidence { p_hit: 0.7, p_miss: 0.45 } }
+    }
+
+    #[test]
+    fn an_id_shared_by_two_sensors_of_one_instant_is_counted() {
+        let (mut e, lidar, camera) = engine();
+        let p = |_| Pose2::IDENTITY;
+        e.insert_scan_observed(lidar, ObservationId(1), &scan(10), f32::NAN, f32::NAN, p).unwrap();
+        e.insert_range_data_observed(ObservationId(1), &frame(camera, 10)).unwrap();
+        assert_eq!(e.stats().shared_ids, 1);
+        // Another id at the same instant is not shared; the same id at a later instant is
+        // a new instant's observation.
+        e.insert_range_data_observed(ObservationId(2), &frame(camera, 10)).unwrap();
+        e.insert_scan_observed(lidar, ObservationId(1), &scan(11), f32::NAN, f32::NAN, p).unwrap();
+        assert_eq!(e.stats().shared_ids, 1);
+        e.insert_range_data_observed(ObservationId(1), &frame(camera, 11)).unwrap();
+        // Observations without an id never count as shared.
+        e.insert_scan(lidar, &scan(11), Pose2::IDENTITY).unwrap();
+        e.insert_range_data(&frame(camera, 11)).unwrap();
+        assert_eq!(e.stats().shared_ids, 2);
+        let s: Vec<_> = e.sensor_stats().cloned().collect();
+        assert_eq!((s[0].shared_ids, s[1].shared_ids), (0, 2));
+        // Both were still inserted as observations of their own.
+        assert_eq!(e.stats().measurements, 7);
+        assert_eq!(e.grid().observations(), 7);
+    }
+
+    #[test]
+    fn per_sensor_counters_on_every_insert_path() {
+        let (mut e, lidar, camera) = engine();
+        let p = |_| Pose2::IDENTITY;
+        e.insert_scan(lidar, &scan(1), Pose2::IDENTITY).unwrap();
+        e.insert_scan_with(lidar, &scan(2), p).unwrap();
+        e.insert_scan_limited(lidar, &scan(3), 0.0, 1.5, p).unwrap();
+        e.insert_scan_observed(lidar, ObservationId(4), &scan(4), f32::NAN, f32::NAN, p).unwrap();
+        e.insert_range_data(&frame(camera, 5)).unwrap();
+        e.insert_range_data_observed(ObservationId(6), &frame(camera, 6)).unwrap();
+        // Refusals: out of order on both paths, and a camera has no lidar model.
+        assert!(matches!(e.insert_scan(lidar, &scan(0), Pose2::IDENTITY), Err(EngineError::OutOfOrder { .. })));
+        assert!(matches!(e.insert_range_data(&frame(camera, 0)), Err(EngineError::OutOfOrder { .. })));
+        assert!(matches!(e.insert_scan(camera, &scan(9), Pose2::IDENTITY), Err(EngineError::WrongModel { .. })));
+        assert!(matches!(e.insert_range_data(&frame(SensorId(5), 9)), Err(EngineError::UnknownSensor(_))));
+        let s: Vec<_> = e.sensor_stats().cloned().collect();
+        assert_eq!((s[0].scans, s[1].scans), (4, 2));
+        assert_eq!((s[0].out_of_order, s[1].out_of_order), (1, 1));
+        assert_eq!((s[0].maps_fed, s[1].maps_fed), (4, 2));
+        // Four scans of three beams: two valid each, but range 2.0 is a no-return under
+        // the stated range_max of 1.5; one NaN each.
+        assert_eq!(s[0].returns.valid, 7);
+        assert_eq!(s[0].returns.no_return, 1);
+        assert_eq!(s[0].returns.nan, 4);
+        assert_eq!(s[0].insert.rays, 7);
+        assert_eq!(s[1].insert.rays, 2);
+        assert_eq!(s[1].insert.hit_updates, 2);
+        assert_eq!(s[1].kind, SensorKind::Camera);
+        // The sensors' counters add up to the engine's.
+        let mut sum = InsertStats::default();
+        sum.add(&s[0].insert);
+        sum.add(&s[1].insert);
+        assert_eq!(sum, e.stats().insert);
+        assert_eq!(e.stats().measurements, 6);
+        assert_eq!(e.stats().out_of_order, 2);
+        assert_eq!(e.stats().unknown_sensor, 2);
+        assert_eq!(e.sensor_kind(camera), Some(SensorKind::Camera));
+        assert!(e.lidar_model(camera).is_none() && e.lidar_model(lidar).is_some());
     }
 }

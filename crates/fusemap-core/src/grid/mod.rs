@@ -1,17 +1,24 @@
-//! Grids: geometry, log-odds cells, sparse tiles, exact ray traversal.
+//! Grids: geometry, log-odds cells, sparse tiles of layers, exact ray traversal, and the
+//! walk of an observation's rays that every layer shares.
 
 mod geometry;
+mod layers;
 pub mod logodds;
+mod mark;
 mod occupancy;
 mod raster;
 mod raycast;
 mod tiles;
+mod walk;
 
 pub use geometry::{
     CellBox, CellIndex, GeometryError, GridGeometry, TileKey, TILE_CELLS, TILE_MASK, TILE_SHIFT, TILE_SIZE,
 };
+pub use layers::{ExtraLayers, MapTile, MarkedTile};
 pub use logodds::{LogOddsTable, OccupancyParams, Ternary};
-pub use occupancy::{InsertStats, OccupancyGrid, OccupancyTile, MAX_RAY_CELLS};
-pub use raster::Raster;
+pub use mark::UpdateMark;
+pub use occupancy::{LayeredGrid, OccupancyGrid, OccupancyTile, OccupancyUpdate};
+pub use raster::{CellRaster, Raster};
 pub use raycast::{CellRay, Step};
 pub use tiles::{Tile, TileKeyHasher, TileMap};
+pub use walk::{walk_observation, CellVisitor, InsertStats, MAX_RAY_CELLS};

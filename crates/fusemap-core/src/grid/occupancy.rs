@@ -1,5 +1,5 @@
-//! The occupancy layer: log-odds cells in sparse tiles, and the insertion of one
-//! observation's rays with the per-scan rules of OctoMap and Cartographer.
+//! The map: a set of layers on one tile key space, with the occupancy layer always
+//! present, and the insertion of one observation's rays.
 //!
 //! **Per-observation rules** (OctoMap `computeUpdate`: "occupied nodes have a preference
 //! over free ones"; Cartographer `ProbabilityGridRangeDataInserter2D`: hits first, then
@@ -8,115 +8,73 @@
 //!    crossing the same cell near the sensor are one piece of evidence, not fifty
 //!    (the design document's "do not count correlated evidence twice", inside a scan);
 //! 2. a cell that ends any hit ray of the observation gets the hit update, never the miss
-//!    update of another ray that passes through it. Hits are applied first and mark their
-//!    cells, so the walks of pass two skip them.
+//!    update of another ray that passes through it.
 //!
-//! The "updated in this observation" mark is a per-tile bitset tagged with the 64-bit
-//! number of the observation that last wrote it: a tile first touched by a newer
-//! observation clears its bitset. The tag cannot wrap (2^64 observations), unlike the
-//! 4-bit counter that made Bonxai drop 7.6 % of its updates (Bonxai PR #61).
+//! The walk that enforces both is [`walk_observation`](super::walk_observation); this
+//! module supplies what the occupancy layer does per cell (a clamped log-odds update,
+//! Thrun et al., *Probabilistic Robotics*, §9.2) and the map's bookkeeping. The tile
+//! layout — occupancy block, shared update mark, extra layers — is in
+//! [`MapTile`](super::MapTile).
 
 use super::{
-    CellBox, CellIndex, CellRay, GridGeometry, LogOddsTable, OccupancyParams, Raster, Step, Ternary, Tile, TileKey,
-    TileMap, TILE_CELLS, TILE_MASK, TILE_SHIFT, TILE_SIZE,
+    walk_observation, CellBox, CellIndex, CellRaster, CellVisitor, ExtraLayers, GridGeometry, InsertStats,
+    LogOddsTable, MapTile, OccupancyParams, Raster, Ternary, TileKey, TileMap, TILE_SIZE,
 };
+#[cfg(test)]
+use super::{CellRay, TILE_CELLS};
 use crate::grid::logodds::probability;
 use crate::measurement::RangeData;
 
-/// Longest ray walked, in cells (|Δi| + |Δj|). Longer rays come from corrupt data (a
-/// range of 1e9 m) and are rejected and counted instead of walking for minutes.
-pub const MAX_RAY_CELLS: u64 = 1 << 22;
+/// One tile of a map with occupancy only.
+pub type OccupancyTile = MapTile<()>;
 
-/// One tile of the occupancy layer.
-pub struct OccupancyTile {
-    /// Log-odds per cell, row-major; NaN for a cell never observed.
-    log_odds: [f32; TILE_CELLS],
-    /// The observation that `updated` belongs to.
-    observation: u64,
-    /// Cells already updated by observation `observation`, one bit per cell.
-    updated: [u64; TILE_CELLS / 64],
-}
+/// A probabilistic occupancy grid with no other layer: log-odds cells in sparse tiles.
+pub type OccupancyGrid = LayeredGrid<()>;
 
-impl Tile for OccupancyTile {
-    fn empty() -> Self {
-        Self { log_odds: [f32::NAN; TILE_CELLS], observation: 0, updated: [0; TILE_CELLS / 64] }
-    }
-}
-
-impl OccupancyTile {
-    /// The stored log-odds of the cell at `offset`, `None` if never observed.
-    #[inline]
-    pub fn log_odds(&self, offset: usize) -> Option<f32> {
-        let v = self.log_odds[offset];
-        (!v.is_nan()).then_some(v)
-    }
-
-    /// Starts observation `obs` on this tile if it is not the current one.
-    #[inline(always)]
-    fn begin(&mut self, obs: u64) {
-        if self.observation != obs {
-            self.observation = obs;
-            self.updated = [0; TILE_CELLS / 64];
-        }
-    }
-
-    /// Applies `delta` to the cell at `offset` unless this observation already updated it.
-    /// Returns whether it did.
-    #[inline(always)]
-    fn update_once(&mut self, offset: usize, delta: f32, table: &LogOddsTable) -> bool {
-        // Branch-free: whether a cell was already updated in this observation follows no
-        // pattern a branch predictor could learn, so the update is always computed and
-        // the old value kept by a select.
-        let word = &mut self.updated[offset >> 6];
-        let bit = 1u64 << (offset & 63);
-        let fresh = *word & bit == 0;
-        *word |= bit;
-        let v = self.log_odds[offset];
-        let base = if v.is_nan() { table.prior } else { v };
-        let updated = table.update(base, delta);
-        self.log_odds[offset] = if fresh { updated } else { v };
-        fresh
-    }
-}
-
-/// What one insertion did.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct InsertStats {
-    /// Rays walked.
-    pub rays: u64,
-    /// Rays refused: a non-finite point, a cell beyond the index range, or longer than
-    /// [`MAX_RAY_CELLS`].
-    pub rays_rejected: u64,
-    /// Cells visited by the walks, counting a cell again for every ray that crosses it.
-    pub cell_visits: u64,
-    /// Cells updated as occupied (once per observation).
-    pub hit_updates: u64,
-    /// Cells updated as free (once per observation).
-    pub miss_updates: u64,
-}
-
-impl InsertStats {
-    /// Adds another insertion's counts.
-    pub fn add(&mut self, o: &InsertStats) {
-        self.rays += o.rays;
-        self.rays_rejected += o.rays_rejected;
-        self.cell_visits += o.cell_visits;
-        self.hit_updates += o.hit_updates;
-        self.miss_updates += o.miss_updates;
-    }
-}
-
-/// A probabilistic occupancy grid: log-odds cells in sparse tiles.
-pub struct OccupancyGrid {
+/// A map: the occupancy layer and the extra layers `L` on one set of sparse tiles.
+///
+/// The occupancy layer is the one every range observation writes ([`insert`](Self::insert));
+/// extra layers are written by their own [`CellVisitor`] in the same walk
+/// ([`insert_with`](Self::insert_with)), so they see exactly the cells, and the
+/// once-per-observation marks, that the occupancy layer sees.
+pub struct LayeredGrid<L = ()> {
     geometry: GridGeometry,
     params: OccupancyParams,
     table: LogOddsTable,
-    tiles: TileMap<OccupancyTile>,
+    tiles: TileMap<MapTile<L>>,
     observations: u64,
     known: Option<CellBox>,
 }
 
-impl OccupancyGrid {
+/// The occupancy layer's per-cell update: the hit or the miss increment, kept on fresh
+/// visits only.
+#[derive(Clone, Copy, Debug)]
+pub struct OccupancyUpdate {
+    table: LogOddsTable,
+    d_hit: f32,
+    d_miss: f32,
+}
+
+impl OccupancyUpdate {
+    /// The update for evidence `(p_hit, p_miss)` against the layer's `table`.
+    pub fn new(table: LogOddsTable, evidence: crate::measurement::Evidence) -> Self {
+        Self { table, d_hit: table.increment(evidence.p_hit), d_miss: table.increment(evidence.p_miss) }
+    }
+}
+
+impl<L> CellVisitor<MapTile<L>> for OccupancyUpdate {
+    #[inline(always)]
+    fn hit(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
+        tile.update_log_odds(offset, self.d_hit, &self.table, fresh);
+    }
+
+    #[inline(always)]
+    fn pass(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
+        tile.update_log_odds(offset, self.d_miss, &self.table, fresh);
+    }
+}
+
+impl<L: ExtraLayers> LayeredGrid<L> {
     /// An empty grid. `params` must be valid (see `config::validate`).
     pub fn new(geometry: GridGeometry, params: OccupancyParams) -> Self {
         Self {
@@ -154,7 +112,8 @@ impl OccupancyGrid {
         self.tiles.len()
     }
 
-    /// Bytes held by tiles.
+    /// Bytes held by tiles (the blocks inline in a tile; an extra layer's boxed blocks are
+    /// not counted).
     pub fn tile_bytes(&self) -> usize {
         self.tiles.tile_bytes()
     }
@@ -162,6 +121,12 @@ impl OccupancyGrid {
     /// The bounding box of every cell any ray has reached, `None` before the first.
     pub fn known_box(&self) -> Option<CellBox> {
         self.known
+    }
+
+    /// The tile holding `cell`, if allocated, and the cell's offset in it (for reading the
+    /// extra layers).
+    pub fn tile_of(&self, cell: CellIndex) -> Option<(&MapTile<L>, usize)> {
+        self.tiles.get_cell(cell)
     }
 
     /// The stored log-odds of a cell, `None` if never observed.
@@ -182,87 +147,31 @@ impl OccupancyGrid {
         }
     }
 
-    /// Inserts one observation (see the module docs for the per-observation rules).
+    /// Inserts one observation into the occupancy layer (see the module docs for the
+    /// per-observation rules).
     pub fn insert(&mut self, data: &RangeData) -> InsertStats {
-        self.observations += 1;
-        let obs = self.observations;
-        let table = self.table;
-        let d_hit = table.increment(data.evidence.p_hit);
-        let d_miss = table.increment(data.evidence.p_miss);
-        let (ox, oy) = (self.geometry.origin().x, self.geometry.origin().y);
-        let inv = 1.0 / self.geometry.resolution();
-        let units = |p: crate::geometry::Point2| ((p.x - ox) * inv, (p.y - oy) * inv);
-        let mut stats = InsertStats::default();
-        let tiles = &mut self.tiles;
-
-        // Pass 1: hits. Each end cell gets the hit update once and is marked, so the
-        // walks of pass 2 leave it alone.
-        for ray in data.rays.iter().filter(|r| r.hit) {
-            let Some((_, _, _, c)) = checked(units(ray.origin), units(ray.end)) else {
-                continue;
-            };
-            let tile = tiles.get_or_insert(c.tile());
-            tile.begin(obs);
-            stats.hit_updates += tile.update_once(c.offset_in_tile(), d_hit, &table) as u64;
-        }
-
-        // Pass 2: walk every ray from its origin to its end, free evidence on every
-        // cell not yet updated in this observation.
-        let mut known = self.known;
-        for ray in &data.rays {
-            let Some((a, b, ca, cb)) = checked(units(ray.origin), units(ray.end)) else {
-                stats.rays_rejected += 1;
-                continue;
-            };
-            let mut walk = CellRay::new(a, b);
-            let n = walk.len_cells();
-            stats.rays += 1;
-            stats.cell_visits += n;
-            let ray_box = CellBox {
-                min: CellIndex::new(ca.x.min(cb.x), ca.y.min(cb.y)),
-                max: CellIndex::new(ca.x.max(cb.x), ca.y.max(cb.y)),
-            };
-            known = Some(known.map_or(ray_box, |k| k.union(ray_box)));
-
-            // Walk inside one tile with a local offset; resolve a tile (one hash
-            // lookup) only when the walk crosses into the next one.
-            let (sx, sy) = (walk.step_x(), walk.step_y() * TILE_SIZE as i64);
-            let mut tile = tiles.get_or_insert(ca.tile());
-            tile.begin(obs);
-            let (mut lx, mut ly) = (ca.x & TILE_MASK, ca.y & TILE_MASK);
-            let mut offset = ca.offset_in_tile() as i64;
-            loop {
-                stats.miss_updates += tile.update_once(offset as usize, d_miss, &table) as u64;
-                match walk.step() {
-                    Step::Done => break,
-                    Step::X => {
-                        lx += sx;
-                        offset += sx;
-                    }
-                    Step::Y => {
-                        ly += sy >> TILE_SHIFT;
-                        offset += sy;
-                    }
-                }
-                if (lx | ly) & !TILE_MASK != 0 {
-                    // Left the tile: `lx` or `ly` is -1 or TILE_SIZE.
-                    let c = walk.cell();
-                    tile = tiles.get_or_insert(c.tile());
-                    tile.begin(obs);
-                    (lx, ly) = (c.x & TILE_MASK, c.y & TILE_MASK);
-                    offset = c.offset_in_tile() as i64;
-                }
-            }
-        }
-        self.known = known;
-        stats
+        self.insert_with(data, &mut ())
     }
 
-    /// Copies the cells of `area` into a dense raster (row 0 = lowest y). Unobserved
-    /// cells hold the prior's log-odds and are marked unknown.
-    pub fn raster(&self, area: CellBox) -> Raster {
+    /// Inserts one observation into the occupancy layer and, in the same walk, into the
+    /// extra layers `layers` writes (occupancy first on each cell, then `layers`).
+    pub fn insert_with<V: CellVisitor<MapTile<L>>>(&mut self, data: &RangeData, layers: &mut V) -> InsertStats {
+        self.observations += 1;
+        let mut visitor = (OccupancyUpdate::new(self.table, data.evidence), layers);
+        walk_observation(&mut self.tiles, &self.geometry, self.observations, &data.rays, &mut self.known, &mut visitor)
+    }
+
+    /// A dense copy of one layer's cells over `area` (row 0 = lowest y): `cell` reads a
+    /// cell from its tile and offset, `None` meaning "never observed", shown as `fill`.
+    /// This is the raster view every layer gives its exporters.
+    pub fn cell_raster<T: Clone>(
+        &self,
+        area: CellBox,
+        fill: T,
+        cell: impl Fn(&MapTile<L>, usize) -> Option<T>,
+    ) -> CellRaster<T> {
         let (w, h) = (area.width(), area.height());
-        let mut log_odds = vec![self.table.prior; w * h];
+        let mut cells = vec![fill; w * h];
         let mut known = vec![false; w * h];
         for (key, tile) in self.tiles.iter() {
             let first = key.first_cell();
@@ -275,55 +184,50 @@ impl OccupancyGrid {
             };
             for y in ov.min.y..=ov.max.y {
                 for x in ov.min.x..=ov.max.x {
-                    let c = CellIndex::new(x, y);
-                    if let Some(l) = tile.log_odds(c.offset_in_tile()) {
+                    if let Some(v) = cell(tile, CellIndex::new(x, y).offset_in_tile()) {
                         let i = (y - area.min.y) as usize * w + (x - area.min.x) as usize;
-                        log_odds[i] = l;
+                        cells[i] = v;
                         known[i] = true;
                     }
                 }
             }
         }
-        Raster {
+        CellRaster {
             width: w,
             height: h,
             resolution: self.geometry.resolution(),
             origin: self.geometry.cell_corner(area.min),
             first_cell: area.min,
-            log_odds,
+            cells,
             known,
+        }
+    }
+
+    /// The occupancy layer's cells of `area` as a raster (row 0 = lowest y). Unobserved
+    /// cells hold the prior's log-odds and are marked unknown.
+    pub fn raster(&self, area: CellBox) -> Raster {
+        let r = self.cell_raster(area, self.table.prior, |t, o| t.log_odds(o));
+        Raster {
+            width: r.width,
+            height: r.height,
+            resolution: r.resolution,
+            origin: r.origin,
+            first_cell: r.first_cell,
+            log_odds: r.cells,
+            known: r.known,
             params: self.params,
         }
     }
 
-    /// The raster of the known bounding box, `None` while nothing is known.
+    /// The occupancy raster of the known bounding box, `None` while nothing is known.
     pub fn known_raster(&self) -> Option<Raster> {
         self.known.map(|b| self.raster(b))
     }
 
     /// Iterates over allocated tiles (for exporters that stream tile by tile).
-    pub fn tiles(&self) -> impl Iterator<Item = (TileKey, &OccupancyTile)> {
+    pub fn tiles(&self) -> impl Iterator<Item = (TileKey, &MapTile<L>)> {
         self.tiles.iter()
     }
-}
-
-#[inline(always)]
-fn cell_of_units((u, v): (f64, f64)) -> Option<CellIndex> {
-    const LIMIT: f64 = 4.611_686_018_427_388e18;
-    let (fx, fy) = (u.floor(), v.floor());
-    // `abs() < LIMIT` is false for NaN and ±inf too.
-    (fx.abs() < LIMIT && fy.abs() < LIMIT).then(|| CellIndex::new(fx as i64, fy as i64))
-}
-
-/// The cells of a ray's two ends, or `None` when the ray must not be walked (non-finite,
-/// beyond the index range, or longer than [`MAX_RAY_CELLS`]).
-#[inline(always)]
-#[allow(clippy::type_complexity)]
-fn checked(a: (f64, f64), b: (f64, f64)) -> Option<((f64, f64), (f64, f64), CellIndex, CellIndex)> {
-    let ca = cell_of_units(a)?;
-    let cb = cell_of_units(b)?;
-    let n = ca.x.abs_diff(cb.x) + ca.y.abs_diff(cb.y);
-    (n <= MAX_RAY_CELLS).then_some((a, b, ca, cb))
 }
 
 fn intersect(a: CellBox, b: CellBox) -> Option<CellBox> {

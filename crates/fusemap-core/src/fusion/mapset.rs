@@ -1,0 +1,313 @@
+//! Several maps fed by one pass over the data, each from its own subset of sensors.
+//!
+//! The validation of the design document compares leave-one-sensor-out maps built from
+//! the same run: M1 = lidar + odometry, M2 = camera + odometry, M3 = everything. Building
+//! them in one pass converts each observation into rays once (the sensor model runs once)
+//! and inserts it into every map whose [`SensorSelection`] includes its sensor. Each map
+//! keeps its own tiles and update marks, so a map built this way is bit for bit the map
+//! a separate run with only its sensors would build: maps never see each other's
+//! observations, and each applies its own in the same time order.
+
+use crate::grid::{InsertStats, OccupancyGrid};
+use crate::measurement::{RangeData, SensorId, SensorKind};
+
+/// Which sensors a map takes observations from. (Odometry is not selected here: it places
+/// observations, it does not observe the map.)
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SensorSelection {
+    /// Every sensor.
+    All,
+    /// Every sensor of these kinds.
+    Kinds(Vec<SensorKind>),
+    /// Exactly these sensors.
+    Sensors(Vec<SensorId>),
+}
+
+impl SensorSelection {
+    /// Whether an observation of `sensor`, of kind `kind`, goes into the map.
+    #[inline]
+    pub fn includes(&self, sensor: SensorId, kind: SensorKind) -> bool {
+        match self {
+            SensorSelection::All => true,
+            SensorSelection::Kinds(k) => k.contains(&kind),
+            SensorSelection::Sensors(s) => s.contains(&sensor),
+        }
+    }
+}
+
+/// One map of a [`MapSet`] with its sensor selection and counters.
+pub struct MapEntry {
+    name: String,
+    sensors: SensorSelection,
+    grid: OccupancyGrid,
+    stats: InsertStats,
+}
+
+impl MapEntry {
+    fn new(name: String, sensors: SensorSelection, grid: OccupancyGrid) -> Self {
+        Self { name, sensors, grid, stats: InsertStats::default() }
+    }
+
+    /// The map's name (`M1`, `lidar-only`, …).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The sensors it takes.
+    pub fn sensors(&self) -> &SensorSelection {
+        &self.sensors
+    }
+
+    /// The map.
+    pub fn grid(&self) -> &OccupancyGrid {
+        &self.grid
+    }
+
+    /// Consumes the entry, returning the map.
+    pub fn into_grid(self) -> OccupancyGrid {
+        self.grid
+    }
+
+    /// What the insertions into this map did, summed.
+    pub fn stats(&self) -> &InsertStats {
+        &self.stats
+    }
+}
+
+/// Maps fed by one engine pass; never empty (the first map is the engine's primary map,
+/// the one [`Engine::grid`](super::Engine::grid) returns).
+pub struct MapSet {
+    primary: MapEntry,
+    others: Vec<MapEntry>,
+}
+
+impl MapSet {
+    /// A set whose first (primary) map is `grid`, named `name`, taking `sensors`.
+    pub fn new(name: impl Into<String>, sensors: SensorSelection, grid: OccupancyGrid) -> Self {
+        Self { primary: MapEntry::new(name.into(), sensors, grid), others: Vec::new() }
+    }
+
+    /// Adds a map and returns its index.
+    pub fn add(&mut self, name: impl Into<String>, sensors: SensorSelection, grid: OccupancyGrid) -> usize {
+        self.others.push(MapEntry::new(name.into(), sensors, grid));
+        self.others.len()
+    }
+
+    /// Adds a map (builder form).
+    pub fn with(mut self, name: impl Into<String>, sensors: SensorSelection, grid: OccupancyGrid) -> Self {
+        self.add(name, sensors, grid);
+        self
+    }
+
+    /// Number of maps (at least one).
+    pub fn len(&self) -> usize {
+        1 + self.others.len()
+    }
+
+    /// Never true: a set holds its primary map.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// The map at `index` (0 is the primary map).
+    pub fn get(&self, index: usize) -> Option<&MapEntry> {
+        match index {
+            0 => Some(&self.primary),
+            i => self.others.get(i - 1),
+        }
+    }
+
+    /// The map named `name` (the first, if several share it).
+    pub fn by_name(&self, name: &str) -> Option<&MapEntry> {
+        self.iter().find(|m| m.name == name)
+    }
+
+    /// The primary map.
+    pub fn primary(&self) -> &MapEntry {
+        &self.primary
+    }
+
+    /// All maps, primary first.
+    pub fn iter(&self) -> impl Iterator<Item = &MapEntry> {
+        std::iter::once(&self.primary).chain(&self.others)
+    }
+
+    /// Consumes the set, returning its maps in order, primary first.
+    pub fn into_entries(self) -> Vec<MapEntry> {
+        std::iter::once(self.primary).chain(self.others).collect()
+    }
+
+    /// Consumes the set, returning the primary map.
+    pub fn into_primary(self) -> OccupancyGrid {
+        self.primary.grid
+    }
+
+    /// Inserts one observation of a sensor of kind `kind` into every map that takes it.
+    /// Returns the summed insertion counts and the number of maps fed.
+    pub fn insert(&mut self, kind: SensorKind, data: &RangeData) -> (InsertStats, u64) {
+        let mut total = InsertStats::default();
+        let mut fed = 0;
+        for m in std::iter::once(&mut self.primary).chain(&mut self.others) {
+            if m.sensors.includes(data.sensor, kind) {
+                let s = m.grid.insert(data);
+                m.stats.add(&s);
+                total.add(&s);
+                fed += 1;
+            }
+        }
+        (total, fed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fusion::{Engine, SensorModel};
+    use crate::geometry::{PlanarMount, Pose2};
+    use crate::grid::{GridGeometry, OccupancyParams, TileKey, TILE_CELLS};
+    use crate::measurement::{ObservationId, SensorKind};
+    use crate::sensor::{LaserScan, LidarModel, LidarParams, ReturnCounts};
+    use crate::sim::SimulatedRun;
+
+    fn grid() -> OccupancyGrid {
+        OccupancyGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default())
+    }
+
+    /// Every stored value of a map, as bits, with its tile key.
+    fn cells(g: &OccupancyGrid) -> Vec<(TileKey, Vec<Option<u32>>)> {
+        g.tiles().map(|(k, t)| (k, (0..TILE_CELLS).map(|o| t.log_odds(o).map(f32::to_bits)).collect())).collect()
+    }
+
+    fn same_map(a: &OccupancyGrid, b: &OccupancyGrid) -> bool {
+        a.observations() == b.observations() && a.known_box() == b.known_box() && cells(a) == cells(b)
+    }
+
+    /// Three sensors seeing the corridor at each instant: a front lidar, a second lidar
+    /// with other evidence and a shorter range, and a camera whose range evidence (every
+    /// fourth beam, weaker) comes from a model outside the engine.
+    struct Rig {
+        run: SimulatedRun,
+        front: LidarModel,
+        rear: LidarModel,
+        camera_model: LidarModel,
+    }
+
+    const FRONT: SensorId = SensorId(0);
+    const REAR: SensorId = SensorId(1);
+    const CAMERA: SensorId = SensorId(2);
+
+    impl Rig {
+        fn new() -> Self {
+            let p = LidarParams::default();
+            Rig {
+                run: SimulatedRun::document_corridor(),
+                front: LidarModel::new(p, PlanarMount::default()),
+                rear: LidarModel::new(
+                    LidarParams { p_occ: 0.7, p_free: 0.45, max_range: 3.0, ..p },
+                    PlanarMount::default(),
+                ),
+                camera_model: LidarModel::new(LidarParams { p_occ: 0.6, p_free: 0.48, ..p }, PlanarMount::default()),
+            }
+        }
+
+        fn engine(&self, maps: MapSet) -> Engine {
+            let mut e = Engine::with_maps(maps);
+            assert_eq!(e.add_lidar("front", self.front), FRONT);
+            assert_eq!(e.add_lidar("rear", self.rear), REAR);
+            assert_eq!(e.add_sensor("camera", SensorModel::External(SensorKind::Camera)), CAMERA);
+            e
+        }
+
+        fn camera_data(&self, scan: &LaserScan, pose: Pose2) -> RangeData {
+            let sparse = LaserScan {
+                stamp: scan.stamp,
+                angle_min: scan.angle_min,
+                angle_increment: scan.angle_increment * 4.0,
+                ranges: scan.ranges.iter().step_by(4).copied().collect(),
+            };
+            let mut out = RangeData::empty(CAMERA, self.camera_model.evidence());
+            self.camera_model.scan_to_range_data(CAMERA, &sparse, pose, &mut out, &mut ReturnCounts::default());
+            out
+        }
+
+        /// Feeds every observation of the sensors in `only`, in time order, each instant's
+        /// observations sharing the instant's id.
+        fn feed(&self, e: &mut Engine, only: &[SensorId]) {
+            for (i, (scan, pose)) in self.run.scans.iter().zip(&self.run.poses).enumerate() {
+                let id = ObservationId(i as u64);
+                if only.contains(&FRONT) {
+                    e.insert_scan_observed(FRONT, id, scan, f32::NAN, f32::NAN, |_| *pose).unwrap();
+                }
+                if only.contains(&REAR) {
+                    e.insert_scan_observed(REAR, id, scan, f32::NAN, f32::NAN, |_| *pose).unwrap();
+                }
+                if only.contains(&CAMERA) {
+                    e.insert_range_data_observed(id, &self.camera_data(scan, *pose)).unwrap();
+                }
+            }
+        }
+
+        /// A separate single-map run with only the sensors in `only`.
+        fn alone(&self, only: &[SensorId]) -> OccupancyGrid {
+            let mut e = self.engine(MapSet::new("alone", SensorSelection::All, grid()));
+            self.feed(&mut e, only);
+            e.into_grid()
+        }
+    }
+
+    #[test]
+    fn maps_of_one_pass_equal_separate_runs_bit_for_bit() {
+        let rig = Rig::new();
+        let maps = MapSet::new("M1", SensorSelection::Kinds(vec![SensorKind::Lidar]), grid())
+            .with("M2", SensorSelection::Kinds(vec![SensorKind::Camera]), grid())
+            .with("M3", SensorSelection::All, grid())
+            .with("rear+camera", SensorSelection::Sensors(vec![REAR, CAMERA]), grid());
+        let mut e = rig.engine(maps);
+        rig.feed(&mut e, &[FRONT, REAR, CAMERA]);
+        let maps = e.maps();
+        assert_eq!(maps.len(), 4);
+        let m1 = rig.alone(&[FRONT, REAR]);
+        let m2 = rig.alone(&[CAMERA]);
+        let m3 = rig.alone(&[FRONT, REAR, CAMERA]);
+        let rc = rig.alone(&[REAR, CAMERA]);
+        assert!(same_map(maps.by_name("M1").unwrap().grid(), &m1));
+        assert!(same_map(maps.by_name("M2").unwrap().grid(), &m2));
+        assert!(same_map(maps.by_name("M3").unwrap().grid(), &m3));
+        assert!(same_map(maps.get(3).unwrap().grid(), &rc));
+        // The maps do differ from one another, so the equalities above say something.
+        assert!(!same_map(&m1, &m3) && !same_map(&m2, &m3) && !same_map(&m1, &rc));
+        assert_eq!(maps.by_name("M1").unwrap().grid().observations(), 80);
+        assert_eq!(maps.by_name("M2").unwrap().grid().observations(), 40);
+        assert_eq!(maps.by_name("M3").unwrap().grid().observations(), 120);
+        // The engine's primary map is M1.
+        assert!(same_map(e.grid(), &m1));
+        // Per-sensor map insertions: front feeds M1 and M3, rear M1, M3 and rear+camera.
+        let s: Vec<_> = e.sensor_stats().cloned().collect();
+        assert_eq!((s[0].maps_fed, s[1].maps_fed, s[2].maps_fed), (80, 120, 120));
+        assert_eq!(s[2].kind, SensorKind::Camera);
+        // Per-map counters add up to the engine's.
+        let mut sum = crate::grid::InsertStats::default();
+        for m in maps.iter() {
+            sum.add(m.stats());
+        }
+        assert_eq!(&sum, &e.stats().insert);
+    }
+
+    #[test]
+    fn selection_by_kind_and_by_sensor() {
+        let lidar = SensorSelection::Kinds(vec![SensorKind::Lidar]);
+        assert!(lidar.includes(SensorId(7), SensorKind::Lidar));
+        assert!(!lidar.includes(SensorId(7), SensorKind::Camera));
+        let some = SensorSelection::Sensors(vec![SensorId(1)]);
+        assert!(some.includes(SensorId(1), SensorKind::Camera));
+        assert!(!some.includes(SensorId(2), SensorKind::Lidar));
+        assert!(SensorSelection::All.includes(SensorId(9), SensorKind::Camera));
+        let set = MapSet::new("a", SensorSelection::All, grid()).with("b", some, grid());
+        assert_eq!(set.len(), 2);
+        assert!(!set.is_empty());
+        assert_eq!(set.get(1).map(|m| m.name()), Some("b"));
+        assert!(set.get(2).is_none());
+        let names: Vec<_> = set.into_entries().into_iter().map(|m| m.name().to_string()).collect();
+        assert_eq!(names, ["a", "b"]);
+    }
+}

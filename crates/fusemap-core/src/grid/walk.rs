@@ -1,0 +1,205 @@
+//! The walk of one observation's rays over the tiles, separate from what is done to each
+//! cell.
+//!
+//! After Cartographer's `ProbabilityGridRangeDataInserter2D` (hits first, then misses,
+//! with an update marker) and OctoMap's `computeUpdate` ("occupied nodes have a preference
+//! over free ones"), for one observation:
+//! 1. **hits**: the end cell of every hit ray is visited once and marked;
+//! 2. **passes**: every ray is walked from its origin to its end cell (Amanatides & Woo,
+//!    [`CellRay`]), visiting each cell it crosses.
+//!
+//! Each visit says whether it is the first of that cell in this observation (`fresh`,
+//! from the tile's shared [`UpdateMark`](super::UpdateMark)). A layer acts only on fresh
+//! visits to count one observation once per cell; since hits come first, a cell that
+//! ends any hit ray is never also updated as free.
+//!
+//! What a visit does is a [`CellVisitor`], a generic parameter, so the walk is compiled
+//! once per layer combination and the per-cell call inlines into the loop: the occupancy
+//! layer, and any later layer, reuse this walk instead of copying it (Bonxai's
+//! `RayIterator` calls a closure per cell for the same reason).
+
+use super::{CellBox, CellIndex, CellRay, GridGeometry, MarkedTile, Step, TileMap, TILE_MASK, TILE_SHIFT, TILE_SIZE};
+use crate::measurement::Ray;
+use serde::Serialize;
+
+/// Longest ray walked, in cells (|Δi| + |Δj|). Longer rays come from corrupt data (a
+/// range of 1e9 m) and are rejected and counted instead of walking for minutes.
+pub const MAX_RAY_CELLS: u64 = 1 << 22;
+
+/// What a layer does to each cell a walk visits.
+///
+/// `tile` is the tile holding the cell, `offset` the cell's row-major offset in it, and
+/// `fresh` whether this is the cell's first visit in the current observation (the visit
+/// has already marked it).
+pub trait CellVisitor<T> {
+    /// The end cell of a hit ray (pass 1).
+    fn hit(&mut self, tile: &mut T, offset: usize, fresh: bool);
+    /// A cell a ray crosses, its end cell included (pass 2).
+    fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool);
+}
+
+/// No layer: the walk alone (its counts and marks).
+impl<T> CellVisitor<T> for () {
+    #[inline(always)]
+    fn hit(&mut self, _: &mut T, _: usize, _: bool) {}
+    #[inline(always)]
+    fn pass(&mut self, _: &mut T, _: usize, _: bool) {}
+}
+
+impl<T, V: CellVisitor<T> + ?Sized> CellVisitor<T> for &mut V {
+    #[inline(always)]
+    fn hit(&mut self, tile: &mut T, offset: usize, fresh: bool) {
+        (**self).hit(tile, offset, fresh)
+    }
+    #[inline(always)]
+    fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool) {
+        (**self).pass(tile, offset, fresh)
+    }
+}
+
+/// Two layers fed by one walk, first `A` then `B` on each cell.
+impl<T, A: CellVisitor<T>, B: CellVisitor<T>> CellVisitor<T> for (A, B) {
+    #[inline(always)]
+    fn hit(&mut self, tile: &mut T, offset: usize, fresh: bool) {
+        self.0.hit(tile, offset, fresh);
+        self.1.hit(tile, offset, fresh);
+    }
+    #[inline(always)]
+    fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool) {
+        self.0.pass(tile, offset, fresh);
+        self.1.pass(tile, offset, fresh);
+    }
+}
+
+/// What one insertion did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct InsertStats {
+    /// Rays walked.
+    pub rays: u64,
+    /// Rays refused: a non-finite point, a cell beyond the index range, or longer than
+    /// [`MAX_RAY_CELLS`].
+    pub rays_rejected: u64,
+    /// Cells visited by the walks, counting a cell again for every ray that crosses it.
+    pub cell_visits: u64,
+    /// Cells updated as occupied (once per observation).
+    pub hit_updates: u64,
+    /// Cells updated as free (once per observation).
+    pub miss_updates: u64,
+}
+
+impl InsertStats {
+    /// Adds another insertion's counts.
+    pub fn add(&mut self, o: &InsertStats) {
+        self.rays += o.rays;
+        self.rays_rejected += o.rays_rejected;
+        self.cell_visits += o.cell_visits;
+        self.hit_updates += o.hit_updates;
+        self.miss_updates += o.miss_updates;
+    }
+}
+
+/// Walks the rays of observation number `obs` over `tiles` (allocating tiles as needed),
+/// calling `visitor` per cell by the two-pass rule of the module docs, and grows `known`
+/// to hold every cell reached. `obs` must differ from every earlier observation's number
+/// on these tiles (the mark is reset by a change of number).
+#[inline]
+pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
+    tiles: &mut TileMap<T>,
+    geometry: &GridGeometry,
+    obs: u64,
+    rays: &[Ray],
+    known: &mut Option<CellBox>,
+    visitor: &mut V,
+) -> InsertStats {
+    let (ox, oy) = (geometry.origin().x, geometry.origin().y);
+    let inv = 1.0 / geometry.resolution();
+    let units = |p: crate::geometry::Point2| ((p.x - ox) * inv, (p.y - oy) * inv);
+    let mut stats = InsertStats::default();
+
+    // Pass 1: hits. Each end cell is visited and marked, so the walks of pass 2 see it
+    // as already updated.
+    for ray in rays.iter().filter(|r| r.hit) {
+        let Some((_, _, _, c)) = checked(units(ray.origin), units(ray.end)) else {
+            continue;
+        };
+        let tile = tiles.get_or_insert(c.tile());
+        let mark = tile.mark();
+        mark.begin(obs);
+        let offset = c.offset_in_tile();
+        let fresh = mark.test_and_set(offset);
+        stats.hit_updates += fresh as u64;
+        visitor.hit(tile, offset, fresh);
+    }
+
+    // Pass 2: walk every ray from its origin to its end.
+    let mut known_box = *known;
+    for ray in rays {
+        let Some((a, b, ca, cb)) = checked(units(ray.origin), units(ray.end)) else {
+            stats.rays_rejected += 1;
+            continue;
+        };
+        let mut walk = CellRay::new(a, b);
+        let n = walk.len_cells();
+        stats.rays += 1;
+        stats.cell_visits += n;
+        // The union with the known box, written out so that it inlines into the loop.
+        let (lo, hi) = known_box.map_or((ca, ca), |k| (k.min, k.max));
+        known_box = Some(CellBox {
+            min: CellIndex::new(lo.x.min(ca.x).min(cb.x), lo.y.min(ca.y).min(cb.y)),
+            max: CellIndex::new(hi.x.max(ca.x).max(cb.x), hi.y.max(ca.y).max(cb.y)),
+        });
+
+        // Walk inside one tile with a local offset; resolve a tile (one hash lookup)
+        // only when the walk crosses into the next one.
+        let (sx, sy) = (walk.step_x(), walk.step_y() * TILE_SIZE as i64);
+        let mut tile = tiles.get_or_insert(ca.tile());
+        tile.mark().begin(obs);
+        let (mut lx, mut ly) = (ca.x & TILE_MASK, ca.y & TILE_MASK);
+        let mut offset = ca.offset_in_tile() as i64;
+        loop {
+            let fresh = tile.mark().test_and_set(offset as usize);
+            stats.miss_updates += fresh as u64;
+            visitor.pass(tile, offset as usize, fresh);
+            match walk.step() {
+                Step::Done => break,
+                Step::X => {
+                    lx += sx;
+                    offset += sx;
+                }
+                Step::Y => {
+                    ly += sy >> TILE_SHIFT;
+                    offset += sy;
+                }
+            }
+            if (lx | ly) & !TILE_MASK != 0 {
+                // Left the tile: `lx` or `ly` is -1 or TILE_SIZE.
+                let c = walk.cell();
+                tile = tiles.get_or_insert(c.tile());
+                tile.mark().begin(obs);
+                (lx, ly) = (c.x & TILE_MASK, c.y & TILE_MASK);
+                offset = c.offset_in_tile() as i64;
+            }
+        }
+    }
+    *known = known_box;
+    stats
+}
+
+#[inline(always)]
+fn cell_of_units((u, v): (f64, f64)) -> Option<CellIndex> {
+    const LIMIT: f64 = 4.611_686_018_427_388e18;
+    let (fx, fy) = (u.floor(), v.floor());
+    // `abs() < LIMIT` is false for NaN and ±inf too.
+    (fx.abs() < LIMIT && fy.abs() < LIMIT).then(|| CellIndex::new(fx as i64, fy as i64))
+}
+
+/// The cells of a ray's two ends, or `None` when the ray must not be walked (non-finite,
+/// beyond the index range, or longer than [`MAX_RAY_CELLS`]).
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn checked(a: (f64, f64), b: (f64, f64)) -> Option<((f64, f64), (f64, f64), CellIndex, CellIndex)> {
+    let ca = cell_of_units(a)?;
+    let cb = cell_of_units(b)?;
+    let n = ca.x.abs_diff(cb.x) + ca.y.abs_diff(cb.y);
+    (n <= MAX_RAY_CELLS).then_some((a, b, ca, cb))
+}
