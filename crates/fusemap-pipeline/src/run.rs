@@ -16,10 +16,10 @@ use crate::sensors::{bind, Bound};
 use crate::track::{choose, count_reordered, ChosenTrack, Track};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, SensorKind, SyncConfig};
-use fusemap_core::fusion::Engine;
+use fusemap_core::fusion::{Engine, MapSet};
 use fusemap_core::geometry::{PlanarMount, Pose2};
 use fusemap_core::grid::OccupancyGrid;
-use fusemap_core::measurement::SensorId;
+use fusemap_core::measurement::{ObservationId, SensorId};
 use fusemap_core::sensor::{LaserScan, LidarModel};
 use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
 use fusemap_io::log::{LogFormat, ScanMessage};
@@ -149,17 +149,22 @@ pub fn map_inventory(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MapRun, PipelineError> {
     let (bound, chosen, track_s) = prepare(plan, inv)?;
-    map_with_track(plan, inv, &bound, chosen, track_s, progress)
+    map_with_track(plan, inv, &bound, chosen, track_s, None, progress)
 }
 
 /// Maps a recording whose first pass is done with a given pose track (a calibration
 /// search, or a comparison of tracks on one log, maps the same scans with several).
+///
+/// `maps`: several maps fed in this one pass, each from its own subset of sensors (the
+/// design document's leave-one-out maps, §5.2); the lidars get sensor ids 0, 1, … in the
+/// order of `bound.lidars`. `None`: one map of every sensor.
 pub fn map_with_track(
     plan: &Plan,
     inv: &Inventory,
     bound: &Bound,
     chosen: ChosenTrack,
     track_s: f64,
+    maps: Option<MapSet>,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MapRun, PipelineError> {
     let cfg = &plan.log;
@@ -174,7 +179,10 @@ pub fn map_with_track(
         Track::Timed(_) => offset_ns(cfg.reorder_window_s),
     };
     let mut merge: OrderedMerge<ScanMessage> = OrderedMerge::new(window);
-    let mut engine = Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy));
+    let mut engine = match maps {
+        Some(m) => Engine::with_maps(m),
+        None => Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy)),
+    };
     let (tree, tree_notes) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
     notes.extend(tree_notes);
     let mut lidars = Vec::new();
@@ -245,6 +253,7 @@ pub fn map_with_track(
         scan: LaserScan { stamp: Stamp::ZERO, angle_min: 0.0, angle_increment: 0.0, ranges: Vec::new() },
         last: None,
         line_trajectory: Vec::new(),
+        next_id: 0,
     };
     let t_map = Instant::now();
     let mut seq = 0i64;
@@ -368,6 +377,9 @@ struct Inserter<'a> {
     scan: LaserScan,
     last: Option<Stamp>,
     line_trajectory: Vec<(Stamp, Pose2)>,
+    /// The next observation id: one per scan released by the merge, so that every insert
+    /// is named (evidence of one instant from several sensors will share one).
+    next_id: u64,
 }
 
 impl Inserter<'_> {
@@ -379,6 +391,8 @@ impl Inserter<'_> {
         scan.angle_increment = msg.scan.angle_increment as f32 as f64;
         scan.ranges.clone_from(&msg.scan.ranges);
         let stamp = msg.scan.stamp;
+        let id = ObservationId(self.next_id);
+        self.next_id += 1;
         match self.track {
             Track::ScanLine => {
                 let Some(pose) = msg.pose.filter(|p| p.is_finite()) else {
@@ -387,7 +401,7 @@ impl Inserter<'_> {
                 };
                 // Line poses do not depend on the stamp: applied in file order.
                 scan.stamp = self.last.map_or(stamp, |last| last.max(stamp));
-                self.engine.insert_scan_limited(l.id, scan, msg.range_min, msg.range_max, |_| pose)?;
+                self.engine.insert_scan_observed(l.id, id, scan, msg.range_min, msg.range_max, |_| pose)?;
                 self.line_trajectory.push((scan.stamp, pose));
                 self.last = Some(scan.stamp);
             }
@@ -407,12 +421,12 @@ impl Inserter<'_> {
                 let end = Stamp(t.0.saturating_add((ti * (n - 1) as f64 * 1e9) as i64));
                 if can_deskew && track.pose_at(end, SyncMode::Interpolate).is_ok() {
                     l.report.scans_deskewed += 1;
-                    self.engine.insert_scan_limited(l.id, scan, msg.range_min, msg.range_max, |i| {
+                    self.engine.insert_scan_observed(l.id, id, scan, msg.range_min, msg.range_max, |i| {
                         let tb = Stamp(t.0.saturating_add((ti * i as f64 * 1e9) as i64));
                         track.pose_at(tb, SyncMode::Interpolate).unwrap_or(pose)
                     })?;
                 } else {
-                    self.engine.insert_scan_limited(l.id, scan, msg.range_min, msg.range_max, |_| pose)?;
+                    self.engine.insert_scan_observed(l.id, id, scan, msg.range_min, msg.range_max, |_| pose)?;
                 }
                 self.last = Some(t);
             }

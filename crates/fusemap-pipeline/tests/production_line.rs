@@ -182,11 +182,11 @@ fn the_fused_map_scores_far_above_raw_odometry() {
     let (bound, fused, track_s) = prepare(&f.plan, &f.inv).unwrap();
     assert!(fused.name.starts_with("estimator"), "{}", fused.name);
     let mut quiet = |_: fusemap_pipeline::Progress| {};
-    let fused_map = map_with_track(&f.plan, &f.inv, &bound, fused, track_s, &mut quiet).unwrap();
+    let fused_map = map_with_track(&f.plan, &f.inv, &bound, fused, track_s, None, &mut quiet).unwrap();
     let raw = ChosenTrack::given("raw odometry", Box::new(raw_odometry(f)));
-    let raw_map = map_with_track(&f.plan, &f.inv, &bound, raw, 0.0, &mut quiet).unwrap();
+    let raw_map = map_with_track(&f.plan, &f.inv, &bound, raw, 0.0, None, &mut quiet).unwrap();
     let truth = ChosenTrack::given("true poses", Box::new(truth_track(f)));
-    let true_map = map_with_track(&f.plan, &f.inv, &bound, truth, 0.0, &mut quiet).unwrap();
+    let true_map = map_with_track(&f.plan, &f.inv, &bound, truth, 0.0, None, &mut quiet).unwrap();
 
     let g: GridGeometry = f.plan.geometry;
     let t = f.rec.truth_occupancy(g).unwrap();

@@ -116,3 +116,29 @@ fn a_lidar_time_offset_moves_its_scans() {
         b.scans_skipped
     );
 }
+
+#[test]
+fn one_pass_feeds_several_maps_each_with_its_sensors() {
+    use fusemap_core::fusion::{MapSet, SensorSelection};
+    use fusemap_core::grid::OccupancyGrid;
+    use fusemap_core::measurement::SensorId;
+    use fusemap_pipeline::recording::Inventory;
+    let plan = with(vec![lidar("/scan"), lidar("/scan_copy")]).validate().unwrap();
+    let inv = Inventory::read(bag()).unwrap();
+    let (bound, track, s) = fusemap_pipeline::run::prepare(&plan, &inv).unwrap();
+    let grid = || OccupancyGrid::new(plan.geometry, plan.occupancy);
+    let maps = MapSet::new("both", SensorSelection::All, grid()).with(
+        "first only",
+        SensorSelection::Sensors(vec![SensorId(0)]),
+        grid(),
+    );
+    let run = fusemap_pipeline::map_with_track(&plan, &inv, &bound, track, s, Some(maps), &mut |_| {}).unwrap();
+    // The first lidar's map from the one pass equals a run that maps only that lidar.
+    let only = map_log(&with(vec![lidar("/scan")]).validate().unwrap(), bag(), &mut |_| {}).unwrap();
+    let a = run.engine.maps().by_name("first only").unwrap().grid().known_raster().unwrap();
+    let b = only.engine.grid().known_raster().unwrap();
+    assert_eq!((a.width, a.height, a.first_cell), (b.width, b.height, b.first_cell));
+    assert!(a.log_odds == b.log_odds && a.known == b.known, "one pass and a separate run differ");
+    let both = run.engine.maps().by_name("both").unwrap().grid().known_raster().unwrap();
+    assert!(both.log_odds != a.log_odds, "the map of both lidars has both lidars' evidence");
+}
