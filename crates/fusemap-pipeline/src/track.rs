@@ -13,8 +13,9 @@ use crate::recording::Inventory;
 use crate::sensors::Bound;
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, PoseSource, SensorKind};
+use fusemap_core::frames::{FrameTree, LookupError};
 use fusemap_core::geometry::{Mount3, Pose2};
-use fusemap_core::time::{PoseBuffer, PoseTrack, PushOutcome, Stamp};
+use fusemap_core::time::{NoPose, PoseBuffer, PoseTrack, PushOutcome, Stamp, SyncMode};
 use serde::Serialize;
 
 /// Counters of the pose track.
@@ -58,6 +59,58 @@ pub struct ChosenTrack {
     pub estimator: Option<serde_json::Value>,
     /// Facts about the track a user should know.
     pub notes: Vec<String>,
+}
+
+/// `root_from_base` looked up in the frame tree at each stamp: the TF pose source when the
+/// base frame hangs below more than one dynamic edge (`map ← odom ← base_link` with a
+/// localiser publishing `map → odom`). Lookups interpolate every dynamic edge on the
+/// chain at the stamp and never extrapolate.
+pub struct TfTrack {
+    tree: FrameTree,
+    root: String,
+    base: String,
+    stamps: Vec<Stamp>,
+}
+
+impl TfTrack {
+    /// The frame at the top of `base`'s chain in `tree`.
+    pub fn root_of(tree: &FrameTree, base: &str) -> Option<String> {
+        let mut f = base;
+        let mut depth = 0;
+        while let Some(p) = tree.parent(f) {
+            f = p;
+            depth += 1;
+            if depth > 1000 {
+                return None;
+            }
+        }
+        (f != base).then(|| f.to_string())
+    }
+}
+
+fn no_pose(e: LookupError) -> NoPose {
+    match e {
+        LookupError::BeforeSamples { by_s, .. } => NoPose::BeforeStart(by_s),
+        LookupError::AfterSamples { by_s, .. } => NoPose::AfterEnd(by_s),
+        LookupError::Gap { gap_s, limit_s, .. } => NoPose::Gap { gap_s, limit_s },
+        _ => NoPose::Empty,
+    }
+}
+
+impl PoseTrack for TfTrack {
+    fn pose_at(&self, t: Stamp, _mode: SyncMode) -> Result<Pose2, NoPose> {
+        let p = self.tree.lookup(&self.root, &self.base, t).map_err(no_pose)?;
+        let m = p.to_mount();
+        Ok(Pose2::new(m.x, m.y, m.yaw))
+    }
+
+    fn span(&self) -> Option<(Stamp, Stamp)> {
+        Some((*self.stamps.first()?, *self.stamps.last()?))
+    }
+
+    fn samples(&self) -> Vec<(Stamp, Pose2)> {
+        self.stamps.iter().filter_map(|&t| self.pose_at(t, SyncMode::Interpolate).ok().map(|p| (t, p))).collect()
+    }
 }
 
 impl ChosenTrack {
@@ -192,6 +245,31 @@ pub fn choose(
             })
         }
         PoseSource::Tf => {
+            let (tree, _) = crate::extrinsics::frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
+            let root = TfTrack::root_of(&tree, &cfg.base_frame);
+            let parent = tree.parent(&cfg.base_frame).map(str::to_string);
+            if let (Some(root), Some(parent)) = (root, parent) {
+                if root != parent {
+                    // More than one edge above the base: compose them at each stamp.
+                    let mut stamps: Vec<Stamp> = tf_samples.iter().map(|s| s.0).collect();
+                    stamps.sort_unstable();
+                    stamps.dedup();
+                    counts.samples = stamps.len() as u64;
+                    let name = format!("TF `{root} → … → {}`", cfg.base_frame);
+                    let track = TfTrack { tree, root, base: cfg.base_frame.clone(), stamps: stamps.clone() };
+                    counts.used = track.samples().len() as u64;
+                    return Ok(ChosenTrack {
+                        source,
+                        track: Track::Timed(Box::new(track)),
+                        name,
+                        counts,
+                        receive: vec![None; stamps.len()],
+                        stamps,
+                        estimator: None,
+                        notes: Vec::new(),
+                    });
+                }
+            }
             let stamps: Vec<Stamp> = tf_samples.iter().map(|s| s.0).collect();
             let buffer = buffer_of(cfg, tf_samples, &mut counts);
             if buffer.is_empty() {

@@ -1,0 +1,66 @@
+//! The TF pose source through the frame tree: with a localiser's `map → odom` above the
+//! odometry's `odom → base_link`, the track is their composition at each scan's stamp.
+
+use fusemap_core::config::{Config, PoseSource};
+use fusemap_core::sim::production::{simulate, Scenario, SimMessage};
+use fusemap_io::log::ros2::writer::msgs::geometry_msgs::TransformStamped;
+use fusemap_io::log::ros2::writer::msgs::std_msgs::Header;
+use fusemap_io::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions};
+use fusemap_io::simulation::to_out_message;
+use fusemap_pipeline::map_log;
+
+fn tf(stamp: fusemap_core::time::Stamp, parent: &str, child: &str, x: f64, y: f64, yaw: f64) -> OutMessage {
+    OutMessage::Tf {
+        is_static: false,
+        transforms: vec![TransformStamped {
+            header: Header { stamp, frame_id: parent.into() },
+            child_frame_id: child.into(),
+            translation: [x, y, 0.0],
+            rotation: [0.0, 0.0, (yaw / 2.0).sin(), (yaw / 2.0).cos()],
+        }],
+    }
+}
+
+#[test]
+fn map_odom_and_base_compose_at_each_stamp() {
+    let mut s = Scenario::default();
+    s.robot.duration_s = 20.0;
+    let rec = simulate(&s).unwrap();
+    let dir = fusemap_io::testdata::temp_dir("tf-chain");
+    let bag = dir.join("bag");
+    let mut w =
+        Rosbag2Writer::create_with(&bag, Rosbag2WriterOptions { overwrite: true, ..Default::default() }).unwrap();
+    let mut n_odom = 0;
+    for m in &rec.messages {
+        match m {
+            SimMessage::Scan(_) | SimMessage::StaticTransform(_) => {
+                w.write(m.stamp(), m.topic(), &to_out_message(m)).unwrap()
+            }
+            SimMessage::Odometry(o) => {
+                // odom → base_link from the odometry, and a localiser's map → odom at 10 Hz:
+                // 10 m east, turned 90°.
+                let yaw = fusemap_core::geometry::quaternion_yaw(o.orientation);
+                w.write(o.stamp, "/tf", &tf(o.stamp, "odom", "base_link", o.position[0], o.position[1], yaw)).unwrap();
+                if n_odom % 5 == 0 {
+                    w.write(o.stamp, "/tf", &tf(o.stamp, "map", "odom", 10.0, 0.0, std::f64::consts::FRAC_PI_2))
+                        .unwrap();
+                }
+                n_odom += 1;
+            }
+            _ => {}
+        }
+    }
+    w.finish().unwrap();
+    let mut cfg = Config::default();
+    cfg.log.pose_source = PoseSource::Tf;
+    let run = map_log(&cfg.validate().unwrap(), &bag, &mut |_| {}).unwrap();
+    assert!(run.report.pose_source.contains("map → … → base_link"), "{}", run.report.pose_source);
+    assert!(run.report.scans_used > 190, "{}", run.report.scans_used);
+    // The first pose: odometry starts at the origin, so map_from_base = map_from_odom.
+    let (_, p) = run.trajectory[0];
+    assert!((p.x - 10.0).abs() < 1e-6 && p.y.abs() < 1e-6, "{p:?}");
+    assert!((p.theta - std::f64::consts::FRAC_PI_2).abs() < 1e-6, "{p:?}");
+    // Later, the odometry's forward motion (east in odom) shows as north in map.
+    let (_, q) = run.trajectory[run.trajectory.len() / 2];
+    assert!(q.y > 3.0 && (q.x - 10.0).abs() < 1.0, "{q:?}");
+}
