@@ -108,11 +108,32 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                 if let Some(v) = n.rotation_per_sqrt_m {
                     est.odometry_rotation_noise_per_m = v;
                 }
+                // nav_msgs/Odometry carries the covariance of the pose in `odom`, which grows
+                // as the robot drives; the estimator wants the covariance of each increment.
+                // That is the growth between consecutive messages, when the driver's
+                // covariance does grow. Many drivers publish a constant one (ROS's
+                // diff_drive_controller does): its growth is zero, and the sensor's noise
+                // figures apply instead — reading a constant 0.01 m² as the noise of every
+                // 20 ms step would make the odometry a hundred times too uncertain.
+                let mut prev: Option<[[f64; 3]; 3]> = None;
                 for m in &inv.odom[&s.topic] {
+                    let increment = match (m.covariance, prev) {
+                        (Some(c), Some(p)) => {
+                            let mut d = [[0.0; 3]; 3];
+                            for (r, row) in d.iter_mut().enumerate() {
+                                for (k, v) in row.iter_mut().enumerate() {
+                                    *v = c[r][k] - p[r][k];
+                                }
+                            }
+                            (0..3).all(|i| d[i][i] > 0.0).then_some(d)
+                        }
+                        _ => None,
+                    };
+                    prev = m.covariance;
                     out.push(EstimatorInput::Odometry {
                         stamp: offset(m.stamp, s),
                         pose: m.pose,
-                        covariance: m.covariance,
+                        covariance: increment,
                     });
                 }
             }
