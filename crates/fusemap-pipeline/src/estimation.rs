@@ -24,7 +24,7 @@ use crate::PipelineError;
 use fusemap_core::config::{Plan, PoseSource, SensorKind};
 use fusemap_core::estimator::{estimate, EstimatorConfig, EstimatorInput, FixQuality};
 use fusemap_core::frames::FrameTree;
-use fusemap_core::geometry::{geodetic::Datum, quaternion_yaw, Mount3, Point2, Pose2};
+use fusemap_core::geometry::{geodetic::Datum, quaternion_yaw, Mount3, Point2, Pose2, Pose3};
 use fusemap_core::time::Stamp;
 use fusemap_io::log::GnssMessage;
 use serde::Serialize;
@@ -156,7 +156,8 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                     out.push(EstimatorInput::Gyro { stamp, yaw_rate, variance });
                     if let Some((orientation, var)) = m.orientation.filter(|_| s.sensor.use_orientation) {
                         // world_from_base = world_from_imu · (base_from_imu)⁻¹.
-                        let q = qmul(orientation, qconj(q_mount));
+                        let world_from_imu = Pose3::new([0.0; 3], orientation);
+                        let q = world_from_imu.compose(&Pose3::new([0.0; 3], q_mount).inverse()).rotation;
                         let yaw = quaternion_yaw(q);
                         if yaw.is_finite() && var.is_finite() && var > 0.0 {
                             out.push(EstimatorInput::Heading { stamp, yaw, variance: var });
@@ -276,21 +277,6 @@ fn gnss_inputs(
         });
     }
     Ok((out, r, notes))
-}
-
-fn qconj(q: [f64; 4]) -> [f64; 4] {
-    [-q[0], -q[1], -q[2], q[3]]
-}
-
-fn qmul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
-    let [ax, ay, az, aw] = a;
-    let [bx, by, bz, bw] = b;
-    [
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    ]
 }
 
 /// Runs the estimator and its smoother over the log's pose sensors.

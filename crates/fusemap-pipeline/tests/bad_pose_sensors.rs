@@ -108,3 +108,28 @@ fn a_gnss_topic_without_a_fix_says_so_and_maps_on_odometry_and_gyro() {
     assert_eq!(l["estimator"]["gnss_input"]["passed"], 0);
     assert!(l["estimator"]["gnss_input"]["no_fix"].as_u64().unwrap() > 100);
 }
+
+/// An IMU that reports its orientation (REP 145: a covariance, not −1) gives the
+/// estimator absolute headings, rotated from the IMU's frame into base_link by its mount.
+#[test]
+fn imu_orientation_is_used_when_the_message_provides_it() {
+    let mut rec = short_run();
+    let truth = rec.truth_trajectory.clone();
+    let at = |t: fusemap_core::time::Stamp| {
+        let i = truth.partition_point(|(s, _)| *s < t).min(truth.len() - 1);
+        truth[i].1.theta
+    };
+    for m in &mut rec.messages {
+        if let SimMessage::Imu(i) = m {
+            let yaw = at(i.stamp);
+            i.orientation = [0.0, 0.0, (yaw / 2.0).sin(), (yaw / 2.0).cos()];
+            i.orientation_covariance = [1e-4, 0.0, 0.0, 0.0, 1e-4, 0.0, 0.0, 0.0, 1e-4];
+        }
+    }
+    let run = map(&rec, "imu-orientation", &Config::default()).expect("maps");
+    let l = serde_json::to_value(&run.report).unwrap();
+    let e = &l["estimator"]["estimator"];
+    println!("headings: {}, init: {}", e["headings"], e["heading_init"]);
+    assert!(e["headings"]["used"].as_u64().unwrap() > 1000, "{}", e["headings"]);
+    assert_eq!(e["heading_init"]["source"]["kind"], "imu_heading", "{}", e["heading_init"]);
+}
