@@ -152,3 +152,25 @@ pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwri
     crate::trajectory::write_tum(&truth_trajectory, &rec.truth_trajectory)?;
     Ok(SimulationFiles { bag, truth_map, truth_trajectory })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(name: &str, text: &str) -> std::path::PathBuf {
+        let p = crate::testdata::temp_dir("scenario").join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    #[test]
+    fn scenario_files_fill_defaults_and_name_bad_keys_and_fields() {
+        let s = load_scenario(&write("short.toml", "[robot]\nduration_s = 30.0\n")).unwrap();
+        assert_eq!(s.robot.duration_s, 30.0);
+        assert_eq!(s.lidar, Scenario::default().lidar);
+        let e = load_scenario(&write("typo.toml", "[robot]\nduration_s = 30.0\nspeeed = 1\n")).unwrap_err().to_string();
+        assert!(e.contains("typo.toml:3") && e.contains("speeed"), "{e}");
+        let e = load_scenario(&write("bad.toml", "[gnss]\nrate_hz = 0.0\n")).unwrap_err().to_string();
+        assert!(e.contains("bad.toml") && e.contains("gnss.rate_hz"), "{e}");
+    }
+}
