@@ -164,6 +164,9 @@ pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
     let mut findings: Vec<String> = Vec::new();
     let mut sync = None;
     match crate::run::prepare(plan, &log) {
+        Ok((bound, _, _)) if bound.lidars.is_empty() => {
+            findings.push("cannot be mapped: every [[sensor]] of kind lidar is disabled".into())
+        }
         Ok((bound, chosen, _)) => {
             notes.extend(bound.notes.iter().cloned());
             let topic = bound.lidars[0].topic.clone();

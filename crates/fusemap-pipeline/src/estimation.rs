@@ -16,12 +16,12 @@
 //! Each sensor's `time_offset_s` is added to its stamps. What is not used is counted by
 //! reason in the report, beside the estimator's own figures.
 
-use crate::extrinsics::{frame_tree, from_tf};
+use crate::extrinsics::{frame_tree, from_tf, resolve};
 use crate::recording::{planar_covariance, Inventory};
 use crate::sensors::{Bound, BoundSensor};
 use crate::track::{ChosenTrack, Track, TrackCounts};
 use crate::PipelineError;
-use fusemap_core::config::{Plan, PoseSource, SensorKind};
+use fusemap_core::config::{LogConfig, Plan, PoseSource, SensorKind};
 use fusemap_core::estimator::{estimate, EstimatorConfig, EstimatorInput, FixQuality};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{geodetic::Datum, quaternion_yaw, Mount3, Point2, Pose2, Pose3};
@@ -33,6 +33,8 @@ use std::collections::BTreeMap;
 /// What the pipeline did with the GNSS fixes before the estimator saw them.
 #[derive(Debug, Default, Clone, Serialize)]
 pub struct GnssInputReport {
+    /// The topic.
+    pub topic: String,
     /// Fixes read.
     pub read: u64,
     /// Given to the estimator.
@@ -57,8 +59,8 @@ pub struct GnssInputReport {
 pub struct Inputs {
     /// Time-ordered inputs.
     pub inputs: Vec<EstimatorInput>,
-    /// The GNSS part of the report.
-    pub gnss: Option<GnssInputReport>,
+    /// The GNSS part of the report, one per GNSS sensor.
+    pub gnss: Vec<GnssInputReport>,
     /// The estimator's config with the sensor tables' noise figures applied.
     pub config: EstimatorConfig,
     /// Facts a user should know.
@@ -69,12 +71,19 @@ fn offset(t: Stamp, s: &BoundSensor) -> Stamp {
     Stamp(t.0.saturating_add(crate::offset_ns(s.sensor.time_offset_s)))
 }
 
-/// The sensor's mount: config, else TF of `frame`, else identity.
-fn mount(s: &BoundSensor, tree: &FrameTree, base: &str, frame: &str, stamp: Option<Stamp>) -> (Mount3, &'static str) {
-    if let Some(m) = s.sensor.base_from_sensor {
-        return (m, "config");
-    }
-    from_tf(tree, base, frame, stamp).unwrap_or((Mount3::default(), "identity"))
+/// The sensor's mount, resolved as a lidar's is: `log.extrinsics` decides between the
+/// config and the log's TF, and a config mount that disagrees with TF is reported.
+fn mount(
+    s: &BoundSensor,
+    cfg: &LogConfig,
+    tree: &FrameTree,
+    frame: &str,
+    stamp: Option<Stamp>,
+    notes: &mut Vec<String>,
+) -> Result<Mount3, PipelineError> {
+    let log_mount = from_tf(tree, &cfg.base_frame, frame, stamp);
+    let name = if frame.is_empty() { s.sensor.name.as_str() } else { frame };
+    Ok(resolve(name, cfg, s.sensor.base_from_sensor, log_mount, notes)?.base_from_sensor)
 }
 
 /// The quality of a fix, for the report and the floor.
@@ -94,7 +103,17 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
     let mut est = plan.estimator.clone();
     let mut notes = Vec::new();
     let mut out = Vec::new();
-    let mut gnss_report = None;
+    let mut gnss_reports = Vec::new();
+    let datum = shared_datum(inv, bound);
+    let odometers: Vec<&str> =
+        bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::WheelOdometry).map(|s| s.topic.as_str()).collect();
+    if odometers.len() > 1 {
+        return Err(PipelineError::Refused(format!(
+            "the estimator fuses one wheel odometry, the config lists {} ({}): disable all but one",
+            odometers.len(),
+            odometers.join(", ")
+        )));
+    }
     for s in &bound.sensors {
         match s.sensor.kind {
             SensorKind::WheelOdometry => {
@@ -115,21 +134,33 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                 // diff_drive_controller does): its growth is zero, and the sensor's noise
                 // figures apply instead — reading a constant 0.01 m² as the noise of every
                 // 20 ms step would make the odometry a hundred times too uncertain.
-                let mut prev: Option<[[f64; 3]; 3]> = None;
+                // The growth is in `odom`; the estimator takes the increment's covariance in
+                // the base frame at the start of the increment: rotated by Rᵀ(θ_prev).
+                let mut prev: Option<([[f64; 3]; 3], f64)> = None;
                 for m in &inv.odom[&s.topic] {
                     let increment = match (m.covariance, prev) {
-                        (Some(c), Some(p)) => {
+                        (Some(c), Some((p, yaw))) if yaw.is_finite() => {
                             let mut d = [[0.0; 3]; 3];
                             for (r, row) in d.iter_mut().enumerate() {
                                 for (k, v) in row.iter_mut().enumerate() {
                                     *v = c[r][k] - p[r][k];
                                 }
                             }
-                            (0..3).all(|i| d[i][i] > 0.0).then_some(d)
+                            let (sn, cs) = yaw.sin_cos();
+                            let rt = [[cs, sn, 0.0], [-sn, cs, 0.0], [0.0, 0.0, 1.0]];
+                            let mut b = [[0.0; 3]; 3];
+                            for (i, row) in b.iter_mut().enumerate() {
+                                for (j, v) in row.iter_mut().enumerate() {
+                                    *v = (0..3)
+                                        .map(|a| (0..3).map(|k| rt[i][a] * d[a][k] * rt[j][k]).sum::<f64>())
+                                        .sum();
+                                }
+                            }
+                            (0..3).all(|i| b[i][i] > 0.0).then_some(b)
                         }
                         _ => None,
                     };
-                    prev = m.covariance;
+                    prev = m.covariance.map(|c| (c, m.pose.theta));
                     out.push(EstimatorInput::Odometry {
                         stamp: offset(m.stamp, s),
                         pose: m.pose,
@@ -143,17 +174,23 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                 }
                 let msgs = &inv.imu[&s.topic];
                 let frame = s.sensor.frame.clone().or_else(|| inv.frames.get(&s.topic).cloned()).unwrap_or_default();
-                let (m3, _) = mount(s, &tree, &cfg.base_frame, &frame, msgs.first().map(|m| m.stamp));
+                let m3 = mount(s, cfg, &tree, &frame, msgs.first().map(|m| m.stamp), &mut notes)?;
                 let r = m3.rotation();
                 let q_mount = m3.quaternion();
                 for m in msgs {
-                    let w = m.angular_velocity;
-                    // The z component of R · ω: the yaw rate of base_link.
-                    let yaw_rate = r[2][0] * w[0] + r[2][1] * w[1] + r[2][2] * w[2];
-                    let var = m.rate_variance;
-                    let variance = (var.is_finite() && var > 0.0).then_some(var);
                     let stamp = offset(m.stamp, s);
-                    out.push(EstimatorInput::Gyro { stamp, yaw_rate, variance });
+                    // `angular_velocity_covariance[0] = -1`: no rate in this message.
+                    if m.rate_covariance[0] != -1.0 {
+                        let w = m.angular_velocity;
+                        // The z component of R · ω: the yaw rate of base_link; its variance
+                        // the (z, z) entry of R Σ Rᵀ.
+                        let yaw_rate = r[2][0] * w[0] + r[2][1] * w[1] + r[2][2] * w[2];
+                        let c = &m.rate_covariance;
+                        let var: f64 =
+                            (0..3).map(|a| (0..3).map(|b| r[2][a] * c[a * 3 + b] * r[2][b]).sum::<f64>()).sum();
+                        let variance = (var.is_finite() && var > 0.0).then_some(var);
+                        out.push(EstimatorInput::Gyro { stamp, yaw_rate, variance });
+                    }
                     if let Some((orientation, var)) = m.orientation.filter(|_| s.sensor.use_orientation) {
                         // world_from_base = world_from_imu · (base_from_imu)⁻¹.
                         let world_from_imu = Pose3::new([0.0; 3], orientation);
@@ -166,10 +203,11 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                 }
             }
             SensorKind::Gnss => {
-                let (inputs, report, n) = gnss_inputs(s, inv, &tree, &cfg.base_frame)?;
+                let (inputs, mut report, n) = gnss_inputs(s, inv, &tree, cfg, datum)?;
                 out.extend(inputs);
                 notes.extend(n);
-                gnss_report = Some(report);
+                report.topic = s.topic.clone();
+                gnss_reports.push(report);
             }
             SensorKind::Pose => {
                 let (ps, yaw) = s.sensor.pose_noise;
@@ -187,34 +225,43 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
             SensorKind::Lidar => {}
         }
     }
-    Ok(Inputs { inputs: out, gnss: gnss_report, config: est, notes })
+    Ok(Inputs { inputs: out, gnss: gnss_reports, config: est, notes })
+}
+
+/// One map frame for every GNSS sensor: the first configured datum, else the earliest good
+/// fix of any GNSS topic (two receivers must not get two ENU frames metres apart).
+fn shared_datum(inv: &Inventory, bound: &Bound) -> Option<((f64, f64, f64), &'static str)> {
+    let gnss = bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::Gnss);
+    if let Some([lat, lon, alt]) = gnss.clone().find_map(|s| s.sensor.datum) {
+        return Some(((lat, lon, alt), "config"));
+    }
+    gnss.flat_map(|s| inv.gnss[&s.topic].iter())
+        .filter(|f| usable_fix(f) && f.altitude.is_finite())
+        .min_by_key(|f| f.stamp)
+        .map(|f| ((f.latitude, f.longitude, f.altitude), "first good fix"))
+}
+
+/// A fix with a position: not `NO_FIX`, latitude and longitude finite (the doctor's rule
+/// too).
+pub fn usable_fix(f: &GnssMessage) -> bool {
+    f.status != GnssMessage::STATUS_NO_FIX && f.latitude.is_finite() && f.longitude.is_finite()
 }
 
 fn gnss_inputs(
     s: &BoundSensor,
     inv: &Inventory,
     tree: &FrameTree,
-    base: &str,
+    cfg: &LogConfig,
+    datum: Option<((f64, f64, f64), &'static str)>,
 ) -> Result<(Vec<EstimatorInput>, GnssInputReport, Vec<String>), PipelineError> {
     let msgs = &inv.gnss[&s.topic];
     let mut r = GnssInputReport { read: msgs.len() as u64, ..Default::default() };
     let mut notes = Vec::new();
-    let good = |f: &&GnssMessage| {
-        f.status != GnssMessage::STATUS_NO_FIX
-            && f.latitude.is_finite()
-            && f.longitude.is_finite()
-            && f.altitude.is_finite()
-    };
-    let datum = match s.sensor.datum {
-        Some([lat, lon, alt]) => {
-            r.datum_source = "config".into();
-            Some((lat, lon, alt))
-        }
-        None => msgs.iter().find(good).map(|f| {
-            r.datum_source = "first good fix".into();
-            (f.latitude, f.longitude, f.altitude)
-        }),
-    };
+    let good = |f: &&GnssMessage| usable_fix(f) && f.altitude.is_finite();
+    if let Some((_, src)) = datum {
+        r.datum_source = src.to_string();
+    }
+    let datum = datum.map(|d| d.0);
     let Some((lat0, lon0, alt0)) = datum else {
         notes.push(format!(
             "GNSS `{}`: {} messages but no usable fix and no datum configured: the fixes are not used",
@@ -228,7 +275,7 @@ fn gnss_inputs(
         Datum::new(lat0, lon0, alt0).map_err(|e| PipelineError::Refused(format!("GNSS `{}`: datum: {e}", s.topic)))?;
     r.datum = Some([lat0, lon0, alt0]);
     let frame = s.sensor.frame.clone().or_else(|| msgs.first().map(|m| m.frame_id.clone())).unwrap_or_default();
-    let (lever, _) = mount(s, tree, base, &frame, msgs.first().map(|m| m.stamp));
+    let lever = mount(s, cfg, tree, &frame, msgs.first().map(|m| m.stamp), &mut notes)?;
     r.lever_arm = Some([lever.x, lever.y]);
     let floors = s.sensor.gnss;
     let mut out = Vec::new();
@@ -292,7 +339,14 @@ pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Ch
     report.insert("inputs", serde_json::Value::from(inputs.len()));
     let stamps: Vec<Stamp> = odom.map(|o| inv.odom[&o.topic].iter().map(|m| m.stamp).collect()).unwrap_or_default();
     let receive = odom.map(|o| inv.odom[&o.topic].iter().map(|m| m.receive_stamp).collect()).unwrap_or_default();
-    let counts = TrackCounts { samples: inputs.len() as u64, used: e.smoothed.len() as u64, ..Default::default() };
+    // The track's own counters are the odometry's: the samples the track is built on.
+    let counts = TrackCounts {
+        samples: e.report.odometry.received as u64,
+        used: e.report.odometry.used as u64,
+        duplicates: e.report.odometry.duplicate_stamps as u64,
+        not_finite: e.report.odometry.not_finite as u64,
+        ..Default::default()
+    };
     Ok(ChosenTrack {
         source: PoseSource::Estimator,
         track: Track::Timed(Box::new(e)),

@@ -35,6 +35,9 @@ pub struct StreamStats {
     /// The largest gap, in key units, between this stream's newest key and the newest key
     /// of all streams at a release: how far this stream lagged behind the others.
     pub max_lag: i64,
+    /// Messages that jumped far ahead of their stream and were not followed there: a glitched
+    /// stamp, which does not move the merge's clock (it is still released, last).
+    pub jumps: u64,
 }
 
 struct Queued<T> {
@@ -81,6 +84,7 @@ pub struct OrderedMerge<T> {
     newest: Option<i64>,
     released: Option<i64>,
     newest_of: Vec<Option<i64>>,
+    pending_jump: Vec<Option<i64>>,
     stats: Vec<StreamStats>,
     peak: usize,
 }
@@ -95,6 +99,7 @@ impl<T> OrderedMerge<T> {
             newest: None,
             released: None,
             newest_of: Vec::new(),
+            pending_jump: Vec::new(),
             stats: Vec::new(),
             peak: 0,
         }
@@ -104,6 +109,7 @@ impl<T> OrderedMerge<T> {
     pub fn add_stream(&mut self, name: impl Into<String>) -> usize {
         self.stats.push(StreamStats { name: name.into(), ..Default::default() });
         self.newest_of.push(None);
+        self.pending_jump.push(None);
         self.stats.len() - 1
     }
 
@@ -118,11 +124,34 @@ impl<T> OrderedMerge<T> {
             st.late += 1;
             return Pushed::Late;
         }
-        match self.newest_of[stream] {
-            Some(n) if key < n => st.reordered += 1,
-            _ => self.newest_of[stream] = Some(key),
+        // A key far ahead of its stream moves the clock only once a second message confirms
+        // the stream went there: one glitched stamp must not release everything at once
+        // and make every later message of every stream late.
+        let jump = self.window.saturating_mul(10).max(1);
+        let advance = match self.newest_of[stream] {
+            Some(n) if key < n => {
+                st.reordered += 1;
+                self.pending_jump[stream] = None;
+                false
+            }
+            Some(n) if self.window > 0 && key.saturating_sub(n) > jump => match self.pending_jump[stream].take() {
+                Some(_) => true,
+                None => {
+                    self.pending_jump[stream] = Some(key);
+                    st.jumps += 1;
+                    false
+                }
+            },
+            _ => {
+                self.pending_jump[stream] = None;
+                true
+            }
+        };
+        if advance {
+            self.pending_jump[stream] = None;
+            self.newest_of[stream] = Some(self.newest_of[stream].map_or(key, |n| n.max(key)));
+            self.newest = Some(self.newest.map_or(key, |n| n.max(key)));
         }
-        self.newest = Some(self.newest.map_or(key, |n| n.max(key)));
         self.heap.push(Reverse(Queued { key, seq: self.seq, stream, item }));
         self.seq += 1;
         self.peak = self.peak.max(self.heap.len());
@@ -217,6 +246,40 @@ mod tests {
         assert_eq!(m.push(a, 25, 0), Pushed::Queued);
         assert_eq!(m.stats()[a].late, 1);
         assert_eq!(m.stats()[a].reordered, 1);
+    }
+
+    #[test]
+    fn one_glitched_stamp_does_not_make_the_rest_late() {
+        let mut m = OrderedMerge::new(10);
+        let a = m.add_stream("a");
+        let b = m.add_stream("b");
+        let mut out = Vec::new();
+        for k in 0..100i64 {
+            if k == 20 {
+                m.push(a, 1_000_000, 0);
+            }
+            // b arrives slightly behind a, within the window.
+            m.push(a, k * 5, 0);
+            m.push(b, k * 5 - 3, 0);
+            drain(&mut m, &mut out);
+        }
+        while let Some(x) = m.pop_final() {
+            out.push(x);
+        }
+        assert_eq!(m.stats()[b].late, 0, "{:?}", m.stats());
+        assert_eq!(m.stats()[a].late, 0);
+        assert_eq!(m.stats()[a].jumps, 1);
+        assert_eq!(out.len(), 201);
+        assert_eq!(out.last().map(|x| x.1), Some(1_000_000), "the glitch is released last");
+        // A real jump (the stream moved on) is followed after one confirming message.
+        let mut m = OrderedMerge::new(10);
+        let a = m.add_stream("a");
+        let mut out = Vec::new();
+        for k in [0, 5, 10, 1000, 1005, 1010, 1015, 1020, 1025] {
+            m.push(a, k, 0);
+            drain(&mut m, &mut out);
+        }
+        assert!(out.len() >= 6, "{out:?}");
     }
 
     #[test]

@@ -24,7 +24,7 @@ pub fn gnss_quality(inv: &Inventory, out: &mut String, findings: &mut Vec<String
         let mut bins = [[0u64; 4]; 10];
         for f in fixes {
             let b = (((f.stamp.0 - first.0) as i128 * 10 / span as i128) as usize).min(9);
-            let k = if !usable(f) {
+            let k = if !crate::estimation::usable_fix(f) {
                 3
             } else {
                 match f.status {
@@ -39,7 +39,7 @@ pub fn gnss_quality(inv: &Inventory, out: &mut String, findings: &mut Vec<String
             let (a, z) = (span as f64 * i as f64 / 10.0 * 1e-9, span as f64 * (i + 1) as f64 / 10.0 * 1e-9);
             writeln!(out, "| {a:.1} | {z:.1} | {} | {} | {} | {} |", b[0], b[1], b[2], b[3])?;
         }
-        let mut good: Vec<Stamp> = fixes.iter().filter(|f| usable(f)).map(|f| f.stamp).collect();
+        let mut good: Vec<Stamp> = fixes.iter().filter(|f| crate::estimation::usable_fix(f)).map(|f| f.stamp).collect();
         good.sort_unstable();
         if good.is_empty() {
             findings.push(format!("{topic}: no usable fix at all (every one NO_FIX or NaN)"));
@@ -58,10 +58,6 @@ pub fn gnss_quality(inv: &Inventory, out: &mut String, findings: &mut Vec<String
         }
     }
     Ok(())
-}
-
-fn usable(f: &GnssMessage) -> bool {
-    f.status != GnssMessage::STATUS_NO_FIX && f.latitude.is_finite() && f.longitude.is_finite()
 }
 
 /// Odometry turn rate against the gyro's, over one-second windows.

@@ -63,8 +63,9 @@ pub struct ImuSample {
     pub receive_stamp: Option<Stamp>,
     /// Angular velocity in the IMU's frame, rad/s.
     pub angular_velocity: [f64; 3],
-    /// `angular_velocity_covariance[8]` (z variance), as the message gives it.
-    pub rate_variance: f64,
+    /// `angular_velocity_covariance`, row-major in the IMU's frame; `[0] = -1` means the
+    /// message carries no rate (sensor_msgs/Imu).
+    pub rate_covariance: [f64; 9],
     /// The orientation and `orientation_covariance[8]` (yaw variance), when the message
     /// provides one (REP 145).
     pub orientation: Option<([f64; 4], f64)>,
@@ -101,7 +102,7 @@ impl From<&ImuMessage> for ImuSample {
             stamp: m.stamp,
             receive_stamp: m.receive_stamp,
             angular_velocity: m.angular_velocity,
-            rate_variance: m.angular_velocity_covariance[8],
+            rate_covariance: m.angular_velocity_covariance,
             orientation: m.has_orientation().then_some((m.orientation, m.orientation_covariance[8])),
         }
     }

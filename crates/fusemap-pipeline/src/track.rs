@@ -176,20 +176,38 @@ pub fn choose(
 ) -> Result<ChosenTrack, PipelineError> {
     let lines_have_poses = bound.lidars.iter().any(|l| inv.scans.get(&l.topic).is_some_and(|t| t.with_pose > 0));
     let odom = bound.first(SensorKind::WheelOdometry);
+    // TF: the base frame's own dynamic edge, and every dynamic edge on its chain to the
+    // root (`odom → base_footprint → base_link` with a static last edge; a leading `/`, as
+    // ROS 1 writes frames, is not part of the name).
+    let strip = |f: &str| f.strip_prefix('/').unwrap_or(f).to_string();
+    let base = strip(&cfg.base_frame);
+    let (tree, _) = crate::extrinsics::frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
+    let mut chain = vec![base.clone()];
+    while let Some(p) = tree.parent(chain.last().map_or("", |s| s.as_str())) {
+        if chain.len() > 1000 || chain.iter().any(|c| c == p) {
+            break;
+        }
+        chain.push(p.to_string());
+    }
     let tf_samples: Vec<(Stamp, Pose2)> = inv
         .tf_dynamic
         .iter()
-        .filter(|t| t.child == cfg.base_frame)
+        .filter(|t| strip(&t.child) == base)
         .map(|t| {
             let m = Mount3::from_translation_quaternion(t.translation, t.rotation);
             (t.stamp, Pose2::new(m.x, m.y, m.yaw))
         })
         .collect();
+    let mut chain_stamps: Vec<Stamp> =
+        inv.tf_dynamic.iter().filter(|t| chain.contains(&strip(&t.child))).map(|t| t.stamp).collect();
+    chain_stamps.sort_unstable();
+    chain_stamps.dedup();
     let source = match cfg.pose_source {
         PoseSource::Auto if lines_have_poses => PoseSource::ScanLine,
-        PoseSource::Auto if has_fusion_sensors(bound) => PoseSource::Estimator,
+        // The estimator's motion model is the wheel odometry: without it, TF is next.
+        PoseSource::Auto if odom.is_some() && has_fusion_sensors(bound) => PoseSource::Estimator,
         PoseSource::Auto if odom.is_some() => PoseSource::Odometry,
-        PoseSource::Auto if !tf_samples.is_empty() => PoseSource::Tf,
+        PoseSource::Auto if !chain_stamps.is_empty() => PoseSource::Tf,
         PoseSource::Auto => {
             return Err(PipelineError::Refused(format!(
                 "the log has no poses: no pose on scan lines, no odometry topic, no TF to `{}`",
@@ -245,30 +263,30 @@ pub fn choose(
             })
         }
         PoseSource::Tf => {
-            let (tree, _) = crate::extrinsics::frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
-            let root = TfTrack::root_of(&tree, &cfg.base_frame);
-            let parent = tree.parent(&cfg.base_frame).map(str::to_string);
-            if let (Some(root), Some(parent)) = (root, parent) {
-                if root != parent {
-                    // More than one edge above the base: compose them at each stamp.
-                    let mut stamps: Vec<Stamp> = tf_samples.iter().map(|s| s.0).collect();
-                    stamps.sort_unstable();
-                    stamps.dedup();
-                    counts.samples = stamps.len() as u64;
-                    let name = format!("TF `{root} → … → {}`", cfg.base_frame);
-                    let track = TfTrack { tree, root, base: cfg.base_frame.clone(), stamps: stamps.clone() };
-                    counts.used = track.samples().len() as u64;
-                    return Ok(ChosenTrack {
-                        source,
-                        track: Track::Timed(Box::new(track)),
-                        name,
-                        counts,
-                        receive: vec![None; stamps.len()],
-                        stamps,
-                        estimator: None,
-                        notes: Vec::new(),
-                    });
+            let root = TfTrack::root_of(&tree, &base);
+            let parent = tree.parent(&base).map(str::to_string);
+            let single_edge = root.is_some() && root == parent && !tf_samples.is_empty();
+            if let (Some(root), false) = (root, single_edge) {
+                // Several edges above the base, or a static one under a dynamic one: compose
+                // the chain at each stamp where one of its dynamic edges has a sample.
+                let stamps = chain_stamps;
+                counts.samples = stamps.len() as u64;
+                let name = format!("TF `{root} → … → {base}`");
+                let track = TfTrack { tree, root, base, stamps: stamps.clone() };
+                counts.used = track.samples().len() as u64;
+                if counts.used == 0 {
+                    return Err(PipelineError::Refused(format!("no usable TF pose of `{}`", cfg.base_frame)));
                 }
+                return Ok(ChosenTrack {
+                    source,
+                    track: Track::Timed(Box::new(track)),
+                    name,
+                    counts,
+                    receive: vec![None; stamps.len()],
+                    stamps,
+                    estimator: None,
+                    notes: Vec::new(),
+                });
             }
             let stamps: Vec<Stamp> = tf_samples.iter().map(|s| s.0).collect();
             let buffer = buffer_of(cfg, tf_samples, &mut counts);

@@ -72,7 +72,7 @@ fn broken_messages_are_counted_and_the_log_still_maps() {
     }
     let run = map(&rec, "bad-pose-sensors", &Config::default()).expect("the log still maps");
     let l = serde_json::to_value(&run.report).unwrap();
-    let g = &l["estimator"]["gnss_input"];
+    let g = &l["estimator"]["gnss_input"][0];
     println!("gnss input: {g}");
     assert_eq!(g["not_finite"], fixes / 10 + u64::from(fixes % 10 >= 1));
     assert_eq!(g["no_fix"], fixes / 10 + u64::from(fixes % 10 >= 3));
@@ -105,8 +105,8 @@ fn a_gnss_topic_without_a_fix_says_so_and_maps_on_odometry_and_gyro() {
     cfg.sensor.push(SensorConfig { datum: Some([48.1, 11.5, 500.0]), ..SensorConfig::new(SensorKind::Gnss) });
     let run = map(&rec, "gnss-no-fix-datum", &cfg).expect("maps");
     let l = serde_json::to_value(&run.report).unwrap();
-    assert_eq!(l["estimator"]["gnss_input"]["passed"], 0);
-    assert!(l["estimator"]["gnss_input"]["no_fix"].as_u64().unwrap() > 100);
+    assert_eq!(l["estimator"]["gnss_input"][0]["passed"], 0);
+    assert!(l["estimator"]["gnss_input"][0]["no_fix"].as_u64().unwrap() > 100);
 }
 
 /// An IMU that reports its orientation (REP 145: a covariance, not −1) gives the

@@ -21,12 +21,14 @@ fn tf(stamp: fusemap_core::time::Stamp, parent: &str, child: &str, x: f64, y: f6
     }
 }
 
-#[test]
-fn map_odom_and_base_compose_at_each_stamp() {
+/// Writes the 20 s production line with its odometry as TF only: `odom → BASE` from each
+/// odometry message, plus `map → odom` (10 m east, turned 90°) at 10 Hz when `localiser`,
+/// plus a static `base_footprint → base_link` when BASE is `/base_footprint`.
+fn bag_with_tf(tag: &str, base: &str, localiser: bool) -> std::path::PathBuf {
     let mut s = Scenario::default();
     s.robot.duration_s = 20.0;
     let rec = simulate(&s).unwrap();
-    let dir = fusemap_io::testdata::temp_dir("tf-chain");
+    let dir = fusemap_io::testdata::temp_dir(tag);
     let bag = dir.join("bag");
     let mut w =
         Rosbag2Writer::create_with(&bag, Rosbag2WriterOptions { overwrite: true, ..Default::default() }).unwrap();
@@ -40,8 +42,15 @@ fn map_odom_and_base_compose_at_each_stamp() {
                 // odom → base_link from the odometry, and a localiser's map → odom at 10 Hz:
                 // 10 m east, turned 90°.
                 let yaw = fusemap_core::geometry::quaternion_yaw(o.orientation);
-                w.write(o.stamp, "/tf", &tf(o.stamp, "odom", "base_link", o.position[0], o.position[1], yaw)).unwrap();
-                if n_odom % 5 == 0 {
+                w.write(o.stamp, "/tf", &tf(o.stamp, "odom", base, o.position[0], o.position[1], yaw)).unwrap();
+                if n_odom == 0 && base != "base_link" {
+                    let mut t = tf(o.stamp, base, "base_link", 0.0, 0.0, 0.0);
+                    if let OutMessage::Tf { is_static, .. } = &mut t {
+                        *is_static = true;
+                    }
+                    w.write(o.stamp, "/tf_static", &t).unwrap();
+                }
+                if localiser && n_odom % 5 == 0 {
                     w.write(o.stamp, "/tf", &tf(o.stamp, "map", "odom", 10.0, 0.0, std::f64::consts::FRAC_PI_2))
                         .unwrap();
                 }
@@ -51,6 +60,12 @@ fn map_odom_and_base_compose_at_each_stamp() {
         }
     }
     w.finish().unwrap();
+    bag
+}
+
+#[test]
+fn map_odom_and_base_compose_at_each_stamp() {
+    let bag = bag_with_tf("tf-chain", "base_link", true);
     let mut cfg = Config::default();
     cfg.log.pose_source = PoseSource::Tf;
     let run = map_log(&cfg.validate().unwrap(), &bag, &mut |_| {}).unwrap();
@@ -63,4 +78,15 @@ fn map_odom_and_base_compose_at_each_stamp() {
     // Later, the odometry's forward motion (east in odom) shows as north in map.
     let (_, q) = run.trajectory[run.trajectory.len() / 2];
     assert!(q.y > 3.0 && (q.x - 10.0).abs() < 1.0, "{q:?}");
+}
+
+/// `odom → /base_footprint` on /tf (a ROS 1 leading slash) and a static `base_footprint →
+/// base_link`, no odometry topic: `auto` finds the chain and maps with it.
+#[test]
+fn a_static_edge_under_the_dynamic_one_and_a_leading_slash_are_followed() {
+    let bag = bag_with_tf("tf-footprint", "/base_footprint", false);
+    let run = map_log(&Config::default().validate().unwrap(), &bag, &mut |_| {}).unwrap();
+    assert!(run.report.pose_source.starts_with("TF `odom → … → base_link`"), "{}", run.report.pose_source);
+    assert!(run.report.scans_used > 190, "{}", run.report.scans_used);
+    assert!(run.trajectory.len() > 900, "{}", run.trajectory.len());
 }

@@ -48,7 +48,7 @@ fn a_simulated_bag_maps_with_the_estimator_and_a_third_party_copy_maps_the_same(
     let l = &s["log"];
     assert!(l["pose_source"].as_str().unwrap().starts_with("estimator ("), "{}", l["pose_source"]);
     assert_eq!(l["scans_read"], 1800);
-    assert_eq!(l["estimator"]["gnss_input"]["datum_source"], "config");
+    assert_eq!(l["estimator"]["gnss_input"][0]["datum_source"], "config");
     assert!(l["estimator"]["estimator"]["fixes"]["used"].as_u64().unwrap() > 600);
     let tum = std::fs::read_to_string(out.join("trajectory.tum")).expect("trajectory.tum");
     assert!(tum.lines().filter(|l| !l.starts_with('#')).count() > 8000, "one pose per odometry step");

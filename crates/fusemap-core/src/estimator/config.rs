@@ -111,6 +111,10 @@ pub struct EstimatorConfig {
     /// The same for RTK fixed solutions (`STATUS_GBAS_FIX`), whose centimetre errors are
     /// close to white, seconds.
     pub rtk_fix_correlation_time_s: f64,
+    /// A fix reported as RTK (`STATUS_GBAS_FIX`) counts as an RTK fixed solution only when
+    /// its σ is at most this, metres: drivers report RTK float and WAAS with the same
+    /// status, and their decimetre errors are correlated like a plain fix's.
+    pub rtk_fix_max_sigma_m: f64,
     /// Test every accepted fix again against the smoothed track and, if any fails the
     /// gate, run the estimate once more without them.
     pub smoothed_fix_gate: bool,
@@ -156,6 +160,7 @@ impl Default for EstimatorConfig {
             max_sample_gap_s: 1.0,
             fix_correlation_time_s: 10.0,
             rtk_fix_correlation_time_s: 0.0,
+            rtk_fix_max_sigma_m: 0.05,
             smoothed_fix_gate: true,
         }
     }
@@ -185,6 +190,7 @@ impl EstimatorConfig {
             ("slip_fix_max_sigma_m", self.slip_fix_max_sigma_m),
             ("stationary_min_s", self.stationary_min_s),
             ("max_sample_gap_s", self.max_sample_gap_s),
+            ("rtk_fix_max_sigma_m", self.rtk_fix_max_sigma_m),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {

@@ -61,8 +61,11 @@ impl Filter<'_> {
         match *c {
             Correction::Position { z, r, antenna, quality } => {
                 let (nu, h) = models::position(&self.x, z, antenna);
+                // Drivers report RTK float (and WAAS) as GBAS_FIX too: only a fix that also
+                // claims centimetres is taken as an RTK fixed solution with white errors.
+                let rtk_var = self.cfg.rtk_fix_max_sigma_m * self.cfg.rtk_fix_max_sigma_m;
                 let tau = match quality {
-                    FixQuality::RtkFixed => self.cfg.rtk_fix_correlation_time_s,
+                    FixQuality::RtkFixed if r[0][0].max(r[1][1]) <= rtk_var => self.cfg.rtk_fix_correlation_time_s,
                     _ => self.cfg.fix_correlation_time_s,
                 };
                 let interval = self.last_fix.map_or(f64::INFINITY, |l| stamp.secs_since(l));

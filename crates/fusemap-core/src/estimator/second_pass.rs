@@ -19,13 +19,17 @@ use super::{EstimatorInput, FixRejection, RejectedFix};
 use crate::time::Stamp;
 use std::collections::HashSet;
 
-/// The accepted fixes of `first` that fail the gate against its smoothed track, with their
-/// NIS.
-pub(crate) fn flagged_fixes(inputs: &[EstimatorInput], first: &Estimate, gate_probability: f64) -> Vec<(Stamp, f64)> {
+/// The accepted fixes of `first` that fail the gate against its smoothed track: their index
+/// in `inputs`, stamp and NIS.
+pub(crate) fn flagged_fixes(
+    inputs: &[EstimatorInput],
+    first: &Estimate,
+    gate_probability: f64,
+) -> Vec<(usize, Stamp, f64)> {
     let Some(gate) = chi_square_quantile(2, gate_probability) else { return Vec::new() };
     let rejected: HashSet<Stamp> = first.report.rejected_fixes.iter().map(|r| r.stamp).collect();
     let mut out = Vec::new();
-    for i in inputs {
+    for (index, i) in inputs.iter().enumerate() {
         let EstimatorInput::Position { stamp, enu, covariance, antenna, .. } = *i else { continue };
         if rejected.contains(&stamp) {
             continue;
@@ -47,7 +51,7 @@ pub(crate) fn flagged_fixes(inputs: &[EstimatorInput], first: &Estimate, gate_pr
         let Some(si) = spd_inverse(&s) else { continue };
         let nis = (0..2).map(|a| (0..2).map(|b| nu[a] * si[a][b] * nu[b]).sum::<f64>()).sum::<f64>();
         if nis > gate {
-            out.push((stamp, nis));
+            out.push((index, stamp, nis));
         }
     }
     out
@@ -68,21 +72,21 @@ pub(crate) fn estimate_with_hindsight(
     }
     // The first estimate is not needed any more: free it before the second is built.
     drop(first);
-    let drop: HashSet<Stamp> = flagged.iter().map(|f| f.0).collect();
-    let kept: Vec<EstimatorInput> = inputs
-        .iter()
-        .filter(|i| !matches!(i, EstimatorInput::Position { stamp, .. } if drop.contains(stamp)))
-        .cloned()
-        .collect();
+    let drop: HashSet<usize> = flagged.iter().map(|f| f.0).collect();
+    let kept: Vec<EstimatorInput> =
+        inputs.iter().enumerate().filter(|(i, _)| !drop.contains(i)).map(|(_, x)| x.clone()).collect();
     let mut second = super::estimate_once(&kept, cfg)?;
     let r = &mut second.report;
     r.fixes.received += flagged.len();
     r.fixes.rejected_smoothed_gate += flagged.len();
-    r.rejected_fixes.extend(flagged.iter().map(|&(stamp, nis)| RejectedFix {
-        stamp,
-        reason: FixRejection::SmoothedGate,
-        nis,
-    }));
+    for &(index, stamp, nis) in &flagged {
+        if let EstimatorInput::Position { quality, .. } = inputs[index] {
+            if let Some(q) = r.fixes_by_quality.iter_mut().find(|q| q.quality == quality) {
+                q.received += 1;
+            }
+        }
+        r.rejected_fixes.push(RejectedFix { stamp, reason: FixRejection::SmoothedGate, nis });
+    }
     r.rejected_fixes.sort_by_key(|f| f.stamp);
     Ok(second)
 }
