@@ -51,6 +51,23 @@ pub fn skip(reason: &str) {
     eprintln!("SKIPPED: {reason}");
 }
 
+/// `$FUSEMAP_PYTHON`, else `python3`, when it imports every module of `modules`; else a
+/// skip notice (a failure under `FUSEMAP_NO_SKIP=1`) and `None`.
+pub fn python_with(modules: &[&str]) -> Option<String> {
+    let python = std::env::var("FUSEMAP_PYTHON").unwrap_or_else(|_| "python3".into());
+    let code: String = modules.iter().map(|m| format!("import {m}\n")).collect();
+    let ok = std::process::Command::new(&python).args(["-c", &code]).output().is_ok_and(|o| o.status.success());
+    if ok {
+        Some(python)
+    } else {
+        skip(&format!(
+            "`{python}` cannot import {} (pip install -r tests/fixtures/requirements.txt)",
+            modules.join(", ")
+        ));
+        None
+    }
+}
+
 /// A fresh empty directory for one test: `fusemap-{tag}-{pid}-{n}` under the system temp
 /// dir, unique per call within the process.
 pub fn temp_dir(tag: &str) -> PathBuf {

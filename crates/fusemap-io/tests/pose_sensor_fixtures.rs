@@ -11,21 +11,8 @@ use fusemap_io::testdata;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// `$FUSEMAP_PYTHON`, else `python3`, if it can import rosbags.
 fn python_with_rosbags() -> Option<String> {
-    let python = std::env::var("FUSEMAP_PYTHON").unwrap_or_else(|_| "python3".into());
-    let ok = Command::new(&python)
-        .args(["-c", "import rosbags.rosbag1, rosbags.rosbag2, numpy"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if ok {
-        Some(python)
-    } else {
-        testdata::skip(&format!(
-            "`{python}` cannot import rosbags and numpy (pip install -r tests/fixtures/requirements.txt)"
-        ));
-        None
-    }
+    testdata::python_with(&["rosbags.rosbag1", "rosbags.rosbag2", "numpy"])
 }
 
 /// One message reduced to what both sides can state: topic, log time, header stamp

@@ -23,21 +23,8 @@ use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// `$FUSEMAP_PYTHON`, else `python3`, if it can import rosbags and mcap_ros2.
 fn python_with_rosbags() -> Option<String> {
-    let python = std::env::var("FUSEMAP_PYTHON").unwrap_or_else(|_| "python3".into());
-    let ok = Command::new(&python)
-        .args(["-c", "import rosbags.rosbag2, rosbags.typesys, numpy, mcap.reader, mcap_ros2.decoder"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if ok {
-        Some(python)
-    } else {
-        testdata::skip(&format!(
-            "`{python}` cannot import rosbags, numpy and mcap_ros2 (pip install -r tests/fixtures/requirements.txt)"
-        ));
-        None
-    }
+    testdata::python_with(&["rosbags.rosbag2", "rosbags.typesys", "numpy", "mcap.reader", "mcap_ros2.decoder"])
 }
 
 /// A float as the comparison expects it: compared by value with the repr python prints.

@@ -3,13 +3,8 @@
 //! estimator, and the same messages rewritten by rosbags' own writer giving the same map
 //! and trajectory byte for byte.
 
-use crate::util::{repo_root, run, stderr, stdout, temp_dir};
+use crate::util::{python, python_with, repo_root, run, stderr, stdout, temp_dir};
 use std::path::Path;
-use std::process::Command;
-
-fn python() -> String {
-    std::env::var("FUSEMAP_PYTHON").unwrap_or_else(|_| "python3".into())
-}
 
 fn summary(dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(dir.join("summary.json")).expect("summary.json")).expect("JSON")
@@ -55,16 +50,11 @@ fn a_simulated_bag_maps_with_the_estimator_and_a_third_party_copy_maps_the_same(
 
     // A third-party reader: rosbags reads every topic with its type, count and ordered
     // log times; its writer copies the bag.
-    let python = python();
-    let imports = "import rosbags.rosbag2";
-    if !Command::new(&python).args(["-c", imports]).output().is_ok_and(|o| o.status.success()) {
-        fusemap_io::testdata::skip(&format!(
-            "`{python}` cannot import rosbags (pip install -r tests/fixtures/requirements.txt)"
-        ));
+    if !python_with(&["rosbags.rosbag2"]) {
         return;
     }
     let copy = d.join("rosbags_copy");
-    let o = Command::new(&python)
+    let o = python()
         .arg(repo_root().join("tests/fixtures/rewrite_rosbag2.py"))
         .arg(d.join("bag"))
         .arg(&copy)
