@@ -243,25 +243,11 @@ impl PoseMessage {
 /// (so that [`Pose2::is_finite`] is false and the consumer rejects it), never the
 /// identity a naive `atan2(0, 0)` would give.
 ///
-/// [`quaternion_yaw`]'s `atan2(2(wz + xy), 1 − 2(y² + z²))` holds for a unit quaternion
-/// only; a quaternion whose squared norm is further than [`UNIT_QUATERNION_TOLERANCE`]
-/// from 1 (float32-rounded, or written scaled: it is the same rotation) is normalised
-/// first. One that is unit up to float64 rounding is used as written, so its yaw is
-/// exactly what it was before.
+/// A scaled quaternion (float32-rounded, or written scaled: the same rotation) is
+/// normalised by [`quaternion_yaw`] itself; a unit one is used as written.
 pub fn planar_pose(position: [f64; 3], orientation: [f64; 4]) -> Pose2 {
-    let n2: f64 = orientation.iter().map(|c| c * c).sum();
-    let q = if (n2 - 1.0).abs() <= UNIT_QUATERNION_TOLERANCE || !(n2.is_finite() && n2 > 0.0) {
-        orientation
-    } else {
-        let n = n2.sqrt();
-        orientation.map(|c| c / n)
-    };
-    Pose2::new(position[0], position[1], quaternion_yaw(q))
+    Pose2::new(position[0], position[1], quaternion_yaw(orientation))
 }
-
-/// How far a quaternion's squared norm may be from 1 for [`planar_pose`] to use it
-/// without normalising: the yaw error of doing so is of the same order, 1e-12 rad.
-pub const UNIT_QUATERNION_TOLERANCE: f64 = 1e-12;
 
 /// One decoded message of a log.
 ///
