@@ -2,6 +2,8 @@
 //! [`RangeData`](crate::measurement::RangeData) the grid consumes. The model, not the
 //! grid, holds the sensor's parameters, so one map can take many sensors.
 
+pub mod camera;
 pub mod lidar;
 
+pub use camera::{DepthImage, ImageError, LabelImage};
 pub use lidar::{LaserScan, LidarModel, LidarParams, MaxRangePolicy, ReturnCounts};
