@@ -4,7 +4,7 @@
 
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::PlanarMount;
-use fusemap_core::grid::{GridGeometry, OccupancyGrid, OccupancyParams};
+use fusemap_core::grid::{FusionGrid, GridGeometry, OccupancyParams};
 use fusemap_core::sensor::LidarModel;
 use fusemap_core::sim::{workload, Workload};
 use std::sync::OnceLock;
@@ -14,7 +14,7 @@ fn main() {
 }
 
 fn map_all(w: &Workload, scans: usize) -> u64 {
-    let grid = OccupancyGrid::new(GridGeometry::centered(w.resolution).unwrap(), OccupancyParams::default());
+    let grid = FusionGrid::new(GridGeometry::centered(w.resolution).unwrap(), OccupancyParams::default());
     let mut e = Engine::new(grid);
     let id = e.add_lidar("laser", LidarModel::new(w.lidar, PlanarMount::default()));
     for (s, p) in w.run.scans.iter().zip(&w.run.poses).take(scans) {

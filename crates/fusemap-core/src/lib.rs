@@ -18,9 +18,9 @@
 //! | the validated run configuration | [`config`] |
 //!
 //! ```
-//! use fusemap_core::{config::Config, fusion::Engine, grid::OccupancyGrid, sim::SimulatedRun};
+//! use fusemap_core::{config::Config, fusion::Engine, grid::FusionGrid, sim::SimulatedRun};
 //! let plan = Config::default().validate().unwrap();
-//! let mut engine = Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy));
+//! let mut engine = Engine::new(FusionGrid::new(plan.geometry, plan.occupancy));
 //! let lidar = plan.lidars[0].clone();
 //! let laser = engine.add_lidar(lidar.name, lidar.model);
 //! let run = SimulatedRun::document_corridor();

@@ -4,7 +4,7 @@
 use fusemap_core::config::Config;
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Point2;
-use fusemap_core::grid::{CellIndex, OccupancyGrid, Ternary};
+use fusemap_core::grid::{CellIndex, FusionGrid, Ternary};
 use fusemap_core::metrics::{map_entropy, Confusion};
 use fusemap_core::sim::SimulatedRun;
 
@@ -14,7 +14,7 @@ fn corridor_map() -> Engine {
 
 fn corridor_map_with(config: Config) -> Engine {
     let plan = config.validate().unwrap();
-    let mut engine = Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy));
+    let mut engine = Engine::new(FusionGrid::new(plan.geometry, plan.occupancy));
     let laser = engine.add_lidar("laser", plan.lidars[0].model);
     let run = SimulatedRun::document_corridor();
     for (scan, pose) in run.scans.iter().zip(&run.poses) {
@@ -23,12 +23,12 @@ fn corridor_map_with(config: Config) -> Engine {
     engine
 }
 
-fn cell(g: &OccupancyGrid, x: f64, y: f64) -> CellIndex {
+fn cell(g: &FusionGrid, x: f64, y: f64) -> CellIndex {
     g.geometry().cell_of(Point2::new(x, y)).unwrap()
 }
 
 /// Cells on the walls within the scanned field: y = ±2 for x ∈ [0.5, 4], x = 4 for |y| < 2.
-fn wall_cells(g: &OccupancyGrid) -> Vec<CellIndex> {
+fn wall_cells(g: &FusionGrid) -> Vec<CellIndex> {
     let res = g.geometry().resolution();
     let mut v = Vec::new();
     let n = (3.5 / res).round() as i64;
@@ -180,7 +180,7 @@ fn fusion_of_more_scans_lowers_entropy() {
     // corridor) after 1 and after 40 scans: more evidence, lower entropy.
     let plan = Config::default().validate().unwrap();
     let run = SimulatedRun::document_corridor();
-    let mut engine = Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy));
+    let mut engine = Engine::new(FusionGrid::new(plan.geometry, plan.occupancy));
     let laser = engine.add_lidar("laser", plan.lidars[0].model);
     let mut after = Vec::new();
     for (i, (scan, pose)) in run.scans.iter().zip(&run.poses).enumerate() {

@@ -3,14 +3,14 @@
 
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::{PlanarMount, Pose2};
-use fusemap_core::grid::{GridGeometry, OccupancyGrid, OccupancyParams, Ternary};
+use fusemap_core::grid::{FusionGrid, GridGeometry, OccupancyParams, Ternary};
 use fusemap_core::sensor::{LaserScan, LidarModel, LidarParams, MaxRangePolicy};
 use fusemap_core::time::Stamp;
 
 const CORPUS: [f32; 8] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -1.0, 1e-9, 10.0, 25.0];
 
 fn map(policy: MaxRangePolicy) -> Engine {
-    let grid = OccupancyGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default());
+    let grid = FusionGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default());
     let mut e = Engine::new(grid);
     let params = LidarParams { max_range_policy: policy, ..Default::default() };
     let id = e.add_lidar("laser", LidarModel::new(params, PlanarMount::default()));

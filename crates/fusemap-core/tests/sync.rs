@@ -6,7 +6,7 @@
 //! their thickness is measured as the mean distance of occupied cells from the true walls.
 
 use fusemap_core::geometry::{PlanarMount, Pose2};
-use fusemap_core::grid::{CellIndex, GridGeometry, OccupancyGrid, OccupancyParams, Ternary};
+use fusemap_core::grid::{CellIndex, FusionGrid, GridGeometry, OccupancyParams, Ternary};
 use fusemap_core::sensor::{LaserScan, LidarModel, LidarParams};
 use fusemap_core::sim::{box_world, simulate_moving_scan, simulate_scan, BoxWorld, ScannerSpec};
 use fusemap_core::time::{PoseBuffer, Stamp, SyncMode};
@@ -27,7 +27,7 @@ fn spec() -> ScannerSpec {
 }
 
 /// Mean distance (in cells) of occupied cells from the nearest true wall, and their count.
-fn wall_spread(g: &OccupancyGrid, w: &BoxWorld) -> (f64, usize) {
+fn wall_spread(g: &FusionGrid, w: &BoxWorld) -> (f64, usize) {
     let b = g.known_box().unwrap();
     let res = g.geometry().resolution();
     let (mut sum, mut n) = (0.0, 0usize);
@@ -45,7 +45,7 @@ fn wall_spread(g: &OccupancyGrid, w: &BoxWorld) -> (f64, usize) {
 }
 
 fn engine() -> (Engine, SensorId) {
-    let grid = OccupancyGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default());
+    let grid = FusionGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default());
     let mut e = Engine::new(grid);
     let id = e.add_lidar(
         "laser",

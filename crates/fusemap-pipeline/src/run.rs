@@ -18,7 +18,7 @@ use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, SensorKind, SyncConfig};
 use fusemap_core::fusion::{Engine, MapSet};
 use fusemap_core::geometry::{PlanarMount, Pose2};
-use fusemap_core::grid::OccupancyGrid;
+use fusemap_core::grid::FusionGrid;
 use fusemap_core::measurement::{ObservationId, SensorId};
 use fusemap_core::sensor::{LaserScan, LidarModel};
 use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
@@ -181,7 +181,7 @@ pub fn map_with_track(
     let mut merge: OrderedMerge<ScanMessage> = OrderedMerge::new(window);
     let mut engine = match maps {
         Some(m) => Engine::with_maps(m),
-        None => Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy)),
+        None => Engine::new(FusionGrid::new(plan.geometry, plan.occupancy)),
     };
     let (tree, tree_notes) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
     notes.extend(tree_notes);

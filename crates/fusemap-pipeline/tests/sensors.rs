@@ -120,13 +120,13 @@ fn a_lidar_time_offset_moves_its_scans() {
 #[test]
 fn one_pass_feeds_several_maps_each_with_its_sensors() {
     use fusemap_core::fusion::{MapSet, SensorSelection};
-    use fusemap_core::grid::OccupancyGrid;
+    use fusemap_core::grid::FusionGrid;
     use fusemap_core::measurement::SensorId;
     use fusemap_pipeline::recording::Inventory;
     let plan = with(vec![lidar("/scan"), lidar("/scan_copy")]).validate().unwrap();
     let inv = Inventory::read(bag()).unwrap();
     let (bound, track, s) = fusemap_pipeline::run::prepare(&plan, &inv).unwrap();
-    let grid = || OccupancyGrid::new(plan.geometry, plan.occupancy);
+    let grid = || FusionGrid::new(plan.geometry, plan.occupancy);
     let maps = MapSet::new("both", SensorSelection::All, grid()).with(
         "first only",
         SensorSelection::Sensors(vec![SensorId(0)]),

@@ -7,7 +7,7 @@
 use anyhow::{bail, Context, Result};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::PlanarMount;
-use fusemap_core::grid::{GridGeometry, OccupancyGrid, OccupancyParams};
+use fusemap_core::grid::{FusionGrid, GridGeometry, OccupancyParams};
 use fusemap_core::sensor::LidarModel;
 use fusemap_core::sim::{workload, WORKLOADS};
 use serde::{Deserialize, Serialize};
@@ -75,7 +75,7 @@ pub fn run_one(name: char) -> Result<BenchRow> {
     let t0 = Instant::now();
     let Some(w) = workload(name) else { bail!("unknown workload `{name}` (expected a, b or c)") };
     let simulate_s = t0.elapsed().as_secs_f64();
-    let grid = OccupancyGrid::new(GridGeometry::centered(w.resolution)?, OccupancyParams::default());
+    let grid = FusionGrid::new(GridGeometry::centered(w.resolution)?, OccupancyParams::default());
     let mut engine = Engine::new(grid);
     let laser = engine.add_lidar("laser", LidarModel::new(w.lidar, PlanarMount::default()));
     let t1 = Instant::now();
@@ -99,7 +99,7 @@ pub fn run_scanfile(path: &std::path::Path, max_scans: Option<usize>) -> Result<
     }
     let simulate_s = t0.elapsed().as_secs_f64();
     let geometry = GridGeometry::new(f.resolution, fusemap_core::geometry::Point2::new(f.origin[0], f.origin[1]))?;
-    let mut engine = Engine::new(OccupancyGrid::new(geometry, OccupancyParams::default()));
+    let mut engine = Engine::new(FusionGrid::new(geometry, OccupancyParams::default()));
     let params =
         fusemap_core::sensor::LidarParams { min_range: f.range_min, max_range: f.range_max, ..Default::default() };
     let laser = engine.add_lidar("laser", LidarModel::new(params, PlanarMount::default()));

@@ -7,14 +7,14 @@ use anyhow::{bail, Result};
 use fusemap_core::config::{Config, Plan};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
-use fusemap_core::grid::OccupancyGrid;
+use fusemap_core::grid::FusionGrid;
 use fusemap_core::sim::{ScannerSpec, SimulatedRun, World};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// An engine with the plan's grid and lidars.
 pub fn engine_for(plan: &Plan) -> Engine {
-    let mut engine = Engine::new(OccupancyGrid::new(plan.geometry, plan.occupancy));
+    let mut engine = Engine::new(FusionGrid::new(plan.geometry, plan.occupancy));
     for l in &plan.lidars {
         engine.add_lidar(l.name.clone(), l.model);
     }

@@ -14,17 +14,23 @@
 //! [`SensorSelection`](super::SensorSelection) takes its sensor. [`Engine::new`] is the
 //! single map taking every sensor.
 //!
-//! **Shared observation ids.** Two observations of the same instant (equal stamps) that
-//! carry the same id — a lidar scan and a camera frame taken together — are recorded in
-//! the counters ([`EngineStats::shared_ids`], [`SensorStats::shared_ids`]). Today each is
-//! still inserted as its own observation; the id is what will let a later version count
-//! them once. Ids are compared within one instant only, so the memory this takes is
-//! bounded by the observations of one stamp.
+//! **Correlated observations are counted once.** Sensors declared correlated
+//! ([`Correlation`]: a lidar and the camera whose frames are taken with its scans) have
+//! their observations within the window merged per cell into one equivalent observation
+//! ([`MergeRule`](crate::grid::MergeRule)), never summed as independent (design document
+//! §2.4). Two observations of the same instant that carry the same id are counted in
+//! [`EngineStats::shared_ids`]; ids are compared within one instant only, so the memory
+//! this takes is bounded by the observations of one stamp.
+//!
+//! **Dynamic layer.** With [`Engine::set_dynamic`], the maps carry a dynamic-object layer:
+//! lidar hits on cells that hold a dynamic object now go there instead of the static
+//! occupancy (when routing is on), and rays through it clear it.
 
+use super::correlation::Correlator;
 use super::sensors::SensorSlot;
-use super::{MapSet, SensorModel, SensorSelection, SensorStats};
+use super::{Correlation, InsertContext, MapSet, SensorModel, SensorSelection, SensorStats};
 use crate::geometry::Pose2;
-use crate::grid::{InsertStats, OccupancyGrid};
+use crate::grid::{DynamicParams, DynamicUpdate, FusionGrid, Group, InsertStats};
 use crate::measurement::{Evidence, ObservationId, RangeData, SensorId, SensorKind};
 use crate::sensor::{LaserScan, LidarModel};
 use crate::time::Stamp;
@@ -70,6 +76,8 @@ pub struct EngineStats {
     /// Measurements whose observation id an earlier measurement of the same instant
     /// already carried.
     pub shared_ids: u64,
+    /// Observations merged into a correlation group another observation had opened.
+    pub correlated_merged: u64,
     /// What the insertions did, summed over the maps that took them (with one map, that
     /// map's counts).
     pub insert: InsertStats,
@@ -77,18 +85,20 @@ pub struct EngineStats {
 
 /// The fusion engine.
 pub struct Engine {
-    maps: MapSet,
+    pub(super) maps: MapSet,
     sensors: Vec<SensorSlot>,
     scratch: RangeData,
     last: Option<Stamp>,
     /// Observation ids applied at stamp `last`.
     ids_at_last: HashSet<ObservationId>,
+    correlator: Correlator,
+    dynamic: Option<(DynamicParams, bool)>,
     stats: EngineStats,
 }
 
 impl Engine {
     /// An engine writing into `grid`, which takes every sensor.
-    pub fn new(grid: OccupancyGrid) -> Self {
+    pub fn new(grid: FusionGrid) -> Self {
         Self::with_maps(MapSet::new("map", SensorSelection::All, grid))
     }
 
@@ -101,7 +111,34 @@ impl Engine {
             scratch: RangeData::empty(SensorId(0), evidence),
             last: None,
             ids_at_last: HashSet::new(),
+            correlator: Correlator::default(),
+            dynamic: None,
             stats: EngineStats::default(),
+        }
+    }
+
+    /// Declares correlated sensors (see the module docs). Call before inserting.
+    pub fn set_correlation(&mut self, correlation: Correlation) {
+        self.correlator = Correlator::new(correlation);
+    }
+
+    /// Gives the maps a dynamic-object layer with `params`; `route_hits`: lidar hits on
+    /// cells holding a dynamic object go there instead of the static layer.
+    pub fn set_dynamic(&mut self, params: DynamicParams, route_hits: bool) {
+        self.dynamic = Some((params, route_hits));
+    }
+
+    /// The dynamic layer's parameters, if the maps carry one.
+    pub fn dynamic_params(&self) -> Option<&DynamicParams> {
+        self.dynamic.as_ref().map(|(p, _)| p)
+    }
+
+    /// How an observation at `stamp` in correlation `group` is inserted.
+    fn context(&self, stamp: Stamp, group: Option<Group>) -> InsertContext {
+        InsertContext {
+            group,
+            dynamic: self.dynamic.map(|(p, _)| DynamicUpdate::new(&p, stamp)),
+            route_hits: self.dynamic.is_some_and(|(_, r)| r),
         }
     }
 
@@ -118,12 +155,12 @@ impl Engine {
     }
 
     /// The primary map.
-    pub fn grid(&self) -> &OccupancyGrid {
+    pub fn grid(&self) -> &FusionGrid {
         self.maps.primary().grid()
     }
 
     /// Consumes the engine, returning the primary map.
-    pub fn into_grid(self) -> OccupancyGrid {
+    pub fn into_grid(self) -> FusionGrid {
         self.maps.into_primary()
     }
 
@@ -162,7 +199,12 @@ impl Engine {
 
     /// Checks that `sensor` is registered and `stamp` is not older than the last applied,
     /// and records the observation id. Counts every refusal.
-    fn admit(&mut self, sensor: SensorId, stamp: Stamp, id: Option<ObservationId>) -> Result<(), EngineError> {
+    fn admit(
+        &mut self,
+        sensor: SensorId,
+        stamp: Stamp,
+        id: Option<ObservationId>,
+    ) -> Result<Option<Group>, EngineError> {
         let Some(slot) = self.sensors.get_mut(sensor.0 as usize) else {
             self.stats.unknown_sensor += 1;
             return Err(EngineError::UnknownSensor(sensor));
@@ -184,7 +226,10 @@ impl Engine {
                 slot.stats.shared_ids += 1;
             }
         }
-        Ok(())
+        let before = self.correlator.merged;
+        let group = self.correlator.assign(sensor, stamp);
+        self.stats.correlated_merged += self.correlator.merged - before;
+        Ok(group)
     }
 
     /// Inserts a lidar scan taken when the robot was at `world_from_base`.
@@ -255,12 +300,13 @@ impl Engine {
                 return Err(EngineError::UnknownSensor(sensor));
             }
         };
-        self.admit(sensor, scan.stamp, id)?;
+        let group = self.admit(sensor, scan.stamp, id)?;
+        let ctx = self.context(scan.stamp, group);
         let slot = &mut self.sensors[sensor.0 as usize];
         let model = model.limited_to(range_min, range_max);
         model.scan_to_range_data_with(sensor, scan, pose_of_beam, &mut self.scratch, &mut slot.stats.returns);
         let (maps, stats, slot) = (&mut self.maps, &mut self.stats, &mut slot.stats);
-        Ok(apply(maps, stats, slot, SensorKind::Lidar, &self.scratch))
+        Ok(apply(maps, stats, slot, SensorKind::Lidar, &self.scratch, &ctx))
     }
 
     /// Inserts range data a sensor model outside the engine produced. Its sensor must be
@@ -279,10 +325,11 @@ impl Engine {
     }
 
     fn range_data(&mut self, id: Option<ObservationId>, data: &RangeData) -> Result<InsertStats, EngineError> {
-        self.admit(data.sensor, data.stamp, id)?;
+        let group = self.admit(data.sensor, data.stamp, id)?;
+        let ctx = self.context(data.stamp, group);
         let slot = &mut self.sensors[data.sensor.0 as usize];
         let kind = slot.model.kind();
-        Ok(apply(&mut self.maps, &mut self.stats, &mut slot.stats, kind, data))
+        Ok(apply(&mut self.maps, &mut self.stats, &mut slot.stats, kind, data, &ctx))
     }
 }
 
@@ -293,8 +340,9 @@ fn apply(
     sensor: &mut SensorStats,
     kind: SensorKind,
     data: &RangeData,
+    ctx: &InsertContext,
 ) -> InsertStats {
-    let (s, fed) = maps.insert(kind, data);
+    let (s, fed) = maps.insert_fused(kind, data, ctx);
     stats.measurements += 1;
     stats.insert.add(&s);
     sensor.scans += 1;
@@ -311,7 +359,7 @@ mod tests {
     use crate::sensor::LidarParams;
 
     fn engine() -> (Engine, SensorId, SensorId) {
-        let grid = OccupancyGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
+        let grid = FusionGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
         let mut e = Engine::new(grid);
         let a = e.add_lidar("front", LidarModel::new(LidarParams::default(), PlanarMount::default()));
         let b = e.add_lidar("rear", LidarModel::new(LidarParams::default(), PlanarMount::default()));
@@ -350,7 +398,7 @@ mod observed_tests {
     use crate::sensor::LidarParams;
 
     fn engine() -> (Engine, SensorId, SensorId) {
-        let grid = OccupancyGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
+        let grid = FusionGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
         let mut e = Engine::new(grid);
         let lidar = e.add_lidar("laser", LidarModel::new(LidarParams::default(), PlanarMount::default()));
         let camera = e.add_sensor("camera", SensorModel::External(SensorKind::Camera));

@@ -8,7 +8,7 @@
 //! a separate run with only its sensors would build: maps never see each other's
 //! observations, and each applies its own in the same time order.
 
-use crate::grid::{InsertStats, OccupancyGrid};
+use crate::grid::{DynamicUpdate, FusedUpdate, FusionGrid, Group, InsertStats};
 use crate::measurement::{RangeData, SensorId, SensorKind};
 
 /// Which sensors a map takes observations from. (Odometry is not selected here: it places
@@ -35,16 +35,27 @@ impl SensorSelection {
     }
 }
 
+/// How an observation is inserted beyond the plain occupancy update.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InsertContext {
+    /// Its correlation group, if any.
+    pub group: Option<Group>,
+    /// The dynamic layer's update at its stamp, if the maps carry one.
+    pub dynamic: Option<DynamicUpdate>,
+    /// Whether hits on cells holding a dynamic object go to the dynamic layer.
+    pub route_hits: bool,
+}
+
 /// One map of a [`MapSet`] with its sensor selection and counters.
 pub struct MapEntry {
     name: String,
     sensors: SensorSelection,
-    grid: OccupancyGrid,
+    grid: FusionGrid,
     stats: InsertStats,
 }
 
 impl MapEntry {
-    fn new(name: String, sensors: SensorSelection, grid: OccupancyGrid) -> Self {
+    fn new(name: String, sensors: SensorSelection, grid: FusionGrid) -> Self {
         Self { name, sensors, grid, stats: InsertStats::default() }
     }
 
@@ -59,12 +70,17 @@ impl MapEntry {
     }
 
     /// The map.
-    pub fn grid(&self) -> &OccupancyGrid {
+    pub fn grid(&self) -> &FusionGrid {
         &self.grid
     }
 
+    /// The map, writable.
+    pub fn grid_mut(&mut self) -> &mut FusionGrid {
+        &mut self.grid
+    }
+
     /// Consumes the entry, returning the map.
-    pub fn into_grid(self) -> OccupancyGrid {
+    pub fn into_grid(self) -> FusionGrid {
         self.grid
     }
 
@@ -83,18 +99,18 @@ pub struct MapSet {
 
 impl MapSet {
     /// A set whose first (primary) map is `grid`, named `name`, taking `sensors`.
-    pub fn new(name: impl Into<String>, sensors: SensorSelection, grid: OccupancyGrid) -> Self {
+    pub fn new(name: impl Into<String>, sensors: SensorSelection, grid: FusionGrid) -> Self {
         Self { primary: MapEntry::new(name.into(), sensors, grid), others: Vec::new() }
     }
 
     /// Adds a map and returns its index.
-    pub fn add(&mut self, name: impl Into<String>, sensors: SensorSelection, grid: OccupancyGrid) -> usize {
+    pub fn add(&mut self, name: impl Into<String>, sensors: SensorSelection, grid: FusionGrid) -> usize {
         self.others.push(MapEntry::new(name.into(), sensors, grid));
         self.others.len()
     }
 
     /// Adds a map (builder form).
-    pub fn with(mut self, name: impl Into<String>, sensors: SensorSelection, grid: OccupancyGrid) -> Self {
+    pub fn with(mut self, name: impl Into<String>, sensors: SensorSelection, grid: FusionGrid) -> Self {
         self.add(name, sensors, grid);
         self
     }
@@ -127,6 +143,11 @@ impl MapSet {
         &self.primary
     }
 
+    /// The primary map, writable (for a layer written outside the engine's insert paths).
+    pub fn primary_mut(&mut self) -> &mut MapEntry {
+        &mut self.primary
+    }
+
     /// All maps, primary first.
     pub fn iter(&self) -> impl Iterator<Item = &MapEntry> {
         std::iter::once(&self.primary).chain(&self.others)
@@ -138,18 +159,25 @@ impl MapSet {
     }
 
     /// Consumes the set, returning the primary map.
-    pub fn into_primary(self) -> OccupancyGrid {
+    pub fn into_primary(self) -> FusionGrid {
         self.primary.grid
     }
 
     /// Inserts one observation of a sensor of kind `kind` into every map that takes it.
     /// Returns the summed insertion counts and the number of maps fed.
     pub fn insert(&mut self, kind: SensorKind, data: &RangeData) -> (InsertStats, u64) {
+        self.insert_fused(kind, data, &InsertContext::default())
+    }
+
+    /// Inserts one observation as a member of a correlation group and/or with the dynamic
+    /// layer (see [`FusedUpdate`]).
+    pub fn insert_fused(&mut self, kind: SensorKind, data: &RangeData, ctx: &InsertContext) -> (InsertStats, u64) {
         let mut total = InsertStats::default();
         let mut fed = 0;
         for m in std::iter::once(&mut self.primary).chain(&mut self.others) {
             if m.sensors.includes(data.sensor, kind) {
-                let s = m.grid.insert(data);
+                let mut v = FusedUpdate::new(*m.grid.table(), data.evidence, ctx.group, ctx.dynamic, ctx.route_hits);
+                let s = m.grid.insert_visited(&data.rays, &mut v);
                 m.stats.add(&s);
                 total.add(&s);
                 fed += 1;
@@ -169,16 +197,16 @@ mod tests {
     use crate::sensor::{LaserScan, LidarModel, LidarParams, ReturnCounts};
     use crate::sim::SimulatedRun;
 
-    fn grid() -> OccupancyGrid {
-        OccupancyGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default())
+    fn grid() -> FusionGrid {
+        FusionGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default())
     }
 
     /// Every stored value of a map, as bits, with its tile key.
-    fn cells(g: &OccupancyGrid) -> Vec<(TileKey, Vec<Option<u32>>)> {
+    fn cells(g: &FusionGrid) -> Vec<(TileKey, Vec<Option<u32>>)> {
         g.tiles().map(|(k, t)| (k, (0..TILE_CELLS).map(|o| t.log_odds(o).map(f32::to_bits)).collect())).collect()
     }
 
-    fn same_map(a: &OccupancyGrid, b: &OccupancyGrid) -> bool {
+    fn same_map(a: &FusionGrid, b: &FusionGrid) -> bool {
         a.observations() == b.observations() && a.known_box() == b.known_box() && cells(a) == cells(b)
     }
 
@@ -248,7 +276,7 @@ mod tests {
         }
 
         /// A separate single-map run with only the sensors in `only`.
-        fn alone(&self, only: &[SensorId]) -> OccupancyGrid {
+        fn alone(&self, only: &[SensorId]) -> FusionGrid {
             let mut e = self.engine(MapSet::new("alone", SensorSelection::All, grid()));
             self.feed(&mut e, only);
             e.into_grid()

@@ -1,10 +1,14 @@
 //! The fusion engine: time-ordered observations from any number of sensors into one or
 //! several maps of layers.
 
+mod correlation;
 mod engine;
 mod mapset;
+#[cfg(test)]
+mod merge_tests;
 mod sensors;
 
+pub use correlation::Correlation;
 pub use engine::{Engine, EngineError, EngineStats};
-pub use mapset::{MapEntry, MapSet, SensorSelection};
+pub use mapset::{InsertContext, MapEntry, MapSet, SensorSelection};
 pub use sensors::{SensorModel, SensorStats};

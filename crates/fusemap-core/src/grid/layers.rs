@@ -77,6 +77,13 @@ impl<L> MapTile<L> {
         self.log_odds[offset] = if fresh { updated } else { v };
     }
 
+    /// The cell's stored occupancy log-odds (NaN: never observed) and the extra layers,
+    /// both writable: for a per-cell update that reads one and writes the other.
+    #[inline(always)]
+    pub fn parts_mut(&mut self, offset: usize) -> (&mut f32, &mut L) {
+        (&mut self.log_odds[offset], &mut self.layers)
+    }
+
     /// The extra layers' blocks.
     pub fn layers(&self) -> &L {
         &self.layers

@@ -1,6 +1,10 @@
 //! Grids: geometry, log-odds cells, sparse tiles of layers, exact ray traversal, and the
 //! walk of an observation's rays that every layer shares.
 
+mod correlated;
+pub mod dynamic;
+mod fused_update;
+mod fusion_layers;
 mod geometry;
 mod layers;
 pub mod logodds;
@@ -8,9 +12,14 @@ mod mark;
 mod occupancy;
 mod raster;
 mod raycast;
+pub mod semantic;
 mod tiles;
 mod walk;
 
+pub use correlated::{Group, GroupBlock, MergeRule};
+pub use dynamic::{DynamicBlock, DynamicParams, DynamicUpdate};
+pub use fused_update::FusedUpdate;
+pub use fusion_layers::{FusionGrid, FusionLayers};
 pub use geometry::{
     CellBox, CellIndex, GeometryError, GridGeometry, TileKey, TILE_CELLS, TILE_MASK, TILE_SHIFT, TILE_SIZE,
 };

@@ -18,7 +18,7 @@
 
 use super::{
     walk_observation, CellBox, CellIndex, CellRaster, CellVisitor, ExtraLayers, GridGeometry, InsertStats,
-    LogOddsTable, MapTile, OccupancyParams, Raster, Ternary, TileKey, TileMap, TILE_SIZE,
+    LogOddsTable, MapTile, MarkedTile, OccupancyParams, Raster, Ternary, TileKey, TileMap, TILE_SIZE,
 };
 #[cfg(test)]
 use super::{CellRay, TILE_CELLS};
@@ -159,6 +159,56 @@ impl<L: ExtraLayers> LayeredGrid<L> {
         self.observations += 1;
         let mut visitor = (OccupancyUpdate::new(self.table, data.evidence), layers);
         walk_observation(&mut self.tiles, &self.geometry, self.observations, &data.rays, &mut self.known, &mut visitor)
+    }
+
+    /// Starts a new observation and returns its number, for an insertion that writes cells
+    /// directly ([`cell_mut`](Self::cell_mut)) and then walks rays
+    /// ([`walk_observation_rays`](Self::walk_observation_rays)) under the same
+    /// once-per-observation marks.
+    pub fn begin_observation(&mut self) -> u64 {
+        self.observations += 1;
+        self.observations
+    }
+
+    /// The tile holding `cell` (allocated if needed), the cell's offset, and whether this
+    /// is the cell's first visit in observation `obs` (the visit marks it). `None` for a
+    /// cell beyond the index range. Grows the known box.
+    pub fn cell_mut(&mut self, cell: CellIndex, obs: u64) -> Option<(&mut MapTile<L>, usize, bool)> {
+        const LIMIT: i64 = 1 << 60;
+        if cell.x.abs() >= LIMIT || cell.y.abs() >= LIMIT {
+            return None;
+        }
+        let b = CellBox { min: cell, max: cell };
+        self.known = Some(self.known.map_or(b, |k| k.union(b)));
+        let tile = self.tiles.get_or_insert(cell.tile());
+        let offset = cell.offset_in_tile();
+        let mark = tile.mark();
+        mark.begin(obs);
+        let fresh = mark.test_and_set(offset);
+        Some((tile, offset, fresh))
+    }
+
+    /// Walks `rays` as part of observation `obs` (begun with
+    /// [`begin_observation`](Self::begin_observation)) with `visitor` alone: no built-in
+    /// occupancy update, the visitor decides what every layer does.
+    pub fn walk_observation_rays<V: CellVisitor<MapTile<L>>>(
+        &mut self,
+        obs: u64,
+        rays: &[crate::measurement::Ray],
+        visitor: &mut V,
+    ) -> InsertStats {
+        walk_observation(&mut self.tiles, &self.geometry, obs, rays, &mut self.known, visitor)
+    }
+
+    /// Inserts one observation's rays with `visitor` alone (see
+    /// [`walk_observation_rays`](Self::walk_observation_rays)).
+    pub fn insert_visited<V: CellVisitor<MapTile<L>>>(
+        &mut self,
+        rays: &[crate::measurement::Ray],
+        visitor: &mut V,
+    ) -> InsertStats {
+        let obs = self.begin_observation();
+        self.walk_observation_rays(obs, rays, visitor)
     }
 
     /// A dense copy of one layer's cells over `area` (row 0 = lowest y): `cell` reads a

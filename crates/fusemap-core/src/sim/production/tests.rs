@@ -438,13 +438,13 @@ fn imu_lateral_acceleration_is_centripetal() {
 /// truth) and the share of glass-fence cells it marks occupied.
 fn map_with_true_poses(s: &Scenario) -> (f64, f64, usize) {
     use crate::fusion::Engine;
-    use crate::grid::{OccupancyGrid, OccupancyParams, Ternary};
+    use crate::grid::{FusionGrid, OccupancyParams, Ternary};
     use crate::sensor::{LaserScan, LidarModel, LidarParams};
     let run = simulate(s).unwrap();
     let traj = Trajectory::generate(&s.robot);
     let start = Stamp(s.world.start_time_s * 1_000_000_000);
     let g = GridGeometry::centered(0.05).unwrap();
-    let mut engine = Engine::new(OccupancyGrid::new(g, OccupancyParams::default()));
+    let mut engine = Engine::new(FusionGrid::new(g, OccupancyParams::default()));
     let params = LidarParams { max_range: s.lidar.range_max_m, ..LidarParams::default() };
     let laser = engine.add_lidar("laser", LidarModel::new(params, s.lidar.mount.to_planar(1e-6).unwrap()));
     for m in &run.messages {

@@ -1,0 +1,102 @@
+//! What one range observation does to each cell of a fusion map: the occupancy update
+//! (merged with its correlation group's, when it belongs to one), and the dynamic layer's
+//! routing and clearing.
+
+use super::{CellVisitor, DynamicUpdate, FusionLayers, Group, LogOddsTable, MapTile};
+use crate::measurement::Evidence;
+
+/// The per-cell update of a range observation into a [`FusionGrid`](super::FusionGrid).
+///
+/// * Occupancy: the hit or miss increment of the evidence, once per observation; as a
+///   member of a correlation [`Group`], merged with the group's other members.
+/// * Dynamic layer (when given): a hit on a cell that holds a dynamic object now goes to
+///   the dynamic layer instead of the static one (a lidar return from a person the camera
+///   labelled, §2.4), when routing is on; a ray crossing a cell the dynamic layer holds
+///   clears it there (the object has left).
+///
+/// With neither a group nor a dynamic layer the update is the plain occupancy update,
+/// branch-free, bit for bit [`OccupancyUpdate`](super::OccupancyUpdate)'s.
+#[derive(Clone, Copy, Debug)]
+pub struct FusedUpdate {
+    table: LogOddsTable,
+    d_hit: f32,
+    d_miss: f32,
+    group: Option<Group>,
+    dynamic: Option<DynamicUpdate>,
+    route_hits: bool,
+    plain: bool,
+}
+
+impl FusedUpdate {
+    /// The update for `evidence` against the map's `table`.
+    pub fn new(
+        table: LogOddsTable,
+        evidence: Evidence,
+        group: Option<Group>,
+        dynamic: Option<DynamicUpdate>,
+        route_hits: bool,
+    ) -> Self {
+        Self {
+            table,
+            d_hit: table.increment(evidence.p_hit),
+            d_miss: table.increment(evidence.p_miss),
+            group,
+            dynamic,
+            route_hits,
+            plain: group.is_none() && dynamic.is_none(),
+        }
+    }
+
+    /// Applies an occupancy increment to a cell on its first visit of the observation.
+    #[inline(always)]
+    pub fn occupancy(
+        table: &LogOddsTable,
+        group: Option<Group>,
+        tile: &mut MapTile<FusionLayers>,
+        offset: usize,
+        delta: f32,
+    ) {
+        match group {
+            None => tile.update_log_odds(offset, delta, table, true),
+            Some(g) => {
+                let (l, layers) = tile.parts_mut(offset);
+                g.update(&mut layers.group, l, offset, delta, table);
+            }
+        }
+    }
+}
+
+impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
+    #[inline(always)]
+    fn hit(&mut self, tile: &mut MapTile<FusionLayers>, offset: usize, fresh: bool) {
+        if self.plain {
+            tile.update_log_odds(offset, self.d_hit, &self.table, fresh);
+            return;
+        }
+        if !fresh {
+            return;
+        }
+        if let Some(dy) = &self.dynamic {
+            if self.route_hits && dy.is_dynamic(tile.layers().dynamic(), offset) {
+                dy.apply(&mut tile.layers_mut().dynamic, offset, dy.d_hit());
+                return;
+            }
+        }
+        Self::occupancy(&self.table, self.group, tile, offset, self.d_hit);
+    }
+
+    #[inline(always)]
+    fn pass(&mut self, tile: &mut MapTile<FusionLayers>, offset: usize, fresh: bool) {
+        if self.plain {
+            tile.update_log_odds(offset, self.d_miss, &self.table, fresh);
+            return;
+        }
+        if !fresh {
+            return;
+        }
+        Self::occupancy(&self.table, self.group, tile, offset, self.d_miss);
+        if let Some(dy) = &self.dynamic {
+            dy.clear(&mut tile.layers_mut().dynamic, offset);
+        }
+    }
+}
