@@ -3,6 +3,8 @@
 
 mod entropy;
 mod scores;
+mod semantic;
 
 pub use entropy::{binary_entropy, map_entropy, EntropyReport};
 pub use scores::{Confusion, TolerantScore};
+pub use semantic::{ClassAccuracy, SemanticAccuracy};
