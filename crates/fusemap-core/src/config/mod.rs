@@ -6,8 +6,10 @@
 //! misspelt `p_ocupied` is an error and not a silently ignored line. Every validation
 //! error names the field, in the path form the TOML file uses (`lidar[0].p_occ`).
 
+mod fusion;
 mod sensor;
 
+pub use fusion::FusionConfig;
 pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 
 use crate::estimator::EstimatorConfig;
@@ -31,6 +33,9 @@ pub struct Config {
     /// How robot logs are read: topics, pose source, time synchronisation.
     #[serde(default)]
     pub log: LogConfig,
+    /// How the sensors' evidence is combined: correlated sensors, the dynamic layer.
+    #[serde(default)]
+    pub fusion: FusionConfig,
 }
 
 /// Where a log's scans get their poses.
@@ -220,6 +225,10 @@ pub struct Plan {
     pub log: LogConfig,
     /// The pose estimator's figures.
     pub estimator: EstimatorConfig,
+    /// How the sensors' evidence is combined.
+    pub fusion: FusionConfig,
+    /// The dynamic layer's parameters (from `[fusion]`).
+    pub dynamic: crate::grid::DynamicParams,
 }
 
 impl Config {
@@ -303,6 +312,15 @@ impl Config {
             Some((field, rest)) if field.starts_with("estimator.") => err(field, rest),
             _ => err("estimator", m),
         })?;
+        let dynamic = self.fusion.validate(occ_t)?;
+        for (i, group) in self.fusion.correlated.iter().enumerate() {
+            for name in group {
+                let known = lidars.iter().any(|l| &l.name == name) || sensors.iter().any(|s| &s.name == name);
+                if !known {
+                    return Err(err(format!("fusion.correlated[{i}]"), format!("no enabled sensor is named `{name}`")));
+                }
+            }
+        }
         Ok(Plan {
             geometry,
             occupancy,
@@ -311,6 +329,8 @@ impl Config {
             disabled_kinds,
             log: g.clone(),
             estimator: self.estimator.clone(),
+            fusion: self.fusion.clone(),
+            dynamic,
         })
     }
 }
