@@ -5,5 +5,8 @@
 pub mod camera;
 pub mod lidar;
 
-pub use camera::{DepthImage, ImageError, LabelImage};
+pub use camera::{
+    Band, CameraError, CameraModel, CameraObservation, CameraParams, CameraPoint, ClassSpec, ClassTable, DepthImage,
+    ImageError, LabelImage, Pinhole, PixelCounts,
+};
 pub use lidar::{LaserScan, LidarModel, LidarParams, MaxRangePolicy, ReturnCounts};
