@@ -26,18 +26,20 @@
 //! lidar hits on cells that hold a dynamic object now go there instead of the static
 //! occupancy (when routing is on), and rays through it clear it.
 
+use super::camera::FrameCells;
 use super::correlation::Correlator;
 use super::sensors::SensorSlot;
 use super::{Correlation, InsertContext, MapSet, SensorModel, SensorSelection, SensorStats};
 use crate::geometry::Pose2;
 use crate::grid::{DynamicParams, DynamicUpdate, FusionGrid, Group, InsertStats};
 use crate::measurement::{Evidence, ObservationId, RangeData, SensorId, SensorKind};
+use crate::sensor::camera::{CameraModel, CameraObservation, DepthImage, LabelImage};
 use crate::sensor::{LaserScan, LidarModel};
 use crate::time::Stamp;
 use std::collections::HashSet;
 
 /// Why the engine refused a measurement.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum EngineError {
     /// No sensor with this id was registered.
     #[error("unknown sensor id {0:?}")]
@@ -51,6 +53,14 @@ pub enum EngineError {
         stamp: Stamp,
         /// The newest stamp applied so far.
         last: Stamp,
+    },
+    /// A camera frame that does not fit its camera (image sizes).
+    #[error("camera {sensor:?}: {error}")]
+    Camera {
+        /// The sensor.
+        sensor: SensorId,
+        /// Why.
+        error: crate::sensor::camera::CameraError,
     },
     /// The sensor's registered model cannot read this kind of measurement (a lidar scan
     /// for a sensor whose model runs outside the engine).
@@ -88,6 +98,8 @@ pub struct Engine {
     pub(super) maps: MapSet,
     sensors: Vec<SensorSlot>,
     scratch: RangeData,
+    camera_scratch: CameraObservation,
+    frame_cells: FrameCells,
     last: Option<Stamp>,
     /// Observation ids applied at stamp `last`.
     ids_at_last: HashSet<ObservationId>,
@@ -109,6 +121,8 @@ impl Engine {
             maps,
             sensors: Vec::new(),
             scratch: RangeData::empty(SensorId(0), evidence),
+            camera_scratch: CameraObservation::empty(SensorId(0)),
+            frame_cells: FrameCells::default(),
             last: None,
             ids_at_last: HashSet::new(),
             correlator: Correlator::default(),
@@ -190,6 +204,76 @@ impl Engine {
             Some(SensorModel::Lidar(m)) => Some(m),
             _ => None,
         }
+    }
+
+    /// Registers a semantic camera and returns its id.
+    pub fn add_camera(&mut self, name: impl Into<String>, model: CameraModel) -> SensorId {
+        self.add_sensor(name, SensorModel::Camera(Box::new(model)))
+    }
+
+    /// The model registered for `sensor`, if it is a camera.
+    pub fn camera_model(&self, sensor: SensorId) -> Option<&CameraModel> {
+        match self.sensors.get(sensor.0 as usize).map(|s| &s.model) {
+            Some(SensorModel::Camera(m)) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// Inserts a camera frame (a label image and its aligned depth image) taken at `stamp`
+    /// when the robot was at `world_from_base`, named by the caller's observation id.
+    /// See [`camera`](super::camera) for what it writes. A frame whose images do not fit
+    /// the camera is refused and counted.
+    pub fn insert_camera_frame(
+        &mut self,
+        sensor: SensorId,
+        id: Option<ObservationId>,
+        stamp: Stamp,
+        labels: &LabelImage,
+        depth: &DepthImage,
+        world_from_base: Pose2,
+    ) -> Result<InsertStats, EngineError> {
+        let Some(slot) = self.sensors.get_mut(sensor.0 as usize) else {
+            self.stats.unknown_sensor += 1;
+            return Err(EngineError::UnknownSensor(sensor));
+        };
+        let SensorModel::Camera(model) = &slot.model else {
+            self.stats.unknown_sensor += 1;
+            return Err(EngineError::WrongModel { sensor, kind: slot.model.kind() });
+        };
+        let mut counts = crate::sensor::camera::PixelCounts::default();
+        if let Err(error) = model.project(labels, depth, world_from_base, &mut self.camera_scratch, &mut counts) {
+            slot.stats.frames_refused += 1;
+            return Err(EngineError::Camera { sensor, error });
+        }
+        self.camera_scratch.stamp = stamp;
+        self.camera_scratch.sensor = sensor;
+        let group = self.admit(sensor, stamp, id)?;
+        let ctx = self.context(stamp, group);
+        let slot = &mut self.sensors[sensor.0 as usize];
+        slot.stats.pixels.add(&counts);
+        let SensorModel::Camera(model) = &slot.model else { unreachable!("checked above") };
+        let k = model.classes().len();
+        let p_free = model.params().p_free;
+        let weight = model.params().occupancy_weight as f32;
+        let mut total = InsertStats::default();
+        let mut fed = 0;
+        for m in self.maps.entries_mut() {
+            if !m.sensors().includes(sensor, SensorKind::Camera) {
+                continue;
+            }
+            self.frame_cells.build(&self.camera_scratch, model, m.grid());
+            let free = weight * m.grid().table().increment(p_free);
+            let s = self.frame_cells.apply(m.grid_mut(), k, free, ctx.group, ctx.dynamic);
+            m.add_stats(&s);
+            total.add(&s);
+            fed += 1;
+        }
+        self.stats.measurements += 1;
+        self.stats.insert.add(&total);
+        slot.stats.scans += 1;
+        slot.stats.maps_fed += fed;
+        slot.stats.insert.add(&total);
+        Ok(total)
     }
 
     /// The kind of a registered sensor.
@@ -289,8 +373,8 @@ impl Engine {
         range_max: f32,
         pose_of_beam: impl FnMut(usize) -> Pose2,
     ) -> Result<InsertStats, EngineError> {
-        let model = match self.sensors.get(sensor.0 as usize).map(|s| s.model) {
-            Some(SensorModel::Lidar(m)) => m,
+        let model = match self.sensors.get(sensor.0 as usize).map(|s| &s.model) {
+            Some(SensorModel::Lidar(m)) => *m,
             Some(other) => {
                 self.stats.unknown_sensor += 1;
                 return Err(EngineError::WrongModel { sensor, kind: other.kind() });

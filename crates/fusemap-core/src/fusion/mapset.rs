@@ -79,6 +79,11 @@ impl MapEntry {
         &mut self.grid
     }
 
+    /// Adds an insertion's counts to the map's.
+    pub(super) fn add_stats(&mut self, s: &InsertStats) {
+        self.stats.add(s);
+    }
+
     /// Consumes the entry, returning the map.
     pub fn into_grid(self) -> FusionGrid {
         self.grid
@@ -146,6 +151,11 @@ impl MapSet {
     /// The primary map, writable (for a layer written outside the engine's insert paths).
     pub fn primary_mut(&mut self) -> &mut MapEntry {
         &mut self.primary
+    }
+
+    /// All maps, primary first, writable.
+    pub(super) fn entries_mut(&mut self) -> impl Iterator<Item = &mut MapEntry> {
+        std::iter::once(&mut self.primary).chain(&mut self.others)
     }
 
     /// All maps, primary first.

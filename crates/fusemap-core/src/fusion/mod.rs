@@ -1,6 +1,9 @@
 //! The fusion engine: time-ordered observations from any number of sensors into one or
 //! several maps of layers.
 
+pub mod camera;
+#[cfg(test)]
+mod camera_tests;
 mod correlation;
 mod engine;
 mod mapset;

@@ -3,6 +3,7 @@
 
 use crate::grid::InsertStats;
 use crate::measurement::SensorKind;
+use crate::sensor::camera::{CameraModel, PixelCounts};
 use crate::sensor::{LidarModel, ReturnCounts};
 use serde::Serialize;
 
@@ -14,10 +15,12 @@ use serde::Serialize;
 /// [`RangeData`](crate::measurement::RangeData) through
 /// [`Engine::insert_range_data_observed`](super::Engine::insert_range_data_observed): the
 /// kind still decides which maps of a [`MapSet`](super::MapSet) take it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum SensorModel {
     /// A 2D lidar and its inverse model.
     Lidar(LidarModel),
+    /// A semantic camera (label + depth images) and its model.
+    Camera(Box<CameraModel>),
     /// A sensor of this kind whose model runs outside the engine.
     External(SensorKind),
 }
@@ -27,6 +30,7 @@ impl SensorModel {
     pub fn kind(&self) -> SensorKind {
         match self {
             SensorModel::Lidar(_) => SensorKind::Lidar,
+            SensorModel::Camera(_) => SensorKind::Camera,
             SensorModel::External(k) => *k,
         }
     }
@@ -43,6 +47,10 @@ pub struct SensorStats {
     pub scans: u64,
     /// Beams by kind of return (lidar scans only).
     pub returns: ReturnCounts,
+    /// Pixels by what became of them (cameras only).
+    pub pixels: PixelCounts,
+    /// Frames refused (images that do not fit the camera).
+    pub frames_refused: u64,
     /// Observations refused for being older than one already applied.
     pub out_of_order: u64,
     /// Observations whose id an earlier observation of the same instant already carried.
@@ -61,6 +69,7 @@ pub(super) struct SensorSlot {
 
 impl SensorSlot {
     pub(super) fn new(name: String, model: SensorModel) -> Self {
-        Self { model, stats: SensorStats { name, kind: model.kind(), ..Default::default() } }
+        let kind = model.kind();
+        Self { model, stats: SensorStats { name, kind, ..Default::default() } }
     }
 }
