@@ -11,7 +11,8 @@
 use fusemap_core::geometry::Pose2;
 use fusemap_core::time::Stamp;
 use fusemap_io::log::{
-    GnssMessage, ImuMessage, LogFormat, LogMessage, OdomMessage, PoseMessage, ReadStats, ScanMessage, Transform,
+    CameraInfoMessage, GnssMessage, ImageMessage, ImuMessage, LogFormat, LogMessage, OdomMessage, PoseMessage,
+    ReadOptions, ReadStats, ScanMessage, Transform,
 };
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -38,6 +39,41 @@ impl ScanTopic {
     pub fn frame(&self) -> Option<&str> {
         self.frames.iter().filter(|(f, _)| !f.is_empty()).max_by_key(|(_, n)| **n).map(|(f, _)| f.as_str())
     }
+}
+
+/// What the first pass learnt about one image topic (headers only: pixels are read in the
+/// second pass, and only for the topics a camera uses).
+#[derive(Clone, Debug, Default)]
+pub struct ImageTopic {
+    /// Header stamps in log order.
+    pub stamps: Vec<Stamp>,
+    /// Receive stamps in log order, where the format has them.
+    pub receive: Vec<Option<Stamp>>,
+    /// Frame ids seen, with their counts.
+    pub frames: BTreeMap<String, u64>,
+    /// Encodings seen, with their counts.
+    pub encodings: BTreeMap<String, u64>,
+    /// Image sizes seen (width, height), with their counts.
+    pub sizes: BTreeMap<(u32, u32), u64>,
+}
+
+impl ImageTopic {
+    /// The most common non-empty frame id.
+    pub fn frame(&self) -> Option<&str> {
+        self.frames.iter().filter(|(f, _)| !f.is_empty()).max_by_key(|(_, n)| **n).map(|(f, _)| f.as_str())
+    }
+}
+
+/// What the first pass kept of one camera-info topic: the calibration is small but
+/// repeated with every frame, so the first message is kept and the others compared.
+#[derive(Clone, Debug)]
+pub struct CameraInfoTopic {
+    /// The first message (by stamp).
+    pub first: CameraInfoMessage,
+    /// Messages read.
+    pub count: u64,
+    /// Messages whose size, distortion or K differ from the first.
+    pub differing: u64,
 }
 
 /// One odometry message as the pipeline keeps it: what the pose track and the estimator
@@ -117,6 +153,10 @@ pub struct Inventory {
     pub format: LogFormat,
     /// Scan topics.
     pub scans: BTreeMap<String, ScanTopic>,
+    /// Image topics (headers only).
+    pub images: BTreeMap<String, ImageTopic>,
+    /// Camera-info topics.
+    pub camera_info: BTreeMap<String, CameraInfoTopic>,
     /// Odometry by topic, in log order.
     pub odom: BTreeMap<String, Vec<OdomSample>>,
     /// IMU samples by topic, in log order.
@@ -174,6 +214,8 @@ impl Inventory {
             path: path.to_path_buf(),
             format: opened.format,
             scans: BTreeMap::new(),
+            images: BTreeMap::new(),
+            camera_info: BTreeMap::new(),
             odom: BTreeMap::new(),
             imu: BTreeMap::new(),
             frames: BTreeMap::new(),
@@ -213,6 +255,43 @@ impl Inventory {
                 LogMessage::Gnss(g) => inv.gnss.entry(g.topic.clone()).or_default().push(g),
                 LogMessage::Pose(p) => inv.poses.entry(p.topic.clone()).or_default().push(p),
                 LogMessage::Tf(t) => tf.push(t),
+                LogMessage::ImageHeader(h) => {
+                    let t = inv.images.entry(h.topic.clone()).or_default();
+                    t.stamps.push(h.stamp);
+                    t.receive.push(h.receive_stamp);
+                    *t.frames.entry(h.frame_id).or_default() += 1;
+                    *t.encodings.entry(h.encoding).or_default() += 1;
+                    *t.sizes.entry((h.width, h.height)).or_default() += 1;
+                }
+                // The first pass asks for no pixels; a reader that gives them anyway is
+                // inventoried the same way.
+                LogMessage::Image(i) => {
+                    let t = inv.images.entry(i.topic.clone()).or_default();
+                    t.stamps.push(i.stamp);
+                    t.receive.push(i.receive_stamp);
+                    *t.frames.entry(i.frame_id).or_default() += 1;
+                    *t.encodings.entry(i.encoding).or_default() += 1;
+                    *t.sizes.entry((i.width, i.height)).or_default() += 1;
+                }
+                LogMessage::CameraInfo(c) => match inv.camera_info.get_mut(&c.topic) {
+                    Some(t) => {
+                        t.count += 1;
+                        let f = &t.first;
+                        if (f.width, f.height) != (c.width, c.height)
+                            || f.distortion_model != c.distortion_model
+                            || f.d != c.d
+                            || f.k != c.k
+                        {
+                            t.differing += 1;
+                        }
+                        if c.stamp < t.first.stamp {
+                            t.first = c;
+                        }
+                    }
+                    None => {
+                        inv.camera_info.insert(c.topic.clone(), CameraInfoTopic { first: c, count: 1, differing: 0 });
+                    }
+                },
             }
         }
         inv.stats = merged_stats(reader.stats(), undecodable);
@@ -232,6 +311,13 @@ impl Inventory {
                 v.sort_by_key(|m| m.receive_stamp);
             }
             tf.sort_by_key(|m| m.receive_stamp);
+            for t in inv.images.values_mut() {
+                let mut pairs: Vec<(Option<Stamp>, Stamp)> =
+                    t.receive.iter().copied().zip(t.stamps.iter().copied()).collect();
+                pairs.sort_by_key(|p| p.0);
+                t.receive = pairs.iter().map(|p| p.0).collect();
+                t.stamps = pairs.iter().map(|p| p.1).collect();
+            }
             for t in inv.scans.values_mut() {
                 let mut pairs: Vec<(Option<Stamp>, Stamp)> =
                     t.receive.iter().copied().zip(t.stamps.iter().copied()).collect();
@@ -257,6 +343,15 @@ impl Inventory {
     }
 }
 
+/// A message the second pass maps: a scan, or an image with its pixels.
+#[derive(Clone, Debug)]
+pub enum RangeMessage {
+    /// A laser scan.
+    Scan(ScanMessage),
+    /// A label or depth image.
+    Image(ImageMessage),
+}
+
 /// The second pass: calls `f` with every scan of `topics`, in log order, and returns the
 /// seconds spent reading. Errors of the container end the pass; undecodable messages were
 /// already counted by the first pass and are skipped.
@@ -265,15 +360,30 @@ pub fn for_each_scan(
     topics: &[String],
     mut f: impl FnMut(ScanMessage) -> Result<(), crate::PipelineError>,
 ) -> Result<f64, crate::PipelineError> {
+    for_each_range_message(path, topics, &[], |m| match m {
+        RangeMessage::Scan(s) => f(s),
+        RangeMessage::Image(_) => Ok(()),
+    })
+}
+
+/// The second pass over scans of `scan_topics` and images of `image_topics` (with their
+/// pixels; other images are not decoded), in log order.
+pub fn for_each_range_message(
+    path: &Path,
+    scan_topics: &[String],
+    image_topics: &[String],
+    mut f: impl FnMut(RangeMessage) -> Result<(), crate::PipelineError>,
+) -> Result<f64, crate::PipelineError> {
     let t0 = Instant::now();
-    let opened = fusemap_io::log::open_log(path)?;
+    let options = ReadOptions::with_image_topics(image_topics.iter().cloned());
+    let opened = fusemap_io::log::open_log_with(path, &options)?;
     let mut reader = opened.reader;
     let mut ignored = ReadStats::default();
     while let Some(m) = next(reader.as_mut(), &mut ignored) {
-        if let LogMessage::Scan(s) = m? {
-            if topics.contains(&s.topic) {
-                f(s)?;
-            }
+        match m? {
+            LogMessage::Scan(s) if scan_topics.contains(&s.topic) => f(RangeMessage::Scan(s))?,
+            LogMessage::Image(i) if image_topics.contains(&i.topic) => f(RangeMessage::Image(i))?,
+            _ => {}
         }
     }
     Ok(t0.elapsed().as_secs_f64())

@@ -9,11 +9,16 @@
 //! type fusemap does not use is counted in [`ReadStats::skipped_by_type`] and skipped.
 
 pub mod carmen;
+mod image;
 mod open;
 pub mod ros1;
 pub mod ros2;
 
-pub use open::{detect, open_log, LogFormat, OpenedLog};
+pub use image::{
+    bytes_per_pixel, check_image_layout, CameraInfoMessage, ImageHeader, ImageMessage, ImagePayloads, ReadOptions,
+    MAX_IMAGE_PIXELS,
+};
+pub use open::{detect, open_log, open_log_with, LogFormat, OpenedLog};
 
 use fusemap_core::geometry::{quaternion_yaw, Pose2};
 use fusemap_core::sensor::LaserScan;
@@ -270,6 +275,12 @@ pub enum LogMessage {
     Gnss(GnssMessage),
     /// A pose estimate with covariance.
     Pose(PoseMessage),
+    /// A camera image with its pixels (a topic [`ReadOptions::images`] asked for).
+    Image(ImageMessage),
+    /// A camera image read without its pixels (every other image topic).
+    ImageHeader(ImageHeader),
+    /// A camera calibration.
+    CameraInfo(CameraInfoMessage),
 }
 
 impl LogMessage {
@@ -282,6 +293,9 @@ impl LogMessage {
             LogMessage::Imu(m) => &m.topic,
             LogMessage::Gnss(m) => &m.topic,
             LogMessage::Pose(m) => &m.topic,
+            LogMessage::Image(m) => &m.topic,
+            LogMessage::ImageHeader(m) => &m.topic,
+            LogMessage::CameraInfo(m) => &m.topic,
         }
     }
 
@@ -295,6 +309,9 @@ impl LogMessage {
             LogMessage::Imu(m) => Some(m.stamp),
             LogMessage::Gnss(m) => Some(m.stamp),
             LogMessage::Pose(m) => Some(m.stamp),
+            LogMessage::Image(m) => Some(m.stamp),
+            LogMessage::ImageHeader(m) => Some(m.stamp),
+            LogMessage::CameraInfo(m) => Some(m.stamp),
         }
     }
 
@@ -307,6 +324,9 @@ impl LogMessage {
             LogMessage::Imu(m) => m.receive_stamp,
             LogMessage::Gnss(m) => m.receive_stamp,
             LogMessage::Pose(m) => m.receive_stamp,
+            LogMessage::Image(m) => m.receive_stamp,
+            LogMessage::ImageHeader(m) => m.receive_stamp,
+            LogMessage::CameraInfo(m) => m.receive_stamp,
         }
     }
 }

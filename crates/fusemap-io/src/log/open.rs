@@ -1,6 +1,6 @@
 //! Opening a log by its content, not its name.
 
-use super::LogReader;
+use super::{LogReader, ReadOptions};
 use crate::{Error, Location, Result};
 use std::fmt;
 use std::io::Read;
@@ -68,13 +68,20 @@ pub fn detect(path: &Path) -> Result<LogFormat> {
     }
 }
 
-/// Opens `path`, recognising the format by content.
+/// Opens `path`, recognising the format by content, with the default
+/// [`ReadOptions`]: images are read without their pixels.
 pub fn open_log(path: &Path) -> Result<OpenedLog> {
+    open_log_with(path, &ReadOptions::default())
+}
+
+/// Opens `path`, recognising the format by content; `options` say which images to decode
+/// in full (CARMEN logs have none).
+pub fn open_log_with(path: &Path, options: &ReadOptions) -> Result<OpenedLog> {
     let format = detect(path)?;
     let reader: Box<dyn LogReader> = match format {
         LogFormat::Carmen => Box::new(super::carmen::CarmenReader::open(path, Default::default())?),
-        LogFormat::Ros1Bag => Box::new(super::ros1::BagReader::open(path)?),
-        LogFormat::Mcap | LogFormat::Rosbag2 => super::ros2::open_ros2(path)?,
+        LogFormat::Ros1Bag => Box::new(super::ros1::BagReader::open_with(path, options.clone())?),
+        LogFormat::Mcap | LogFormat::Rosbag2 => Box::new(super::ros2::Ros2Reader::open_with(path, options.clone())?),
     };
     Ok(OpenedLog { format, reader })
 }

@@ -143,6 +143,14 @@ impl<'a> Cursor<'a> {
         Ok(chunks.iter().map(|c| f32::from_le_bytes(*c)).collect())
     }
 
+    /// A variable-length `float64[]`.
+    pub(super) fn f64_vec(&mut self, what: &str) -> Result<Vec<f64>, Malformed> {
+        let n = self.array_len(8, what)?;
+        let bytes = self.take(n * 8, what)?;
+        let (chunks, _) = bytes.as_chunks::<8>();
+        Ok(chunks.iter().map(|c| f64::from_le_bytes(*c)).collect())
+    }
+
     /// Skips a variable-length `float32[]`, checking that it fits.
     pub(super) fn skip_f32_array(&mut self, what: &str) -> Result<(), Malformed> {
         let n = self.array_len(4, what)?;

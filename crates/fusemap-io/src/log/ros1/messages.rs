@@ -9,7 +9,8 @@
 
 use super::cursor::{Cursor, Malformed};
 use crate::log::{
-    planar_pose, GnssMessage, ImuMessage, LogMessage, OdomMessage, PoseMessage, ScanMessage, TfMessage, Transform,
+    check_image_layout, planar_pose, CameraInfoMessage, GnssMessage, ImageHeader, ImageMessage, ImuMessage, LogMessage,
+    OdomMessage, PoseMessage, ScanMessage, TfMessage, Transform,
 };
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::Stamp;
@@ -29,6 +30,10 @@ pub(super) enum Kind {
     NavSatFix,
     /// `geometry_msgs/PoseWithCovarianceStamped`.
     PoseWithCovarianceStamped,
+    /// `sensor_msgs/Image`.
+    Image,
+    /// `sensor_msgs/CameraInfo`.
+    CameraInfo,
 }
 
 impl Kind {
@@ -45,6 +50,8 @@ impl Kind {
             b"geometry_msgs/PoseWithCovarianceStamped" => {
                 (Kind::PoseWithCovarianceStamped, "953b798c0f514ff060a53a3498ce6246")
             }
+            b"sensor_msgs/Image" => (Kind::Image, "060021388200f6f0f447d0fcd9c64743"),
+            b"sensor_msgs/CameraInfo" => (Kind::CameraInfo, "c9a58c1b0b154e0e6da7578cb991d214"),
             _ => return None,
         })
     }
@@ -58,6 +65,8 @@ impl Kind {
             Kind::Imu => "Imu",
             Kind::NavSatFix => "NavSatFix",
             Kind::PoseWithCovarianceStamped => "PoseWithCovarianceStamped",
+            Kind::Image => "Image",
+            Kind::CameraInfo => "CameraInfo",
         }
     }
 }
@@ -66,8 +75,15 @@ impl Kind {
 /// element of a TF array can take.
 const MIN_TRANSFORM_SIZE: usize = 4 + 8 + 4 + 4 + 7 * 8;
 
-/// Decodes one message payload of `kind` published on `topic` and logged at `receive`.
-pub(super) fn decode(kind: Kind, topic: &str, receive: Stamp, payload: &[u8]) -> Result<LogMessage, Malformed> {
+/// Decodes one message payload of `kind` published on `topic` and logged at `receive`;
+/// an image's pixels are copied only with `pixels` (else it is an [`ImageHeader`]).
+pub(super) fn decode(
+    kind: Kind,
+    topic: &str,
+    receive: Stamp,
+    payload: &[u8],
+    pixels: bool,
+) -> Result<LogMessage, Malformed> {
     let mut c = Cursor::new(payload);
     let receive_stamp = Some(receive);
     let message = match kind {
@@ -77,6 +93,8 @@ pub(super) fn decode(kind: Kind, topic: &str, receive: Stamp, payload: &[u8]) ->
         Kind::Imu => imu(&mut c, topic, receive_stamp).map(LogMessage::Imu),
         Kind::NavSatFix => nav_sat_fix(&mut c, topic, receive_stamp).map(LogMessage::Gnss),
         Kind::PoseWithCovarianceStamped => pose_with_covariance(&mut c, topic, receive_stamp).map(LogMessage::Pose),
+        Kind::Image => image(&mut c, topic, receive_stamp, pixels),
+        Kind::CameraInfo => camera_info(&mut c, topic, receive_stamp).map(LogMessage::CameraInfo),
     }
     .map_err(|e| e.context(kind.name()))?;
     if !c.is_empty() {
@@ -223,4 +241,77 @@ fn pose_with_covariance(
     let orientation = c.f64s::<4>("pose.pose.orientation")?;
     let covariance = c.f64s::<36>("pose.covariance")?;
     Ok(PoseMessage { topic: topic.to_string(), stamp, receive_stamp, frame_id, position, orientation, covariance })
+}
+
+/// `sensor_msgs/Image`: header; `uint32 height`, `uint32 width`; `string encoding`;
+/// `uint8 is_bigendian`; `uint32 step`; `uint8[] data`. The layout is checked
+/// ([`check_image_layout`]) before the pixels are copied, and they are copied only with
+/// `pixels`.
+fn image(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>, pixels: bool) -> Result<LogMessage, Malformed> {
+    let (stamp, frame_id) = header(c)?;
+    let height = c.u32("height")?;
+    let width = c.u32("width")?;
+    let encoding = c.string("encoding")?;
+    let [is_bigendian] = c.array::<1>("is_bigendian")?;
+    let step = c.u32("step")?;
+    let data = c.prefixed("data")?;
+    check_image_layout(width, height, &encoding, step, data.len() as u64).map_err(Malformed)?;
+    let topic = topic.to_string();
+    let is_bigendian = is_bigendian != 0;
+    Ok(if pixels {
+        LogMessage::Image(ImageMessage {
+            topic,
+            stamp,
+            receive_stamp,
+            frame_id,
+            width,
+            height,
+            encoding,
+            is_bigendian,
+            step,
+            data: data.to_vec(),
+        })
+    } else {
+        LogMessage::ImageHeader(ImageHeader {
+            topic,
+            stamp,
+            receive_stamp,
+            frame_id,
+            width,
+            height,
+            encoding,
+            is_bigendian,
+            step,
+            data_len: data.len() as u64,
+        })
+    })
+}
+
+/// `sensor_msgs/CameraInfo`: header; `uint32 height`, `uint32 width`; `string
+/// distortion_model`; `float64[] D`; `float64[9] K`, `float64[9] R`, `float64[12] P`;
+/// `uint32 binning_x`, `uint32 binning_y`; `RegionOfInterest roi` (four `uint32`, a
+/// `bool`). R, P, binning and roi are read past.
+fn camera_info(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<CameraInfoMessage, Malformed> {
+    let (stamp, frame_id) = header(c)?;
+    let height = c.u32("height")?;
+    let width = c.u32("width")?;
+    let distortion_model = c.string("distortion_model")?;
+    let d = c.f64_vec("D")?;
+    let k = c.f64s::<9>("K")?;
+    c.f64s::<9>("R")?;
+    c.f64s::<12>("P")?;
+    c.u32("binning_x")?;
+    c.u32("binning_y")?;
+    c.take(4 * 4 + 1, "roi")?;
+    Ok(CameraInfoMessage {
+        topic: topic.to_string(),
+        stamp,
+        receive_stamp,
+        frame_id,
+        width,
+        height,
+        distortion_model,
+        d,
+        k,
+    })
 }

@@ -14,6 +14,8 @@
 //! | `sensor_msgs/Imu` | [`LogMessage::Imu`] |
 //! | `sensor_msgs/NavSatFix` | [`LogMessage::Gnss`] |
 //! | `geometry_msgs/PoseWithCovarianceStamped` | [`LogMessage::Pose`] |
+//! | `sensor_msgs/Image` | [`LogMessage::Image`] for the topics [`ReadOptions::images`] asks for, else [`LogMessage::ImageHeader`] (pixels not copied) |
+//! | `sensor_msgs/CameraInfo` | [`LogMessage::CameraInfo`] |
 //! | anything else | skipped, counted in [`ReadStats::skipped_by_type`] |
 //!
 //! Chunks may be stored uncompressed or compressed with `bz2` or `lz4` (the LZ4 frame
@@ -51,7 +53,7 @@ mod record;
 #[cfg(test)]
 mod tests;
 
-use crate::log::{LogMessage, LogReader, ReadStats};
+use crate::log::{LogMessage, LogReader, ReadOptions, ReadStats};
 use crate::{Error, Location, Result};
 use cursor::{Cursor, Malformed};
 use messages::Kind;
@@ -110,6 +112,8 @@ struct Decoder {
     /// Message data records seen so far, of any type.
     messages: u64,
     stats: ReadStats,
+    /// Which images to decode in full.
+    options: ReadOptions,
 }
 
 /// What a connection record said.
@@ -151,9 +155,15 @@ const MAX_RESERVE: usize = 1 << 20;
 impl BagReader<BufReader<File>> {
     /// Opens the bag at `path` and reads its bag header.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
+        Self::open_with(path, ReadOptions::default())
+    }
+
+    /// Opens the bag at `path` with `options` (which images to decode in full).
+    pub fn open_with(path: impl AsRef<Path>, options: ReadOptions) -> Result<Self> {
         let path = path.as_ref();
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let mut reader = Self::from_reader(BufReader::with_capacity(1 << 16, file), path)?;
+        reader.decoder.options = options;
         reader.prefetch = prefetch::Prefetch::spawn(path);
         Ok(reader)
     }
@@ -177,6 +187,7 @@ impl<R: Read> BagReader<R> {
                 connections: HashMap::new(),
                 messages: 0,
                 stats: ReadStats::default(),
+                options: ReadOptions::default(),
             },
             finished: false,
             compressed_chunks: 0,
@@ -184,6 +195,11 @@ impl<R: Read> BagReader<R> {
         };
         reader.read_preamble()?;
         Ok(reader)
+    }
+
+    /// Decodes the images `options` name in full from now on (see [`ReadOptions`]).
+    pub fn set_options(&mut self, options: ReadOptions) {
+        self.decoder.options = options;
     }
 
     /// The file name used in errors.
@@ -455,7 +471,8 @@ impl Decoder {
             self.stats.skip_type(&connection.ty);
             return Ok(None);
         };
-        messages::decode(kind, &connection.topic, receive, data).map(Some).map_err(|m| {
+        let pixels = self.options.images.wants(&connection.topic);
+        messages::decode(kind, &connection.topic, receive, data, pixels).map(Some).map_err(|m| {
             Error::format(&self.path, Location::Message { index: self.messages, topic: connection.topic.clone() }, m.0)
         })
     }

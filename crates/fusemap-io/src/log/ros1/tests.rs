@@ -10,6 +10,7 @@ use fusemap_core::time::Stamp;
 use std::collections::BTreeMap;
 use std::io::Write;
 
+mod camera;
 mod pose_sensors;
 
 // ---------------------------------------------------------------------------------------

@@ -197,6 +197,16 @@ impl<'a> CdrReader<'a> {
         }
     }
 
+    /// The error for `field`, which started at `position` (a value of [`Self::position`]
+    /// taken before it was read).
+    pub fn invalid_at(&self, field: &str, position: usize, what: impl fmt::Display) -> CdrError {
+        CdrError::Invalid {
+            field: self.path_to(field),
+            offset: ENCAPSULATION_HEADER_LEN + position,
+            what: what.to_string(),
+        }
+    }
+
     /// Skips padding up to a multiple of `align`, then takes `n` bytes.
     fn take(&mut self, field: &str, align: usize, n: usize) -> Result<&'a [u8], CdrError> {
         let pad = (align - self.pos % align) % align;
@@ -295,6 +305,28 @@ impl<'a> CdrReader<'a> {
         let n = self.sequence_len(field, 4)?;
         let bytes = self.take(field, 4, n * 4)?;
         Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
+    }
+
+    /// A `float64[]` sequence (the count, then elements aligned to 8).
+    pub fn f64_seq(&mut self, field: &str) -> Result<Vec<f64>, CdrError> {
+        let n = self.sequence_len(field, 8)?;
+        let mut out = Vec::with_capacity(n);
+        if n > 0 {
+            let bytes = self.take(field, 8, n * 8)?;
+            for b in bytes.chunks_exact(8) {
+                let mut a = [0u8; 8];
+                a.copy_from_slice(b);
+                out.push(f64::from_le_bytes(a));
+            }
+        }
+        Ok(out)
+    }
+
+    /// A `uint8[]` sequence, borrowed from the payload (not copied: an image's pixels
+    /// are copied only when wanted).
+    pub fn u8_seq(&mut self, field: &str) -> Result<&'a [u8], CdrError> {
+        let n = self.sequence_len(field, 1)?;
+        self.take(field, 1, n)
     }
 
     /// A `string`: `u32` length including the NUL terminator, the bytes, the NUL.

@@ -4,8 +4,9 @@
 //! each message's receive stamp.
 //!
 //! The order is taken once as a list of row ids (8 bytes a message); each payload is then
-//! fetched by id, so memory stays small however large the bag, whether or not the file
-//! has rosbag2's index on `timestamp`.
+//! fetched by id and decoded where SQLite holds it (never copied out), so memory stays
+//! small however large the bag, whether or not the file has rosbag2's index on
+//! `timestamp`.
 
 use super::{error_chain, RawMessage, Source, Topic};
 use crate::error::{Error, Location, Result};
@@ -22,10 +23,6 @@ pub(crate) struct Db3Source {
     /// Row ids in timestamp order.
     order: Vec<i64>,
     next: usize,
-    /// The current message.
-    topic_id: i64,
-    log_time: Stamp,
-    payload: Vec<u8>,
 }
 
 impl Db3Source {
@@ -68,65 +65,59 @@ impl Db3Source {
             rows.collect::<rusqlite::Result<Vec<i64>>>().map_err(|e| sql_error("reading table `messages`", e))?
         };
 
-        Ok(Self {
-            path: path.to_path_buf(),
-            conn,
-            topics,
-            order,
-            next: 0,
-            topic_id: 0,
-            log_time: Stamp::ZERO,
-            payload: Vec::new(),
-        })
+        Ok(Self { path: path.to_path_buf(), conn, topics, order, next: 0 })
     }
 
-    fn fetch(&mut self, index: u64, id: i64) -> Result<()> {
-        let at =
-            |topic: String, message: String| Error::format(&self.path, Location::Message { index, topic }, message);
+    /// Fetches row `id` and hands it to `visit`, its payload borrowed from SQLite.
+    fn fetch(&mut self, index: u64, id: i64, visit: &mut dyn FnMut(RawMessage<'_>)) -> Result<()> {
+        let path = &self.path;
+        let at = |topic: String, message: String| Error::format(path, Location::Message { index, topic }, message);
+        let topics = &self.topics;
+        // Ok(Err(topic_id)): the row names a topic `topics` does not list.
         let row = self.conn.prepare_cached("SELECT topic_id, timestamp, data FROM messages WHERE id = ?1").and_then(
             |mut stmt| {
                 stmt.query_row([id], |row| {
-                    Ok((row.get::<_, i64>(0)?, row.get::<_, i64>(1)?, row.get::<_, Vec<u8>>(2)?))
+                    let topic_id = row.get::<_, i64>(0)?;
+                    let timestamp = row.get::<_, i64>(1)?;
+                    let data = match row.get_ref(2)? {
+                        rusqlite::types::ValueRef::Blob(b) => b,
+                        rusqlite::types::ValueRef::Null => &[],
+                        other => {
+                            return Err(rusqlite::Error::FromSqlConversionFailure(
+                                2,
+                                other.data_type(),
+                                "the `data` column is not a blob".into(),
+                            ))
+                        }
+                    };
+                    let Some(topic) = topics.get(&topic_id) else { return Ok(Err(topic_id)) };
+                    visit(RawMessage { path, topic, log_time: Stamp(timestamp), data });
+                    Ok(Ok(()))
                 })
                 .optional()
             },
         );
-        let (topic_id, timestamp, data) = match row {
-            Ok(Some(row)) => row,
-            Ok(None) => {
-                return Err(at(
-                    format!("(row id {id})"),
-                    format!("row id {id} of table `messages` vanished while reading"),
-                ))
-            }
-            Err(e) => {
-                return Err(at(
-                    format!("(row id {id})"),
-                    format!("SQLite: row id {id} of table `messages`: {}", error_chain(&e)),
-                ))
-            }
-        };
-        if !self.topics.contains_key(&topic_id) {
-            return Err(at(
+        match row {
+            Ok(Some(Ok(()))) => Ok(()),
+            Ok(Some(Err(topic_id))) => Err(at(
                 format!("(topic id {topic_id})"),
                 format!("row id {id} of table `messages` has topic_id {topic_id}, which table `topics` does not list"),
-            ));
+            )),
+            Ok(None) => {
+                Err(at(format!("(row id {id})"), format!("row id {id} of table `messages` vanished while reading")))
+            }
+            Err(e) => Err(at(
+                format!("(row id {id})"),
+                format!("SQLite: row id {id} of table `messages`: {}", error_chain(&e)),
+            )),
         }
-        self.topic_id = topic_id;
-        self.log_time = Stamp(timestamp);
-        self.payload = data;
-        Ok(())
     }
 }
 
 impl Source for Db3Source {
-    fn next_raw(&mut self, index: u64) -> Option<Result<RawMessage<'_>>> {
+    fn next_raw(&mut self, index: u64, visit: &mut dyn FnMut(RawMessage<'_>)) -> Option<Result<()>> {
         let id = *self.order.get(self.next)?;
         self.next += 1;
-        if let Err(e) = self.fetch(index, id) {
-            return Some(Err(e));
-        }
-        let topic = self.topics.get(&self.topic_id)?;
-        Some(Ok(RawMessage { path: &self.path, topic, log_time: self.log_time, data: &self.payload }))
+        Some(self.fetch(index, id, visit))
     }
 }

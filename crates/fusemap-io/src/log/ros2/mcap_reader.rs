@@ -29,10 +29,6 @@ pub(crate) struct McapSource {
     /// Schema id → (name, encoding).
     schemas: HashMap<u16, (String, String)>,
     channels: HashMap<u16, Topic>,
-    /// The current message's channel, log time and payload (copied out of the reader's
-    /// buffer, which the next read may move).
-    current: Option<(u16, Stamp)>,
-    payload: Vec<u8>,
 }
 
 impl McapSource {
@@ -54,8 +50,6 @@ impl McapSource {
             bytes_read: 0,
             schemas: HashMap::new(),
             channels: HashMap::new(),
-            current: None,
-            payload: Vec::new(),
         })
     }
 
@@ -68,8 +62,9 @@ impl McapSource {
     }
 
     /// Advances to the next message record, handling schema and channel records on the
-    /// way. `Ok(false)` at the end of the file.
-    fn advance(&mut self, index: u64) -> Result<bool> {
+    /// way, and hands it to `visit` where the reader holds it. `Ok(false)` at the end of
+    /// the file.
+    fn advance(&mut self, index: u64, visit: &mut dyn FnMut(RawMessage<'_>)) -> Result<bool> {
         loop {
             let event = match self.reader.next_event() {
                 None => return Ok(false),
@@ -113,16 +108,16 @@ impl McapSource {
                                 .insert(c.id, Topic { name: c.topic, type_name, encoding: c.message_encoding });
                         }
                         Record::Message { header, data } => {
-                            self.payload.clear();
-                            self.payload.extend_from_slice(&data);
-                            let log_time = i64::try_from(header.log_time).map_err(|_| {
-                                self.message_error(
-                                    index,
-                                    header.channel_id,
-                                    format!("log_time {} ns is beyond year 2262", header.log_time),
-                                )
-                            })?;
-                            self.current = Some((header.channel_id, Stamp(log_time)));
+                            let channel = header.channel_id;
+                            let Ok(log_time) = i64::try_from(header.log_time) else {
+                                let what = format!("log_time {} ns is beyond year 2262", header.log_time);
+                                return Err(message_error(&self.path, &self.channels, index, channel, what));
+                            };
+                            let Some(topic) = self.channels.get(&channel) else {
+                                let what = format!("message on channel {channel}, which no Channel record declared");
+                                return Err(message_error(&self.path, &self.channels, index, channel, what));
+                            };
+                            visit(RawMessage { path: &self.path, topic, log_time: Stamp(log_time), data: &data });
                             return Ok(true);
                         }
                         _ => {}
@@ -131,31 +126,23 @@ impl McapSource {
             }
         }
     }
+}
 
-    fn message_error(&self, index: u64, channel: u16, message: String) -> Error {
-        let topic = match self.channels.get(&channel) {
-            Some(t) => t.name.clone(),
-            None => format!("(channel {channel})"),
-        };
-        Error::format(&self.path, Location::Message { index, topic }, message)
-    }
+/// A message error naming the message's topic (or its channel when undeclared).
+fn message_error(path: &Path, channels: &HashMap<u16, Topic>, index: u64, channel: u16, message: String) -> Error {
+    let topic = match channels.get(&channel) {
+        Some(t) => t.name.clone(),
+        None => format!("(channel {channel})"),
+    };
+    Error::format(path, Location::Message { index, topic }, message)
 }
 
 impl Source for McapSource {
-    fn next_raw(&mut self, index: u64) -> Option<Result<RawMessage<'_>>> {
-        match self.advance(index) {
-            Ok(true) => {}
-            Ok(false) => return None,
-            Err(e) => return Some(Err(e)),
-        }
-        let (channel, log_time) = self.current?;
-        match self.channels.get(&channel) {
-            Some(topic) => Some(Ok(RawMessage { path: &self.path, topic, log_time, data: &self.payload })),
-            None => Some(Err(self.message_error(
-                index,
-                channel,
-                format!("message on channel {channel}, which no Channel record declared"),
-            ))),
+    fn next_raw(&mut self, index: u64, visit: &mut dyn FnMut(RawMessage<'_>)) -> Option<Result<()>> {
+        match self.advance(index, visit) {
+            Ok(true) => Some(Ok(())),
+            Ok(false) => None,
+            Err(e) => Some(Err(e)),
         }
     }
 }

@@ -5,8 +5,9 @@
 //! yield raw messages with their topic, type name, encoding and log time; one
 //! [`Ros2Reader`] decodes those fusemap uses (`sensor_msgs/msg/LaserScan`,
 //! `nav_msgs/msg/Odometry`, `tf2_msgs/msg/TFMessage`, `sensor_msgs/msg/Imu`,
-//! `sensor_msgs/msg/NavSatFix`, `geometry_msgs/msg/PoseWithCovarianceStamped`; see
-//! [`cdr`] and [`msgs`]) into [`LogMessage`]s and counts the rest in
+//! `sensor_msgs/msg/NavSatFix`, `geometry_msgs/msg/PoseWithCovarianceStamped`,
+//! `sensor_msgs/msg/Image`, `sensor_msgs/msg/CameraInfo`; see [`cdr`] and [`msgs`]) into
+//! [`LogMessage`]s and counts the rest in
 //! [`ReadStats::skipped_by_type`]. A message whose payload does not decode is an
 //! [`Error::Format`] at [`Location::Message`] (file, 1-based index in the log, topic),
 //! and reading can go on with the next one ([`Error::is_skippable`]); a container error
@@ -14,6 +15,10 @@
 //!
 //! Every message gets its container's log time as `receive_stamp` (MCAP `log_time`,
 //! `.db3` `timestamp`); the header stamp is passed on as written.
+//!
+//! Payloads are decoded where the container holds them (MCAP's chunk buffer, SQLite's
+//! row), never copied first; an image's pixels are copied only for the topics
+//! [`ReadOptions::images`] names, every other image is an [`ImageHeader`].
 //!
 //! ```no_run
 //! use fusemap_io::log::ros2::open_ros2;
@@ -40,8 +45,8 @@ pub mod writer;
 
 use crate::error::{Error, Location, Result};
 use crate::log::{
-    planar_pose, GnssMessage, ImuMessage, LogMessage, LogReader, OdomMessage, PoseMessage, ReadStats, ScanMessage,
-    TfMessage, Transform,
+    planar_pose, CameraInfoMessage, GnssMessage, ImageHeader, ImageMessage, ImuMessage, LogMessage, LogReader,
+    OdomMessage, PoseMessage, ReadOptions, ReadStats, ScanMessage, TfMessage, Transform,
 };
 use cdr::{decode_cdr, CdrError};
 use fusemap_core::sensor::LaserScan;
@@ -87,17 +92,23 @@ pub enum KnownType {
     NavSatFix,
     /// `geometry_msgs/msg/PoseWithCovarianceStamped`.
     PoseWithCovarianceStamped,
+    /// `sensor_msgs/msg/Image`.
+    Image,
+    /// `sensor_msgs/msg/CameraInfo`.
+    CameraInfo,
 }
 
 impl KnownType {
     /// All of them, for tests and fuzzing.
-    pub const ALL: [KnownType; 6] = [
+    pub const ALL: [KnownType; 8] = [
         KnownType::LaserScan,
         KnownType::Odometry,
         KnownType::TfMessage,
         KnownType::Imu,
         KnownType::NavSatFix,
         KnownType::PoseWithCovarianceStamped,
+        KnownType::Image,
+        KnownType::CameraInfo,
     ];
 
     /// The type from its ROS 2 name (`sensor_msgs/msg/LaserScan`); the ROS 1 spelling
@@ -112,6 +123,8 @@ impl KnownType {
             "geometry_msgs/msg/PoseWithCovarianceStamped" | "geometry_msgs/PoseWithCovarianceStamped" => {
                 Some(KnownType::PoseWithCovarianceStamped)
             }
+            "sensor_msgs/msg/Image" | "sensor_msgs/Image" => Some(KnownType::Image),
+            "sensor_msgs/msg/CameraInfo" | "sensor_msgs/CameraInfo" => Some(KnownType::CameraInfo),
             _ => None,
         }
     }
@@ -125,17 +138,31 @@ impl KnownType {
             KnownType::Imu => "sensor_msgs/msg/Imu",
             KnownType::NavSatFix => "sensor_msgs/msg/NavSatFix",
             KnownType::PoseWithCovarianceStamped => "geometry_msgs/msg/PoseWithCovarianceStamped",
+            KnownType::Image => "sensor_msgs/msg/Image",
+            KnownType::CameraInfo => "sensor_msgs/msg/CameraInfo",
         }
     }
 }
 
 /// Decodes one CDR payload (encapsulation header included) of type `kind` received on
-/// `topic` into fusemap's message type.
+/// `topic` into fusemap's message type; an image with its pixels.
 pub fn decode_known(
     kind: KnownType,
     topic: &str,
     receive_stamp: Option<Stamp>,
     payload: &[u8],
+) -> std::result::Result<LogMessage, CdrError> {
+    decode_known_with(kind, topic, receive_stamp, payload, true)
+}
+
+/// [`decode_known`], with an image's pixels copied only with `pixels` (else it becomes
+/// an [`ImageHeader`]; its layout is checked either way).
+pub fn decode_known_with(
+    kind: KnownType,
+    topic: &str,
+    receive_stamp: Option<Stamp>,
+    payload: &[u8],
+    pixels: bool,
 ) -> std::result::Result<LogMessage, CdrError> {
     use msgs::{geometry_msgs, nav_msgs, sensor_msgs, tf2_msgs};
     Ok(match kind {
@@ -239,6 +266,52 @@ pub fn decode_known(
                 covariance: m.pose.covariance,
             })
         }
+        KnownType::Image => {
+            let m = sensor_msgs::Image::from_payload(payload)?;
+            let stamp = m.header.stamp.to_stamp();
+            let is_bigendian = m.is_bigendian != 0;
+            if pixels {
+                LogMessage::Image(ImageMessage {
+                    topic: topic.to_owned(),
+                    stamp,
+                    receive_stamp,
+                    frame_id: m.header.frame_id,
+                    width: m.width,
+                    height: m.height,
+                    encoding: m.encoding,
+                    is_bigendian,
+                    step: m.step,
+                    data: m.data.to_vec(),
+                })
+            } else {
+                LogMessage::ImageHeader(ImageHeader {
+                    topic: topic.to_owned(),
+                    stamp,
+                    receive_stamp,
+                    frame_id: m.header.frame_id,
+                    width: m.width,
+                    height: m.height,
+                    encoding: m.encoding,
+                    is_bigendian,
+                    step: m.step,
+                    data_len: m.data.len() as u64,
+                })
+            }
+        }
+        KnownType::CameraInfo => {
+            let m: sensor_msgs::CameraInfo = decode_cdr(payload)?;
+            LogMessage::CameraInfo(CameraInfoMessage {
+                topic: topic.to_owned(),
+                stamp: m.header.stamp.to_stamp(),
+                receive_stamp,
+                frame_id: m.header.frame_id,
+                width: m.width,
+                height: m.height,
+                distortion_model: m.distortion_model,
+                d: m.d,
+                k: m.k,
+            })
+        }
     })
 }
 
@@ -277,8 +350,11 @@ pub(crate) struct RawMessage<'a> {
 
 /// A storage file that yields raw messages in its order.
 pub(crate) trait Source {
-    /// The next message; `index` is its 1-based position in the whole log, for errors.
-    fn next_raw(&mut self, index: u64) -> Option<Result<RawMessage<'_>>>;
+    /// Hands the next message to `visit`, its payload borrowed from where the container
+    /// holds it (so an unwanted payload is never copied); `index` is its 1-based position
+    /// in the whole log, for errors. `None` at the end of the storage, `Some(Err)` for an
+    /// error of the container (which ends the log).
+    fn next_raw(&mut self, index: u64, visit: &mut dyn FnMut(RawMessage<'_>)) -> Option<Result<()>>;
 }
 
 /// Storage that is opened when the reader reaches it.
@@ -314,11 +390,28 @@ pub struct Ros2Reader {
     stats: ReadStats,
     finished: bool,
     scratch: Vec<u8>,
+    options: ReadOptions,
 }
 
 impl Ros2Reader {
     /// Opens a rosbag2 directory (or its `metadata.yaml`), a `.mcap` or a `.db3` file.
     pub fn open(path: &Path) -> Result<Self> {
+        Self::open_with(path, ReadOptions::default())
+    }
+
+    /// [`Ros2Reader::open`] with `options` (which images to decode in full).
+    pub fn open_with(path: &Path, options: ReadOptions) -> Result<Self> {
+        let mut reader = Self::open_any(path)?;
+        reader.options = options;
+        Ok(reader)
+    }
+
+    /// Decodes the images `options` name in full from now on.
+    pub fn set_options(&mut self, options: ReadOptions) {
+        self.options = options;
+    }
+
+    fn open_any(path: &Path) -> Result<Self> {
         if path.is_dir() {
             return Self::open_rosbag2(path);
         }
@@ -380,6 +473,7 @@ impl Ros2Reader {
             stats: ReadStats::default(),
             finished: false,
             scratch: Vec::new(),
+            options: ReadOptions::default(),
         })
     }
 
@@ -399,7 +493,11 @@ impl Ros2Reader {
                 }
             };
             let index = self.index + 1;
-            let raw = match source.next_raw(index) {
+            let (stats, scratch, options, zstd_messages) =
+                (&mut self.stats, &mut self.scratch, &self.options, self.zstd_messages);
+            let mut out = None;
+            let mut visit = |raw: RawMessage<'_>| out = decode_raw(raw, index, stats, scratch, options, zstd_messages);
+            match source.next_raw(index, &mut visit) {
                 None => {
                     self.current = None;
                     continue;
@@ -408,41 +506,52 @@ impl Ros2Reader {
                     self.finished = true;
                     return Some(Err(e));
                 }
-                Some(Ok(raw)) => raw,
-            };
+                Some(Ok(())) => {}
+            }
             self.index = index;
-            let topic = raw.topic;
-            let Some(kind) = KnownType::from_name(&topic.type_name) else {
-                let t = if topic.type_name.is_empty() { "(no schema)" } else { &topic.type_name };
-                self.stats.skip_type(t);
-                continue;
-            };
-            if !topic.encoding.eq_ignore_ascii_case("cdr") {
-                self.stats.skip_type(&format!("{} ({} encoding)", topic.type_name, topic.encoding));
-                continue;
+            if let Some(message) = out {
+                return Some(message);
             }
-            let at = |message: String| {
-                Error::format(raw.path, Location::Message { index, topic: topic.name.clone() }, message)
-            };
-            let mut payload = raw.data;
-            if self.zstd_messages {
-                self.scratch.clear();
-                let decoded = zstd::stream::read::Decoder::new(payload)
-                    .and_then(|d| d.take(MAX_MESSAGE_LEN).read_to_end(&mut self.scratch));
-                if let Err(e) = decoded {
-                    return Some(Err(at(format!(
-                        "{}: the bag says messages are zstd-compressed, but: {e}",
-                        topic.type_name
-                    ))));
-                }
-                payload = &self.scratch;
-            }
-            let log_time = Some(raw.log_time);
-            return Some(
-                decode_known(kind, &topic.name, log_time, payload).map_err(|e| at(format!("{}: {e}", topic.type_name))),
-            );
         }
     }
+}
+
+/// Decodes one raw message: `None` when its type is not one fusemap uses (counted in
+/// `stats`).
+fn decode_raw(
+    raw: RawMessage<'_>,
+    index: u64,
+    stats: &mut ReadStats,
+    scratch: &mut Vec<u8>,
+    options: &ReadOptions,
+    zstd_messages: bool,
+) -> Option<Result<LogMessage>> {
+    let topic = raw.topic;
+    let Some(kind) = KnownType::from_name(&topic.type_name) else {
+        let t = if topic.type_name.is_empty() { "(no schema)" } else { &topic.type_name };
+        stats.skip_type(t);
+        return None;
+    };
+    if !topic.encoding.eq_ignore_ascii_case("cdr") {
+        stats.skip_type(&format!("{} ({} encoding)", topic.type_name, topic.encoding));
+        return None;
+    }
+    let at = |message: String| Error::format(raw.path, Location::Message { index, topic: topic.name.clone() }, message);
+    let mut payload = raw.data;
+    if zstd_messages {
+        scratch.clear();
+        let decoded =
+            zstd::stream::read::Decoder::new(payload).and_then(|d| d.take(MAX_MESSAGE_LEN).read_to_end(scratch));
+        if let Err(e) = decoded {
+            return Some(Err(at(format!("{}: the bag says messages are zstd-compressed, but: {e}", topic.type_name))));
+        }
+        payload = scratch;
+    }
+    let pixels = options.images.wants(&topic.name);
+    Some(
+        decode_known_with(kind, &topic.name, Some(raw.log_time), payload, pixels)
+            .map_err(|e| at(format!("{}: {e}", topic.type_name))),
+    )
 }
 
 impl LogReader for Ros2Reader {

@@ -8,6 +8,7 @@ use super::*;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+mod camera;
 mod pose_sensors;
 
 /// A little-endian CDR writer for tests. Padding is 0xAA, so a decoder that reads
@@ -242,6 +243,8 @@ fn all_payloads() -> Vec<(KnownType, Vec<u8>)> {
             KnownType::PoseWithCovarianceStamped,
             pose_sensors::pose_payload("map", [1.0, 2.0, 3.0], [0.0, 0.0, 0.0, 1.0]),
         ),
+        (KnownType::Image, camera::Img::labels().payload()),
+        (KnownType::CameraInfo, camera::camera_info_payload(&[0.1, 0.2], camera::sample_k())),
     ]
 }
 
@@ -402,6 +405,8 @@ fn check_sample(messages: Vec<Result<LogMessage>>, stats: &ReadStats) {
             LogMessage::Imu(_) => "imu",
             LogMessage::Gnss(_) => "gnss",
             LogMessage::Pose(_) => "pose",
+            LogMessage::Image(_) | LogMessage::ImageHeader(_) => "image",
+            LogMessage::CameraInfo(_) => "camera info",
         })
         .collect();
     assert_eq!(kinds, ["tf", "scan", "odom", "imu", "scan"]);

@@ -1,8 +1,10 @@
-//! `sensor_msgs`: planar laser scans, inertial measurements and satellite navigation fixes.
+//! `sensor_msgs`: planar laser scans, inertial measurements, satellite navigation fixes,
+//! camera images and calibrations.
 
 use super::geometry_msgs::{Quaternion, Vector3};
 use super::std_msgs::Header;
-use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
+use crate::log::check_image_layout;
+use crate::log::ros2::cdr::{check_encapsulation, CdrDecode, CdrError, CdrReader};
 
 /// `sensor_msgs/msg/LaserScan`: one sweep of a planar range finder.
 ///
@@ -133,6 +135,125 @@ impl CdrDecode for NavSatFix {
             altitude: r.f64("altitude")?,
             position_covariance: r.f64_array("position_covariance")?,
             position_covariance_type: r.u8("position_covariance_type")?,
+        })
+    }
+}
+
+/// `sensor_msgs/msg/Image`: an uncompressed image, pixel (0, 0) at the top left, with its
+/// pixels borrowed from the payload (so that reading the header costs no copy).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image<'a> {
+    /// Acquisition time; `frame_id` is the camera's optical frame (z forward, x right,
+    /// y down).
+    pub header: Header,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// Pixel encoding (`sensor_msgs/image_encodings.h` names: `mono8`, `16UC1`, …).
+    pub encoding: String,
+    /// Non-zero when multi-byte pixels are big-endian.
+    pub is_bigendian: u8,
+    /// Full row length, bytes.
+    pub step: u32,
+    /// The pixels, `step × height` bytes.
+    pub data: &'a [u8],
+}
+
+impl<'a> Image<'a> {
+    /// Reads the fields in declaration order and checks the layout
+    /// ([`check_image_layout`]): an image whose sizes do not fit its data is an error at
+    /// its `data` field.
+    pub fn decode(r: &mut CdrReader<'a>) -> Result<Self, CdrError> {
+        let header = r.decode_field("header")?;
+        let height = r.u32("height")?;
+        let width = r.u32("width")?;
+        let encoding = r.string("encoding")?;
+        let is_bigendian = r.u8("is_bigendian")?;
+        let step = r.u32("step")?;
+        let at = r.position();
+        let data = r.u8_seq("data")?;
+        check_image_layout(width, height, &encoding, step, data.len() as u64)
+            .map_err(|e| r.invalid_at("data", at, e))?;
+        Ok(Self { header, height, width, encoding, is_bigendian, step, data })
+    }
+
+    /// Decodes a whole payload (encapsulation header included).
+    pub fn from_payload(payload: &'a [u8]) -> Result<Self, CdrError> {
+        let body = check_encapsulation(payload)?;
+        Self::decode(&mut CdrReader::new(body))
+    }
+}
+
+/// `sensor_msgs/msg/RegionOfInterest`: a rectangle of the image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RegionOfInterest {
+    /// Leftmost column.
+    pub x_offset: u32,
+    /// Topmost row.
+    pub y_offset: u32,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// True when the region is to be rectified.
+    pub do_rectify: bool,
+}
+
+impl CdrDecode for RegionOfInterest {
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        Ok(Self {
+            x_offset: r.u32("x_offset")?,
+            y_offset: r.u32("y_offset")?,
+            height: r.u32("height")?,
+            width: r.u32("width")?,
+            do_rectify: r.u8("do_rectify")? != 0,
+        })
+    }
+}
+
+/// `sensor_msgs/msg/CameraInfo`: the calibration of a camera (pinhole intrinsics `k`,
+/// distortion `d` of `distortion_model`, rectification `r`, projection `p`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraInfo {
+    /// Stamp and the optical frame.
+    pub header: Header,
+    /// Image rows the calibration is for.
+    pub height: u32,
+    /// Image columns the calibration is for.
+    pub width: u32,
+    /// `plumb_bob`, `rational_polynomial`, `equidistant`, …
+    pub distortion_model: String,
+    /// Distortion parameters, as many as the model has.
+    pub d: Vec<f64>,
+    /// Row-major 3 × 3 intrinsics `fx 0 cx; 0 fy cy; 0 0 1`.
+    pub k: [f64; 9],
+    /// Row-major 3 × 3 rectification rotation (stereo).
+    pub r: [f64; 9],
+    /// Row-major 3 × 4 projection of the rectified image.
+    pub p: [f64; 12],
+    /// Horizontal binning, 0 or 1 for none.
+    pub binning_x: u32,
+    /// Vertical binning.
+    pub binning_y: u32,
+    /// The region of the full image this calibration covers.
+    pub roi: RegionOfInterest,
+}
+
+impl CdrDecode for CameraInfo {
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        Ok(Self {
+            header: r.decode_field("header")?,
+            height: r.u32("height")?,
+            width: r.u32("width")?,
+            distortion_model: r.string("distortion_model")?,
+            d: r.f64_seq("d")?,
+            k: r.f64_array("k")?,
+            r: r.f64_array("r")?,
+            p: r.f64_array("p")?,
+            binning_x: r.u32("binning_x")?,
+            binning_y: r.u32("binning_y")?,
+            roi: r.decode_field("roi")?,
         })
     }
 }
