@@ -118,3 +118,32 @@ fn frames_that_do_not_fit_the_camera_are_refused_and_counted() {
     assert_eq!(e.stats().measurements, 0);
     let _ = CellIndex::new(0, 0);
 }
+
+#[test]
+fn the_layers_as_rasters() {
+    let (mut e, cam) = engine();
+    e.set_dynamic(DynamicParams::default(), true);
+    let m = model();
+    let (labels, depth) = render(&m, 3.0, -0.3..0.3);
+    for k in 0..5 {
+        e.insert_camera_frame(cam, None, Stamp(k * 100_000_000), &labels, &depth, Pose2::IDENTITY).unwrap();
+    }
+    let g = e.grid();
+    let area = g.known_box().unwrap();
+    let s = super::rasters::semantic_cells(g, area, m.classes());
+    let wall = g.geometry().cell_of(Point2::new(3.01, 1.0)).unwrap();
+    let idx = |r: &crate::grid::CellRaster<_>, c: CellIndex| {
+        ((c.y - r.first_cell.y) as usize) * r.width + (c.x - r.first_cell.x) as usize
+    };
+    let i = idx(&s.best, wall);
+    assert_eq!(m.classes().get(s.best.cells[i] as u8).id, WALL);
+    let sum: f32 = s.probs[i * s.classes..(i + 1) * s.classes].iter().sum();
+    assert!((sum - 1.0).abs() < 1e-5 && s.prob[i] > 0.5);
+    // The person's cells: dynamic now, unknown (decayed to nothing) a minute later.
+    let person = g.geometry().cell_of(Point2::new(3.01, 0.0)).unwrap();
+    let now = super::rasters::dynamic_cells(g, area, Stamp(400_000_000), 2.0);
+    let j = ((person.y - now.first_cell.y) as usize) * now.width + (person.x - now.first_cell.x) as usize;
+    assert!(now.known[j] && now.cells[j] > 0.65, "{}", now.cells[j]);
+    let later = super::rasters::dynamic_cells(g, area, Stamp(60_000_000_000), 2.0);
+    assert!((later.cells[j] - 0.5).abs() < 0.01);
+}

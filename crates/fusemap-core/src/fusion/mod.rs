@@ -9,6 +9,7 @@ mod engine;
 mod mapset;
 #[cfg(test)]
 mod merge_tests;
+pub mod rasters;
 mod sensors;
 
 pub use correlation::Correlation;

@@ -1,0 +1,58 @@
+//! Dense views of a fusion map's extra layers, for exporters: the semantic layer's most
+//! likely class, its probability and the whole distribution per cell, and the dynamic
+//! layer's probability at a given time.
+
+use super::camera::cell_semantics;
+use crate::grid::{logodds::probability, CellBox, CellIndex, CellRaster, FusionGrid};
+use crate::sensor::camera::ClassTable;
+use crate::time::Stamp;
+
+/// The semantic layer over an area.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SemanticCells {
+    /// Per cell, the index (into the class table) of the most likely class, -1 where the
+    /// layer holds no evidence; `known` marks cells with evidence.
+    pub best: CellRaster<i16>,
+    /// Per cell, the probability of the most likely class (0 without evidence).
+    pub prob: Vec<f32>,
+    /// Per cell, the probability of every class: `cells × classes`, cell-major.
+    pub probs: Vec<f32>,
+    /// Number of classes.
+    pub classes: usize,
+}
+
+/// The semantic layer of `grid` over `area` with the class table `classes`.
+pub fn semantic_cells(grid: &FusionGrid, area: CellBox, classes: &ClassTable) -> SemanticCells {
+    let eligible: Vec<bool> = classes.iter().map(|c| !c.ignore && !c.dynamic).collect();
+    let k = eligible.len();
+    let best = grid.cell_raster(area, -1i16, |tile, offset| {
+        let mut out = vec![0.0; k];
+        cell_semantics(tile, offset, &eligible, &mut out).map(|(b, _)| b as i16)
+    });
+    let n = best.width * best.height;
+    let mut prob = vec![0.0f32; n];
+    let mut probs = vec![0.0f32; n * k];
+    for row in 0..best.height {
+        for col in 0..best.width {
+            let i = row * best.width + col;
+            if !best.known[i] {
+                continue;
+            }
+            let cell = CellIndex::new(best.first_cell.x + col as i64, best.first_cell.y + row as i64);
+            if let Some((tile, offset)) = grid.tile_of(cell) {
+                if let Some((_, p)) = cell_semantics(tile, offset, &eligible, &mut probs[i * k..(i + 1) * k]) {
+                    prob[i] = p;
+                }
+            }
+        }
+    }
+    SemanticCells { best, prob, probs, classes: k }
+}
+
+/// The dynamic layer's probability over `area` at `now` (its evidence decayed with
+/// `half_life_s`); cells the layer never wrote are unknown (0.5, `known` false).
+pub fn dynamic_cells(grid: &FusionGrid, area: CellBox, now: Stamp, half_life_s: f64) -> CellRaster<f32> {
+    grid.cell_raster(area, 0.5f32, |tile, offset| {
+        tile.layers().dynamic()?.log_odds_at(offset, now, half_life_s).map(|l| probability(l as f64) as f32)
+    })
+}
