@@ -6,13 +6,16 @@
 //! misspelt `p_ocupied` is an error and not a silently ignored line. Every validation
 //! error names the field, in the path form the TOML file uses (`lidar[0].p_occ`).
 
+mod camera;
 mod sensor;
 
+pub use camera::{ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
 pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 
 use crate::estimator::EstimatorConfig;
 use crate::geometry::Point2;
 use crate::grid::{GridGeometry, OccupancyParams};
+use crate::sensor::ClassTable;
 use serde::{Deserialize, Serialize};
 
 /// The whole configuration.
@@ -31,6 +34,10 @@ pub struct Config {
     /// How robot logs are read: topics, pose source, time synchronisation.
     #[serde(default)]
     pub log: LogConfig,
+    /// The semantic classes of the cameras' label images, one `[[class]]` table each;
+    /// none: [`ClassTable::production_default`].
+    #[serde(default)]
+    pub class: Vec<ClassConfig>,
 }
 
 /// Where a log's scans get their poses.
@@ -214,6 +221,11 @@ pub struct Plan {
     /// The enabled sensors that are not lidars, as configured (kinds not listed are
     /// auto-detected by the log pipeline with [`auto_sensor`]).
     pub sensors: Vec<PlannedSensor>,
+    /// The enabled cameras. Only cameras listed in the config: they are never
+    /// auto-detected.
+    pub cameras: Vec<PlannedCamera>,
+    /// The semantic classes of the label images.
+    pub classes: ClassTable,
     /// Kinds listed only with `enabled = false`: not auto-detected either.
     pub disabled_kinds: Vec<SensorKind>,
     /// How logs are read.
@@ -258,7 +270,8 @@ impl Config {
             free_threshold: free_t,
         };
 
-        let (mut lidars, sensors) = sensor::plan_sensors(&self.sensor, prior)?;
+        let sensor::PlannedSensors { mut lidars, cameras, others: sensors } =
+            sensor::plan_sensors(&self.sensor, prior)?;
         let lidar_listed = self.sensor.iter().any(|s| s.kind == SensorKind::Lidar);
         if lidars.is_empty() && !lidar_listed {
             lidars.push(sensor::default_lidar());
@@ -298,6 +311,7 @@ impl Config {
                 listed.clone().next().is_some() && listed.all(|s| !s.enabled)
             })
             .collect();
+        let classes = camera::class_table(&self.class)?;
         // The estimator names the field first: `estimator.gate_probability must be …`.
         self.estimator.validate().map_err(|m| match m.split_once(' ') {
             Some((field, rest)) if field.starts_with("estimator.") => err(field, rest),
@@ -308,6 +322,8 @@ impl Config {
             occupancy,
             lidars,
             sensors,
+            cameras,
+            classes,
             disabled_kinds,
             log: g.clone(),
             estimator: self.estimator.clone(),
