@@ -222,7 +222,9 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                     out.push(EstimatorInput::Pose { stamp: offset(m.stamp, s), pose: m.pose2(), covariance: cov });
                 }
             }
-            SensorKind::Lidar => {}
+            // Lidars and cameras give the map evidence, not the estimator (cameras are
+            // planned apart, in `Plan::cameras`, and never bound here).
+            SensorKind::Lidar | SensorKind::Camera => {}
         }
     }
     Ok(Inputs { inputs: out, gnss: gnss_reports, config: est, notes })

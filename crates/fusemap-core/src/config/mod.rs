@@ -6,15 +6,18 @@
 //! misspelt `p_ocupied` is an error and not a silently ignored line. Every validation
 //! error names the field, in the path form the TOML file uses (`lidar[0].p_occ`).
 
+mod camera;
 mod fusion;
 mod sensor;
 
+pub use camera::{ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
 pub use fusion::FusionConfig;
 pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 
 use crate::estimator::EstimatorConfig;
 use crate::geometry::Point2;
 use crate::grid::{GridGeometry, OccupancyParams};
+use crate::sensor::ClassTable;
 use serde::{Deserialize, Serialize};
 
 /// The whole configuration.
@@ -36,6 +39,10 @@ pub struct Config {
     /// How the sensors' evidence is combined: correlated sensors, the dynamic layer.
     #[serde(default)]
     pub fusion: FusionConfig,
+    /// The semantic classes of the cameras' label images, one `[[class]]` table each;
+    /// none: [`ClassTable::production_default`].
+    #[serde(default)]
+    pub class: Vec<ClassConfig>,
 }
 
 /// Where a log's scans get their poses.
@@ -219,6 +226,11 @@ pub struct Plan {
     /// The enabled sensors that are not lidars, as configured (kinds not listed are
     /// auto-detected by the log pipeline with [`auto_sensor`]).
     pub sensors: Vec<PlannedSensor>,
+    /// The enabled cameras. Only cameras listed in the config: they are never
+    /// auto-detected.
+    pub cameras: Vec<PlannedCamera>,
+    /// The semantic classes of the label images.
+    pub classes: ClassTable,
     /// Kinds listed only with `enabled = false`: not auto-detected either.
     pub disabled_kinds: Vec<SensorKind>,
     /// How logs are read.
@@ -267,7 +279,8 @@ impl Config {
             free_threshold: free_t,
         };
 
-        let (mut lidars, sensors) = sensor::plan_sensors(&self.sensor, prior)?;
+        let sensor::PlannedSensors { mut lidars, cameras, others: sensors } =
+            sensor::plan_sensors(&self.sensor, prior)?;
         let lidar_listed = self.sensor.iter().any(|s| s.kind == SensorKind::Lidar);
         if lidars.is_empty() && !lidar_listed {
             lidars.push(sensor::default_lidar());
@@ -307,6 +320,7 @@ impl Config {
                 listed.clone().next().is_some() && listed.all(|s| !s.enabled)
             })
             .collect();
+        let classes = camera::class_table(&self.class)?;
         // The estimator names the field first: `estimator.gate_probability must be …`.
         self.estimator.validate().map_err(|m| match m.split_once(' ') {
             Some((field, rest)) if field.starts_with("estimator.") => err(field, rest),
@@ -315,7 +329,9 @@ impl Config {
         let dynamic = self.fusion.validate(occ_t)?;
         for (i, group) in self.fusion.correlated.iter().enumerate() {
             for name in group {
-                let known = lidars.iter().any(|l| &l.name == name) || sensors.iter().any(|s| &s.name == name);
+                let known = lidars.iter().any(|l| &l.name == name)
+                    || cameras.iter().any(|c| &c.name == name)
+                    || sensors.iter().any(|s| &s.name == name);
                 if !known {
                     return Err(err(format!("fusion.correlated[{i}]"), format!("no enabled sensor is named `{name}`")));
                 }
@@ -326,6 +342,8 @@ impl Config {
             occupancy,
             lidars,
             sensors,
+            cameras,
+            classes,
             disabled_kinds,
             log: g.clone(),
             estimator: self.estimator.clone(),

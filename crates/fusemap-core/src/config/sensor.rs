@@ -6,7 +6,8 @@
 //! wrong kind is an error naming it (a `p_occ` on an IMU is a mistake, not a no-op).
 //!
 //! Kinds not listed at all are looked for in the log under their usual topics (`/scan` or
-//! the log's only scan topic, `/odom`, `/imu`, `/fix`), so a log with no config still maps;
+//! the log's only scan topic, `/odom`, `/imu`, `/fix`), so a log with no config still maps
+//! (cameras excepted: a camera is used only when listed);
 //! a kind that is listed is used exactly as written (its topic must be in the log), and
 //! `enabled = false` switches a kind off, auto-detection included.
 
@@ -14,6 +15,7 @@ use crate::geometry::{Mount3, PlanarMount};
 use crate::sensor::{LidarModel, LidarParams, MaxRangePolicy};
 use serde::{Deserialize, Serialize};
 
+use super::camera::{plan_camera, PlannedCamera};
 use super::{err, finite, probability, ConfigError};
 
 /// What a sensor is.
@@ -30,12 +32,21 @@ pub enum SensorKind {
     Gnss,
     /// Absolute poses (`geometry_msgs/PoseWithCovarianceStamped`), e.g. from a localiser.
     Pose,
+    /// A semantic camera: a class-label image, an aligned depth image and their
+    /// `CameraInfo` ([`CameraModel`](crate::sensor::CameraModel)). Never auto-detected.
+    Camera,
 }
 
 impl SensorKind {
     /// Every kind, in table order.
-    pub const ALL: [SensorKind; 5] =
-        [SensorKind::Lidar, SensorKind::WheelOdometry, SensorKind::Imu, SensorKind::Gnss, SensorKind::Pose];
+    pub const ALL: [SensorKind; 6] = [
+        SensorKind::Lidar,
+        SensorKind::WheelOdometry,
+        SensorKind::Imu,
+        SensorKind::Gnss,
+        SensorKind::Pose,
+        SensorKind::Camera,
+    ];
 
     /// The config spelling.
     pub fn as_str(self) -> &'static str {
@@ -45,6 +56,7 @@ impl SensorKind {
             SensorKind::Imu => "imu",
             SensorKind::Gnss => "gnss",
             SensorKind::Pose => "pose",
+            SensorKind::Camera => "camera",
         }
     }
 
@@ -57,7 +69,7 @@ impl SensorKind {
         }
     }
 
-    /// The topic looked for when the config names none.
+    /// The topic looked for when the config names none (for a camera, its label images).
     pub fn default_topic(self) -> &'static str {
         match self {
             SensorKind::Lidar => "/scan",
@@ -65,6 +77,7 @@ impl SensorKind {
             SensorKind::Imu => "/imu",
             SensorKind::Gnss => "/fix",
             SensorKind::Pose => "/pose",
+            SensorKind::Camera => "/camera/labels",
         }
     }
 }
@@ -73,7 +86,7 @@ impl SensorKind {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SensorConfig {
-    /// `lidar`, `wheel_odometry`, `imu`, `gnss` or `pose`.
+    /// `lidar`, `wheel_odometry`, `imu`, `gnss`, `pose` or `camera`.
     pub kind: SensorKind,
     /// A name for reports; default: the kind, numbered when repeated.
     #[serde(default)]
@@ -92,8 +105,9 @@ pub struct SensorConfig {
     /// calibration turns).
     #[serde(default)]
     pub time_offset_s: f64,
-    /// The mount `base_from_sensor`. Given, it is checked against the log's TF; left out,
-    /// the log's TF is used, else identity.
+    /// The mount `base_from_sensor` (for a camera: `base_from_camera_optical`, the optical
+    /// frame of REP 103). Given, it is checked against the log's TF; left out, the log's TF
+    /// is used, else identity (for a camera: a level forward camera at the base origin).
     #[serde(default)]
     pub base_from_sensor: Option<Mount3>,
 
@@ -159,6 +173,45 @@ pub struct SensorConfig {
     /// Pose: yaw σ where the message's covariance is zero or unusable, degrees.
     #[serde(default)]
     pub yaw_noise_deg: Option<f64>,
+
+    /// Camera: the aligned depth images' topic (default `/camera/depth`).
+    #[serde(default)]
+    pub depth_topic: Option<String>,
+    /// Camera: the `CameraInfo` topic (default `/camera/camera_info`).
+    #[serde(default)]
+    pub info_topic: Option<String>,
+    /// Camera: use every `stride`-th pixel of every `stride`-th row.
+    #[serde(default)]
+    pub stride: Option<u32>,
+    /// Camera: shortest depth used, metres.
+    #[serde(default)]
+    pub min_depth_m: Option<f64>,
+    /// Camera: longest depth used, metres.
+    #[serde(default)]
+    pub max_depth_m: Option<f64>,
+    /// Camera: `k` of the depth noise `σ = k·d²`, 1/m.
+    #[serde(default)]
+    pub depth_sigma_k: Option<f64>,
+    /// Camera: base-frame height below which a point is floor, metres.
+    #[serde(default)]
+    pub floor_band_m: Option<f64>,
+    /// Camera: top of the obstacle band, metres.
+    #[serde(default)]
+    pub obstacle_max_z_m: Option<f64>,
+    /// Camera: occupancy probability of a cell a camera ray crossed (its weak free
+    /// evidence).
+    #[serde(default)]
+    pub camera_p_free: Option<f64>,
+    /// Camera: factor on every occupancy contribution of the camera.
+    #[serde(default)]
+    pub occupancy_weight: Option<f64>,
+    /// Camera: factor on the semantic weight of a label contradicting its point's height.
+    #[serde(default)]
+    pub inconsistent_label_weight: Option<f64>,
+    /// Camera: largest stamp difference of a label image and the depth image it is paired
+    /// with, seconds.
+    #[serde(default)]
+    pub pair_tolerance_s: Option<f64>,
 }
 
 fn yes() -> bool {
@@ -194,6 +247,18 @@ impl SensorConfig {
             sigma_unknown_m: None,
             position_noise_m: None,
             yaw_noise_deg: None,
+            depth_topic: None,
+            info_topic: None,
+            stride: None,
+            min_depth_m: None,
+            max_depth_m: None,
+            depth_sigma_k: None,
+            floor_band_m: None,
+            obstacle_max_z_m: None,
+            camera_p_free: None,
+            occupancy_weight: None,
+            inconsistent_label_weight: None,
+            pair_tolerance_s: None,
         }
     }
 
@@ -225,6 +290,19 @@ impl SensorConfig {
         check(self.sigma_unknown_m.is_some(), "sigma_unknown_m", g);
         check(self.position_noise_m.is_some(), "position_noise_m", SensorKind::Pose);
         check(self.yaw_noise_deg.is_some(), "yaw_noise_deg", SensorKind::Pose);
+        let c = SensorKind::Camera;
+        check(self.depth_topic.is_some(), "depth_topic", c);
+        check(self.info_topic.is_some(), "info_topic", c);
+        check(self.stride.is_some(), "stride", c);
+        check(self.min_depth_m.is_some(), "min_depth_m", c);
+        check(self.max_depth_m.is_some(), "max_depth_m", c);
+        check(self.depth_sigma_k.is_some(), "depth_sigma_k", c);
+        check(self.floor_band_m.is_some(), "floor_band_m", c);
+        check(self.obstacle_max_z_m.is_some(), "obstacle_max_z_m", c);
+        check(self.camera_p_free.is_some(), "camera_p_free", c);
+        check(self.occupancy_weight.is_some(), "occupancy_weight", c);
+        check(self.inconsistent_label_weight.is_some(), "inconsistent_label_weight", c);
+        check(self.pair_tolerance_s.is_some(), "pair_tolerance_s", c);
         v
     }
 }
@@ -310,13 +388,19 @@ pub struct PlannedLidar {
     pub explicit: bool,
 }
 
-/// Validates the `[[sensor]]` tables into lidars and the other sensors. `prior` is the
-/// map's prior (lidar probabilities must straddle it).
-pub(super) fn plan_sensors(
-    tables: &[SensorConfig],
-    prior: f64,
-) -> Result<(Vec<PlannedLidar>, Vec<PlannedSensor>), ConfigError> {
+/// The `[[sensor]]` tables, validated and sorted by what the run does with them.
+pub(super) struct PlannedSensors {
+    pub lidars: Vec<PlannedLidar>,
+    pub cameras: Vec<PlannedCamera>,
+    pub others: Vec<PlannedSensor>,
+}
+
+/// Validates the `[[sensor]]` tables into lidars, cameras and the other sensors. `prior`
+/// is the map's prior (lidar probabilities must straddle it; camera free evidence must be
+/// below it).
+pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<PlannedSensors, ConfigError> {
     let mut lidars = Vec::new();
+    let mut cameras = Vec::new();
     let mut others = Vec::new();
     let mut names: Vec<String> = Vec::new();
     for (i, s) in tables.iter().enumerate() {
@@ -349,6 +433,10 @@ pub(super) fn plan_sensors(
         }
         if s.kind == SensorKind::Lidar {
             lidars.push(plan_lidar(i, s, name, prior)?);
+            continue;
+        }
+        if s.kind == SensorKind::Camera {
+            cameras.push(plan_camera(i, s, name, prior)?);
             continue;
         }
         let pos = |k: &str, v: Option<f64>| -> Result<Option<f64>, ConfigError> {
@@ -413,7 +501,7 @@ pub(super) fn plan_sensors(
             explicit: true,
         });
     }
-    Ok((lidars, others))
+    Ok(PlannedSensors { lidars, cameras, others })
 }
 
 fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<PlannedLidar, ConfigError> {
@@ -464,10 +552,10 @@ fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<Pl
 
 /// The sensor a kind gets when the config lists none of it: looked for under its usual
 /// topic, with default noise figures.
-/// `None` for [`SensorKind::Lidar`], whose default is [`PlannedLidar`]'s.
+/// `None` for [`SensorKind::Lidar`], whose default is [`PlannedLidar`]'s, and for
+/// [`SensorKind::Camera`], which is mapped only when the config lists it.
 pub fn auto_sensor(kind: SensorKind) -> Option<PlannedSensor> {
-    let (_, mut v) = plan_sensors(&[SensorConfig::new(kind)], 0.5).ok()?;
-    let mut s = v.pop()?;
+    let mut s = plan_sensors(&[SensorConfig::new(kind)], 0.5).ok()?.others.pop()?;
     s.explicit = false;
     Some(s)
 }
