@@ -15,7 +15,7 @@ use fusemap_io::log::Transform;
 use serde::Serialize;
 
 /// What was decided about one sensor's mount.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct ExtrinsicsReport {
     /// `tf` (static TF, else the first dynamic transforms), `scan_line` (CARMEN
     /// ROBOTLASER1), `config` or `identity`.

@@ -23,6 +23,7 @@
 
 #![warn(missing_docs)]
 
+pub mod camera;
 pub mod doctor;
 pub mod estimation;
 pub mod extrinsics;

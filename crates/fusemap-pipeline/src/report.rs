@@ -111,6 +111,10 @@ pub struct LogReport {
     pub scans_reordered: u64,
     /// Every lidar mapped.
     pub lidars: Vec<LidarReport>,
+    /// Every camera mapped.
+    pub cameras: Vec<crate::camera::CameraReport>,
+    /// Observations merged into a correlation group another observation had opened.
+    pub correlated_merged: u64,
     /// The sensors that were read, by name: `kind topic`.
     pub sensors: BTreeMap<String, String>,
     /// The pose track's counters.

@@ -8,15 +8,16 @@
 //! de-skewed). Every scan that cannot be posed is skipped and counted with its reason;
 //! clock faults are reported, and the usable part of the log is still mapped.
 
+use crate::camera::{build_camera, MappedCamera};
 use crate::extrinsics::{frame_tree, lidar_mount_from_log, resolve, ExtrinsicsReport};
 use crate::merge::{OrderedMerge, Pushed};
-use crate::recording::{for_each_scan, Inventory};
+use crate::recording::{for_each_range_message, Inventory, RangeMessage};
 use crate::report::{LidarReport, LogReport, Skipped};
 use crate::sensors::{bind, Bound};
 use crate::track::{choose, count_reordered, ChosenTrack, Track};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, SensorKind, SyncConfig};
-use fusemap_core::fusion::{Engine, MapSet};
+use fusemap_core::fusion::{Correlation, Engine, MapSet};
 use fusemap_core::geometry::{PlanarMount, Pose2};
 use fusemap_core::grid::FusionGrid;
 use fusemap_core::measurement::{ObservationId, SensorId};
@@ -178,7 +179,7 @@ pub fn map_with_track(
         Track::ScanLine => 0,
         Track::Timed(_) => offset_ns(cfg.reorder_window_s),
     };
-    let mut merge: OrderedMerge<ScanMessage> = OrderedMerge::new(window);
+    let mut merge: OrderedMerge<RangeMessage> = OrderedMerge::new(window);
     let mut engine = match maps {
         Some(m) => Engine::with_maps(m),
         None => Engine::new(FusionGrid::new(plan.geometry, plan.occupancy)),
@@ -239,11 +240,55 @@ pub fn map_with_track(
         });
     }
 
-    // The second pass: every lidar's scans, merged in stamp order (file order for poses on
-    // the scan lines, which do not depend on the stamps: some corrected CARMEN logs have
-    // broken or all-zero stamps).
+    let mut cameras: Vec<MappedCamera> = Vec::new();
+    for c in &plan.cameras {
+        let (model, report) = build_camera(c, &plan.classes, plan.geometry.resolution(), inv, &tree, cfg, &mut notes)?;
+        let id = engine.add_camera(c.name.clone(), model);
+        let label_stream = merge.add_stream(c.topic.clone());
+        let depth_stream = merge.add_stream(c.depth_topic.clone());
+        cameras.push(MappedCamera::new(id, c, label_stream, depth_stream, report));
+    }
+    if !cameras.is_empty() {
+        engine.set_dynamic(plan.dynamic, plan.fusion.route_lidar_hits_to_dynamic);
+    }
+    if !plan.fusion.correlated.is_empty() {
+        let id_of = |name: &str| {
+            lidars
+                .iter()
+                .zip(&bound.lidars)
+                .find(|(_, b)| b.lidar.name == name)
+                .map(|(l, _)| l.id)
+                .or_else(|| cameras.iter().find(|c| c.report.name == name).map(|c| c.id))
+        };
+        let mut groups = Vec::new();
+        for g in &plan.fusion.correlated {
+            let ids: Vec<SensorId> = g.iter().filter_map(|n| id_of(n)).collect();
+            if ids.len() < g.len() {
+                notes.push(format!(
+                    "fusion.correlated: {} of the group [{}] are not mapped in this run; the group is used without them",
+                    g.len() - ids.len(),
+                    g.join(", ")
+                ));
+            }
+            if ids.len() >= 2 {
+                groups.push(ids);
+            }
+        }
+        engine.set_correlation(Correlation {
+            groups,
+            window_ns: offset_ns(plan.fusion.correlation_window_s),
+            rule: plan.fusion.merge,
+        });
+    }
+
+    // The second pass: every lidar's scans and every camera's images, merged in stamp
+    // order (file order for poses on the scan lines, which do not depend on the stamps:
+    // some corrected CARMEN logs have broken or all-zero stamps).
     let topics: Vec<String> = bound.lidars.iter().map(|b| b.topic.clone()).collect();
-    let total: u64 = lidars.iter().map(|l| l.report.scans_read).sum();
+    let image_topics: Vec<String> =
+        plan.cameras.iter().flat_map(|c| [c.topic.clone(), c.depth_topic.clone()]).collect();
+    let total: u64 = lidars.iter().map(|l| l.report.scans_read).sum::<u64>()
+        + image_topics.iter().map(|t| inv.images.get(t).map_or(0, |i| i.stamps.len() as u64)).sum::<u64>();
     progress(Progress::Phase { name: "mapping", total });
     let mut inserter = Inserter {
         engine: &mut engine,
@@ -257,30 +302,51 @@ pub fn map_with_track(
     };
     let t_map = Instant::now();
     let mut seq = 0i64;
-    let read_s = for_each_scan(&inv.path, &topics, |msg| {
-        let Some(l) = lidars.iter_mut().find(|l| l.report.topic == msg.topic) else { return Ok(()) };
-        let key = match chosen.track {
-            Track::ScanLine => {
-                seq += 1;
-                seq
+    let read_s = for_each_range_message(&inv.path, &topics, &image_topics, |msg| {
+        let (stream, key) = match &msg {
+            RangeMessage::Scan(scan) => {
+                let Some(l) = lidars.iter_mut().find(|l| l.report.topic == scan.topic) else { return Ok(()) };
+                let key = match chosen.track {
+                    Track::ScanLine => {
+                        seq += 1;
+                        seq
+                    }
+                    Track::Timed(_) => scan.scan.stamp.0.saturating_add(l.offset_ns),
+                };
+                (l.stream, key)
             }
-            Track::Timed(_) => msg.scan.stamp.0.saturating_add(l.offset_ns),
+            RangeMessage::Image(image) => {
+                let Some((c, stream)) = cameras.iter().find_map(|c| {
+                    (c.report.topic == image.topic)
+                        .then_some(c.label_stream)
+                        .or_else(|| (c.report.depth_topic == image.topic).then_some(c.depth_stream))
+                        .map(|s| (c, s))
+                }) else {
+                    return Ok(());
+                };
+                (stream, image.stamp.0.saturating_add(c.offset_ns))
+            }
         };
-        if merge.push(l.stream, key, msg) == Pushed::Late {
-            l.report.scans_skipped.late += 1;
+        if merge.push(stream, key, msg) == Pushed::Late {
+            if let Some(l) = lidars.iter_mut().find(|l| l.stream == stream) {
+                l.report.scans_skipped.late += 1;
+            } else if let Some(c) = cameras.iter_mut().find(|c| c.label_stream == stream || c.depth_stream == stream) {
+                c.report.frames_skipped.late += 1;
+            }
             progress(Progress::Advance(1));
         }
         while let Some((s, key, msg)) = merge.pop_ready() {
-            let l = lidars.iter_mut().find(|l| l.stream == s).expect("every stream is a lidar's");
-            inserter.insert(l, Stamp(key), &msg)?;
+            release(&mut inserter, &mut lidars, &mut cameras, s, Stamp(key), msg)?;
             progress(Progress::Advance(1));
         }
         Ok(())
     })?;
     while let Some((s, key, msg)) = merge.pop_final() {
-        let l = lidars.iter_mut().find(|l| l.stream == s).expect("every stream is a lidar's");
-        inserter.insert(l, Stamp(key), &msg)?;
+        release(&mut inserter, &mut lidars, &mut cameras, s, Stamp(key), msg)?;
         progress(Progress::Advance(1));
+    }
+    for c in &mut cameras {
+        c.finish();
     }
     progress(Progress::Done);
     let map_s = t_map.elapsed().as_secs_f64();
@@ -320,6 +386,34 @@ pub fn map_with_track(
             inv.stats.malformed,
             inv.stats.malformed_examples.join("; ")
         ));
+    }
+    for c in &mut cameras {
+        if let Some(stats) = engine.sensor_stats().find(|s| s.name == c.report.name) {
+            c.report.pixels = stats.pixels;
+        }
+        let r = &c.report;
+        if r.frames_used == 0 {
+            notes.push(format!(
+                "camera `{}` mapped no frame: {} label and {} depth images read, {} pairs, {} without a pose, {} undecodable{}, {} refused{}",
+                r.name,
+                r.labels_read,
+                r.depths_read,
+                r.frames_paired,
+                r.frames_skipped.total(),
+                r.undecodable,
+                r.undecodable_example.as_ref().map_or(String::new(), |e| format!(" ({e})")),
+                r.frames_refused,
+                r.refused_example.as_ref().map_or(String::new(), |e| format!(" ({e})")),
+            ));
+        } else if r.labels_unpaired + r.depths_unpaired > 0 {
+            notes.push(format!(
+                "camera `{}`: {} label and {} depth images had no partner within {} s and were dropped",
+                r.name,
+                r.labels_unpaired,
+                r.depths_unpaired,
+                plan.cameras.iter().find(|c| c.name == r.name).map_or(0.0, |c| c.pair_tolerance_s)
+            ));
+        }
     }
     let pose_timing =
         (!chosen.stamps.is_empty()).then(|| StreamTiming::analyze(&chosen.stamps, &chosen.receive, limits(cfg)));
@@ -363,9 +457,41 @@ pub fn map_with_track(
         track_s,
         map_s,
         lidars: lidars.into_iter().map(|l| l.report).collect(),
+        cameras: cameras.into_iter().map(|c| c.report).collect(),
+        correlated_merged: engine.stats().correlated_merged,
     };
     notes.extend(chosen.notes.iter().cloned());
     Ok(MapRun { engine, format: inv.format, report, trajectory, notes })
+}
+
+/// Inserts one released message: a lidar's scan, or a camera's image (a frame when it
+/// completes a label + depth pair).
+fn release(
+    inserter: &mut Inserter<'_>,
+    lidars: &mut [Mapped],
+    cameras: &mut [MappedCamera],
+    stream: usize,
+    key: Stamp,
+    msg: RangeMessage,
+) -> Result<(), PipelineError> {
+    match msg {
+        RangeMessage::Scan(scan) => {
+            let l = lidars.iter_mut().find(|l| l.stream == stream).expect("a scan stream is a lidar's");
+            inserter.insert(l, key, &scan)
+        }
+        RangeMessage::Image(image) => {
+            let c = cameras
+                .iter_mut()
+                .find(|c| c.label_stream == stream || c.depth_stream == stream)
+                .expect("an image stream is a camera's");
+            if let Some((t, label, depth)) = c.take(stream, key, image) {
+                let id = ObservationId(inserter.next_id);
+                inserter.next_id += 1;
+                c.insert(inserter.engine, inserter.track, inserter.mode, id, t, &label, &depth)?;
+            }
+            Ok(())
+        }
+    }
 }
 
 /// Inserts released scans with their poses.

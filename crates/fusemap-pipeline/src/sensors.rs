@@ -130,14 +130,8 @@ pub fn bind(plan: &Plan, topics: &BTreeMap<SensorKind, BTreeMap<String, u64>>) -
             out.sensors.push(BoundSensor { sensor, topic });
         }
     }
-    // Cameras are planned (`Plan::cameras`) but not read from logs yet: say so rather
-    // than map less than the config lists without a word.
-    for c in &plan.cameras {
-        out.notes.push(format!(
-            "camera `{}` ({}) is configured, but the log pipeline does not read cameras yet: not mapped",
-            c.name, c.topic
-        ));
-    }
+    // Cameras are planned apart (`Plan::cameras`) and bound when the run builds their
+    // models from the log's images and camera info (`camera::build_camera`).
     Ok(out)
 }
 

@@ -1,0 +1,274 @@
+//! Cameras in a log run: the model built from the log's `CameraInfo` and the camera's
+//! mount, label and depth images paired by stamp, and each frame inserted with the pose at
+//! its own (offset-corrected) stamp.
+//!
+//! Pairing: the merge releases images in stamp order; a label image and a depth image
+//! whose stamps differ by at most `pair_tolerance_s` are one frame (the stamp of the
+//! label image is the frame's). An image with no partner within the tolerance is counted
+//! and dropped, never paired with a far one.
+
+use crate::extrinsics::{from_tf, resolve, ExtrinsicsReport};
+use crate::recording::Inventory;
+use crate::report::Skipped;
+use crate::track::Track;
+use crate::PipelineError;
+use fusemap_core::config::{LogConfig, PlannedCamera};
+use fusemap_core::frames::FrameTree;
+use fusemap_core::fusion::{Engine, EngineError};
+use fusemap_core::geometry::Pose3;
+use fusemap_core::measurement::{ObservationId, SensorId};
+use fusemap_core::sensor::camera::{CameraModel, ClassTable, Pinhole, PixelCounts};
+use fusemap_core::time::{Stamp, SyncMode};
+use fusemap_io::log::ImageMessage;
+use serde::Serialize;
+
+/// What happened to one camera's images.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CameraReport {
+    /// The camera's name.
+    pub name: String,
+    /// Label image topic.
+    pub topic: String,
+    /// Depth image topic.
+    pub depth_topic: String,
+    /// Camera-info topic.
+    pub info_topic: String,
+    /// The optical frame.
+    pub frame: String,
+    /// Label images read.
+    pub labels_read: u64,
+    /// Depth images read.
+    pub depths_read: u64,
+    /// Label + depth pairs formed.
+    pub frames_paired: u64,
+    /// Label images with no depth image within the tolerance.
+    pub labels_unpaired: u64,
+    /// Depth images with no label image within the tolerance.
+    pub depths_unpaired: u64,
+    /// Frames inserted into the map.
+    pub frames_used: u64,
+    /// Frames with no pose at their stamp, by reason.
+    pub frames_skipped: Skipped,
+    /// Images whose encoding or layout could not be decoded (the first reason kept).
+    pub undecodable: u64,
+    /// The first undecodable image's reason.
+    pub undecodable_example: Option<String>,
+    /// Frames whose images do not fit the camera (sizes).
+    pub frames_refused: u64,
+    /// The first refusal's reason.
+    pub refused_example: Option<String>,
+    /// The clock offset applied, seconds.
+    pub time_offset_s: f64,
+    /// Intrinsics used: width, height, fx, fy, cx, cy.
+    pub intrinsics: [f64; 6],
+    /// Camera-info messages that differ from the first (intrinsics are taken from the first).
+    pub camera_info_differing: u64,
+    /// Where the mount came from.
+    pub extrinsics: ExtrinsicsReport,
+    /// What became of the pixels.
+    pub pixels: PixelCounts,
+}
+
+/// One camera as the second pass uses it.
+pub(crate) struct MappedCamera {
+    pub(crate) id: SensorId,
+    pub(crate) offset_ns: i64,
+    pub(crate) label_stream: usize,
+    pub(crate) depth_stream: usize,
+    tolerance_ns: i64,
+    pending_label: Option<(Stamp, ImageMessage)>,
+    pending_depth: Option<(Stamp, ImageMessage)>,
+    pub(crate) report: CameraReport,
+}
+
+/// Builds a camera's model from the inventory: intrinsics from its `CameraInfo`, mount
+/// from TF or the config.
+pub(crate) fn build_camera(
+    c: &PlannedCamera,
+    classes: &ClassTable,
+    resolution: f64,
+    inv: &Inventory,
+    tree: &FrameTree,
+    cfg: &LogConfig,
+    notes: &mut Vec<String>,
+) -> Result<(CameraModel, CameraReport), PipelineError> {
+    let refuse = |m: String| PipelineError::Refused(format!("camera `{}`: {m}", c.name));
+    let info = inv.camera_info.get(&c.info_topic).ok_or_else(|| {
+        refuse(format!(
+            "the log has no camera info on `{}` (the intrinsics of the label and depth images); log camera-info topics: {}",
+            c.info_topic,
+            list(inv.camera_info.keys())
+        ))
+    })?;
+    for t in [&c.topic, &c.depth_topic] {
+        if !inv.images.contains_key(t) {
+            return Err(refuse(format!(
+                "the log has no images on `{t}`; log image topics: {}",
+                list(inv.images.keys())
+            )));
+        }
+    }
+    let i = &info.first;
+    let pinhole = Pinhole::from_camera_info(i.width, i.height, i.k, &i.distortion_model, &i.d)
+        .map_err(|e| refuse(format!("camera info on `{}`: {e}", c.info_topic)))?;
+    if info.differing > 0 {
+        notes.push(format!(
+            "camera `{}`: {} of {} camera-info messages differ from the first; the first is used",
+            c.name, info.differing, info.count
+        ));
+    }
+    let labels = &inv.images[&c.topic];
+    let first_image = labels.stamps.iter().min().copied();
+    if first_image.is_some_and(|s| s < i.stamp) {
+        notes.push(format!(
+            "camera `{}`: the first camera info arrives after the first image; its intrinsics are used for every frame",
+            c.name
+        ));
+    }
+    let frame = c.frame.clone().or_else(|| labels.frame().map(str::to_string)).unwrap_or_default();
+    let log_mount = from_tf(tree, &cfg.base_frame, &frame, first_image);
+    let ext = resolve(&frame, cfg, c.mount_given.then_some(c.mount), log_mount, notes)?;
+    let m = ext.base_from_sensor;
+    let base_from_optical = Pose3::new([m.x, m.y, m.z], m.quaternion());
+    let model = CameraModel::new(pinhole, base_from_optical, c.params, resolution, classes.clone())
+        .map_err(|e| refuse(e.to_string()))?;
+    let report = CameraReport {
+        name: c.name.clone(),
+        topic: c.topic.clone(),
+        depth_topic: c.depth_topic.clone(),
+        info_topic: c.info_topic.clone(),
+        frame,
+        time_offset_s: c.time_offset_s,
+        intrinsics: [pinhole.width as f64, pinhole.height as f64, pinhole.fx, pinhole.fy, pinhole.cx, pinhole.cy],
+        camera_info_differing: info.differing,
+        extrinsics: ext,
+        ..Default::default()
+    };
+    Ok((model, report))
+}
+
+fn list<'a>(it: impl Iterator<Item = &'a String>) -> String {
+    let v: Vec<&str> = it.map(String::as_str).collect();
+    if v.is_empty() {
+        "none".into()
+    } else {
+        v.join(", ")
+    }
+}
+
+impl MappedCamera {
+    pub(crate) fn new(
+        id: SensorId,
+        c: &PlannedCamera,
+        label_stream: usize,
+        depth_stream: usize,
+        report: CameraReport,
+    ) -> Self {
+        Self {
+            id,
+            offset_ns: crate::run::offset_ns(c.time_offset_s),
+            label_stream,
+            depth_stream,
+            tolerance_ns: crate::run::offset_ns(c.pair_tolerance_s),
+            pending_label: None,
+            pending_depth: None,
+            report,
+        }
+    }
+
+    /// Takes one released image (`key`: its offset-corrected stamp) and returns a frame
+    /// when it completes a pair.
+    pub(crate) fn take(
+        &mut self,
+        stream: usize,
+        key: Stamp,
+        msg: ImageMessage,
+    ) -> Option<(Stamp, ImageMessage, ImageMessage)> {
+        let is_label = stream == self.label_stream;
+        if is_label {
+            self.report.labels_read += 1;
+        } else {
+            self.report.depths_read += 1;
+        }
+        let tol = self.tolerance_ns;
+        let (mine, other) = if is_label {
+            (&mut self.pending_label, &mut self.pending_depth)
+        } else {
+            (&mut self.pending_depth, &mut self.pending_label)
+        };
+        if let Some((t, _)) = other {
+            if key.0.abs_diff(t.0) <= tol as u64 {
+                let (t_other, m_other) = other.take().expect("checked");
+                self.report.frames_paired += 1;
+                return Some(if is_label { (key, msg, m_other) } else { (t_other, m_other, msg) });
+            }
+            // Released in stamp order: an older partner can no longer be paired.
+            other.take();
+            if is_label {
+                self.report.depths_unpaired += 1;
+            } else {
+                self.report.labels_unpaired += 1;
+            }
+        }
+        if mine.replace((key, msg)).is_some() {
+            if is_label {
+                self.report.labels_unpaired += 1;
+            } else {
+                self.report.depths_unpaired += 1;
+            }
+        }
+        None
+    }
+
+    /// Counts images left unpaired at the end of the log.
+    pub(crate) fn finish(&mut self) {
+        self.report.labels_unpaired += self.pending_label.take().is_some() as u64;
+        self.report.depths_unpaired += self.pending_depth.take().is_some() as u64;
+    }
+
+    /// Decodes and inserts one frame taken at `stamp`.
+    pub(crate) fn insert(
+        &mut self,
+        engine: &mut Engine,
+        track: &Track,
+        mode: SyncMode,
+        id: ObservationId,
+        stamp: Stamp,
+        label: &ImageMessage,
+        depth: &ImageMessage,
+    ) -> Result<(), PipelineError> {
+        let Track::Timed(track) = track else {
+            // Poses written on scan lines (CARMEN) cannot place a camera frame.
+            self.report.frames_skipped.no_pose_on_line += 1;
+            return Ok(());
+        };
+        let pose = match track.pose_at(stamp, mode) {
+            Ok(p) => p,
+            Err(why) => {
+                self.report.frames_skipped.count(why);
+                return Ok(());
+            }
+        };
+        let decoded = fusemap_io::camera::labels(label).and_then(|l| fusemap_io::camera::depth(depth).map(|d| (l, d)));
+        let (labels, depths) = match decoded {
+            Ok(v) => v,
+            Err(e) => {
+                self.report.undecodable += 1;
+                self.report.undecodable_example.get_or_insert_with(|| e.to_string());
+                return Ok(());
+            }
+        };
+        match engine.insert_camera_frame(self.id, Some(id), stamp, &labels, &depths, pose) {
+            Ok(_) => {
+                self.report.frames_used += 1;
+                Ok(())
+            }
+            Err(EngineError::Camera { error, .. }) => {
+                self.report.frames_refused += 1;
+                self.report.refused_example.get_or_insert_with(|| error.to_string());
+                Ok(())
+            }
+            Err(e) => Err(e.into()),
+        }
+    }
+}
