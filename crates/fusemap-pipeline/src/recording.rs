@@ -213,6 +213,8 @@ impl Inventory {
                 LogMessage::Gnss(g) => inv.gnss.entry(g.topic.clone()).or_default().push(g),
                 LogMessage::Pose(p) => inv.poses.entry(p.topic.clone()).or_default().push(p),
                 LogMessage::Tf(t) => tf.push(t),
+                // Camera messages are not used by this pass yet.
+                LogMessage::Image(_) | LogMessage::ImageHeader(_) | LogMessage::CameraInfo(_) => {}
             }
         }
         inv.stats = merged_stats(reader.stats(), undecodable);
