@@ -16,6 +16,7 @@ pub mod npz;
 pub mod picture;
 pub mod read_ahead;
 pub mod scanfile;
+pub mod semantic;
 pub mod simulation;
 pub mod trajectory;
 pub mod world_file;

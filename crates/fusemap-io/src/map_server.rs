@@ -106,7 +106,7 @@ pub fn write_map_server(yaml_path: &Path, raster: &Raster) -> Result<PathBuf> {
 /// A finite float in plain decimal that reads back to the same `f64`, always with a
 /// decimal point so YAML 1.1 readers (PyYAML) see a float and not an integer or a string
 /// (`1e-7`, which YAML 1.1 does not take as a float).
-fn yaml_float(v: f64) -> String {
+pub(crate) fn yaml_float(v: f64) -> String {
     // Display never uses exponent notation and is the shortest round-trip form.
     let s = format!("{v}");
     if s.contains('.') {
@@ -118,7 +118,7 @@ fn yaml_float(v: f64) -> String {
 
 /// A YAML scalar for `s`: plain when it is unambiguous (what `map_saver` writes),
 /// double-quoted with escapes otherwise (spaces, `#`, `:`, quotes, leading dashes…).
-fn yaml_string(s: &str) -> String {
+pub(crate) fn yaml_string(s: &str) -> String {
     let plain = !s.is_empty()
         && s.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-' | '/'))
         && !s.starts_with('-')

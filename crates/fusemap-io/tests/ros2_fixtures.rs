@@ -33,7 +33,12 @@ fn read(path: &Path) -> Decoded {
             LogMessage::Odometry(o) => d.odometry.push(o),
             LogMessage::Tf(t) if t.is_static => d.tf_static.push(t),
             LogMessage::Tf(t) => d.tf.push(t),
-            LogMessage::Imu(_) | LogMessage::Gnss(_) | LogMessage::Pose(_) => {
+            LogMessage::Imu(_)
+            | LogMessage::Gnss(_)
+            | LogMessage::Pose(_)
+            | LogMessage::Image(_)
+            | LogMessage::ImageHeader(_)
+            | LogMessage::CameraInfo(_) => {
                 panic!("{}: only scans, odometry and transforms were written", path.display())
             }
         }

@@ -66,8 +66,10 @@ impl ImageMessage {
     }
 }
 
-/// A `sensor_msgs/Image` read without its pixels (see the [module docs](self)): what a
-/// first pass keeps of an image topic.
+/// A `sensor_msgs/Image` read without its pixels: what a first pass keeps of an image
+/// topic (stamps, frame, size, encoding). Readers give one for every image whose topic
+/// [`ReadOptions::images`] does not ask for; the payload's length is checked
+/// ([`check_image_layout`]) but its bytes are neither decoded nor copied.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ImageHeader {
     /// Topic.

@@ -7,6 +7,14 @@
 //! as in ROS). A record that cannot be decoded is an error naming file and record (one
 //! message's payload: [`crate::Error::is_skippable`], the reader goes on); a record of a
 //! type fusemap does not use is counted in [`ReadStats::skipped_by_type`] and skipped.
+//!
+//! Camera images are the exception to "decode everything": they are large, and most
+//! passes over a log do not want them. [`open_log`] gives every `sensor_msgs/Image` as an
+//! [`ImageHeader`] (stamps, frame, size, encoding; pixels neither decoded nor copied);
+//! [`open_log_with`] and [`ReadOptions`] name the image topics whose pixels a pass wants,
+//! which then come as [`ImageMessage`]s. Either way an image's declared sizes are checked
+//! against its data first ([`check_image_layout`], [`MAX_IMAGE_PIXELS`]): one that does
+//! not fit is a malformed message like any other.
 
 pub mod carmen;
 mod image;

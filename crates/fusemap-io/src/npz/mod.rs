@@ -20,8 +20,9 @@
 //! epoch (1980-01-01) so the same map gives byte-identical files.
 
 use crate::atomic::{check_raster, write_atomic};
+use crate::semantic::SemanticRaster;
 use crate::{Error, Location, Result};
-use fusemap_core::grid::Raster;
+use fusemap_core::grid::{CellRaster, Raster};
 use std::collections::HashSet;
 use std::fs::File;
 use std::io::{self, BufReader, Read, Seek, Write};
@@ -48,18 +49,35 @@ pub enum NpyData<'a> {
     U8(&'a [u8]),
     /// `int32`, written as `'<i4'`.
     I32(&'a [i32]),
+    /// `int16`, written as `'<i2'`.
+    I16(&'a [i16]),
+    /// Unicode strings, written as NumPy's fixed-width `'<U{n}'` (UTF-32, little-endian,
+    /// `n` the longest string's length in characters, shorter ones padded with NUL),
+    /// which `np.load` reads without `allow_pickle`.
+    Str(&'a [String]),
 }
 
 impl NpyData<'_> {
     /// NumPy's dtype string (`descr`): explicit little-endian (`<`) for multi-byte types,
     /// `|` (not applicable) for single bytes, as `numpy.dtype.str` spells them.
-    pub fn descr(&self) -> &'static str {
+    pub fn descr(&self) -> String {
         match self {
-            NpyData::F32(_) => "<f4",
-            NpyData::F64(_) => "<f8",
-            NpyData::Bool(_) => "|b1",
-            NpyData::U8(_) => "|u1",
-            NpyData::I32(_) => "<i4",
+            NpyData::F32(_) => "<f4".into(),
+            NpyData::F64(_) => "<f8".into(),
+            NpyData::Bool(_) => "|b1".into(),
+            NpyData::U8(_) => "|u1".into(),
+            NpyData::I32(_) => "<i4".into(),
+            NpyData::I16(_) => "<i2".into(),
+            NpyData::Str(_) => format!("<U{}", self.str_width()),
+        }
+    }
+
+    /// Characters per element of a [`NpyData::Str`] array: the longest string's (at
+    /// least 1, as NumPy has no `<U0` it round-trips).
+    fn str_width(&self) -> usize {
+        match self {
+            NpyData::Str(d) => d.iter().map(|s| s.chars().count()).max().unwrap_or(0).max(1),
+            _ => 0,
         }
     }
 
@@ -71,6 +89,8 @@ impl NpyData<'_> {
             NpyData::Bool(d) => d.len(),
             NpyData::U8(d) => d.len(),
             NpyData::I32(d) => d.len(),
+            NpyData::I16(d) => d.len(),
+            NpyData::Str(d) => d.len(),
         }
     }
 
@@ -83,7 +103,9 @@ impl NpyData<'_> {
         match self {
             NpyData::F32(_) | NpyData::I32(_) => 4,
             NpyData::F64(_) => 8,
+            NpyData::I16(_) => 2,
             NpyData::Bool(_) | NpyData::U8(_) => 1,
+            NpyData::Str(_) => 4 * self.str_width(),
         }
     }
 }
@@ -169,6 +191,18 @@ impl<'a> NpyArray<'a> {
             NpyData::F32(d) => chunks!(d, f32::to_le_bytes),
             NpyData::F64(d) => chunks!(d, f64::to_le_bytes),
             NpyData::I32(d) => chunks!(d, i32::to_le_bytes),
+            NpyData::I16(d) => chunks!(d, i16::to_le_bytes),
+            NpyData::Str(d) => {
+                let width = self.data.str_width();
+                for s in d {
+                    buf.clear();
+                    for c in s.chars() {
+                        buf.extend_from_slice(&u32::from(c).to_le_bytes());
+                    }
+                    buf.resize(4 * width, 0);
+                    w.write_all(&buf)?;
+                }
+            }
             NpyData::Bool(d) => chunks!(d, |b: bool| [u8::from(b)]),
             NpyData::U8(d) => w.write_all(d)?,
         }
@@ -214,6 +248,17 @@ impl<W: Write + Seek> NpzWriter<W> {
     }
 }
 
+/// Layers written into the map's `.npz` beside the occupancy arrays, each optional; they
+/// must cover the same cells as the occupancy raster (same size, resolution and origin).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NpzLayers<'a> {
+    /// The semantic layer: `semantic_class`, `semantic_prob`, `semantic_probs` and the
+    /// class table (`semantic_class_ids`, `semantic_class_names`, `semantic_class_colors`).
+    pub semantic: Option<&'a SemanticRaster>,
+    /// The dynamic layer's probability per cell: `dynamic` (NaN where never observed).
+    pub dynamic: Option<&'a CellRaster<f32>>,
+}
+
 /// Writes a map as `.npz`, atomically, with exactly these arrays:
 ///
 /// | name | dtype | shape | meaning |
@@ -229,23 +274,91 @@ impl<W: Write + Seek> NpzWriter<W> {
 /// `origin + (ix, iy) · resolution` to `origin + (ix + 1, iy + 1) · resolution`. To show
 /// it the right way up, use `imshow(occupancy, origin='lower')`.
 pub fn write_map_npz(path: &Path, raster: &Raster) -> Result<()> {
+    write_map_npz_with(path, raster, &NpzLayers::default())
+}
+
+/// [`write_map_npz`] plus the optional layers, same indexing (`[iy, ix]`, row 0 the
+/// lowest y), K the number of classes:
+///
+/// | name | dtype | shape | meaning |
+/// |---|---|---|---|
+/// | `semantic_class` | int16 | (height, width) | most likely class, an index into the class arrays; -1: no semantic evidence |
+/// | `semantic_prob` | float32 | (height, width) | its probability |
+/// | `semantic_probs` | float32 | (height, width, K) | every class's probability (only when given) |
+/// | `semantic_class_ids` | int32 | (K,) | the label id of each class index |
+/// | `semantic_class_names` | `<U{n}` | (K,) | its name |
+/// | `semantic_class_colors` | uint8 | (K, 3) | its RGB colour (as in `semantic.png`) |
+/// | `dynamic` | float32 | (height, width) | the dynamic layer's probability; NaN where never observed |
+///
+/// A layer that does not match the occupancy raster's cells, or a semantic raster that
+/// fails [`SemanticRaster::check`], is an error naming the file; nothing is written.
+pub fn write_map_npz_with(path: &Path, raster: &Raster, layers: &NpzLayers<'_>) -> Result<()> {
     check_raster(path, raster, false)?;
+    let bad = |what: String| Error::format(path, Location::File, what);
     let shape = [raster.height, raster.width];
     let occupancy = raster.occupancy();
-    let arrays = [
+    let mut arrays = vec![
         ("occupancy", NpyArray::new(&shape, NpyData::F32(&occupancy))),
         ("log_odds", NpyArray::new(&shape, NpyData::F32(&raster.log_odds))),
         ("known", NpyArray::new(&shape, NpyData::Bool(&raster.known))),
     ];
     let resolution = [raster.resolution];
     let origin = [raster.origin.x, raster.origin.y];
-    let scalars = [
-        ("resolution", NpyArray::new(&[], NpyData::F64(&resolution))),
-        ("origin", NpyArray::new(&[2], NpyData::F64(&origin))),
-    ];
+    arrays.push(("resolution", NpyArray::new(&[], NpyData::F64(&resolution))));
+    arrays.push(("origin", NpyArray::new(&[2], NpyData::F64(&origin))));
+
+    let same_cells = |what: &str, w: usize, h: usize, res: f64, o: [f64; 2]| -> Result<()> {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs()));
+        if (w, h) != (raster.width, raster.height)
+            || !close(res, raster.resolution)
+            || !close(o[0], raster.origin.x)
+            || !close(o[1], raster.origin.y)
+        {
+            return Err(bad(format!(
+                "the {what} layer ({w} × {h} cells of {res} m at ({}, {})) does not cover the occupancy map's cells \
+                 ({} × {} of {} m at ({}, {}))",
+                o[0], o[1], raster.width, raster.height, raster.resolution, raster.origin.x, raster.origin.y
+            )));
+        }
+        Ok(())
+    };
+    let (names, ids, colors);
+    let k_shape;
+    if let Some(s) = layers.semantic {
+        s.check().map_err(|e| bad(format!("semantic layer: {e}")))?;
+        same_cells("semantic", s.width, s.height, s.resolution, s.origin)?;
+        names = s.classes.iter().map(|c| c.name.clone()).collect::<Vec<_>>();
+        ids = s.classes.iter().map(|c| i32::from(c.id)).collect::<Vec<_>>();
+        colors = s.classes.iter().flat_map(|c| c.color).collect::<Vec<_>>();
+        k_shape = [raster.height, raster.width, s.classes.len()];
+        arrays.push(("semantic_class", NpyArray::new(&shape, NpyData::I16(&s.best))));
+        arrays.push(("semantic_prob", NpyArray::new(&shape, NpyData::F32(&s.prob))));
+        if !s.probs.is_empty() {
+            arrays.push(("semantic_probs", NpyArray::new(&k_shape, NpyData::F32(&s.probs))));
+        }
+        arrays.push(("semantic_class_ids", NpyArray::new(&[ids.len()], NpyData::I32(&ids))));
+        arrays.push(("semantic_class_names", NpyArray::new(&[names.len()], NpyData::Str(&names))));
+        arrays.push(("semantic_class_colors", NpyArray::new(&[names.len(), 3], NpyData::U8(&colors))));
+    }
+    let dynamic;
+    if let Some(d) = layers.dynamic {
+        same_cells("dynamic", d.width, d.height, d.resolution, [d.origin.x, d.origin.y])?;
+        if d.cells.len() != d.width * d.height || d.known.len() != d.cells.len() {
+            return Err(bad(format!(
+                "the dynamic layer is {} × {} cells but holds {} values and {} known flags",
+                d.width,
+                d.height,
+                d.cells.len(),
+                d.known.len()
+            )));
+        }
+        dynamic = d.cells.iter().zip(&d.known).map(|(&p, &k)| if k { p } else { f32::NAN }).collect::<Vec<_>>();
+        arrays.push(("dynamic", NpyArray::new(&shape, NpyData::F32(&dynamic))));
+    }
+
     let mut all = Vec::new();
-    for (name, array) in arrays.into_iter().chain(scalars) {
-        // check_raster guarantees the sizes; this keeps the writer panic-free regardless.
+    for (name, array) in arrays {
+        // The checks above guarantee the sizes; this keeps the writer panic-free regardless.
         let array = array.ok_or_else(|| {
             Error::format(path, Location::Field(name.into()), "array size does not match the map's shape")
         })?;
@@ -274,6 +387,10 @@ pub enum NpyValues {
     U8(Vec<u8>),
     /// `<i4`.
     I32(Vec<i32>),
+    /// `<i2`.
+    I16(Vec<i16>),
+    /// `<U{n}`, NUL padding removed.
+    Str(Vec<String>),
 }
 
 /// An array read from an `.npz`.
@@ -287,8 +404,8 @@ pub struct NpyOwned {
 
 /// Reads the array `name` (with or without `.npy`) of an `.npz` file.
 ///
-/// Supports what [`NpyArray`] writes: little-endian `f4`, `f8`, `i4`, and `b1`, `u1`, C
-/// order, `.npy` versions 1.0 to 3.0, stored or deflated members (`np.savez` and
+/// Supports what [`NpyArray`] writes: little-endian `f4`, `f8`, `i4`, `i2`, `U{n}`, and
+/// `b1`, `u1`, C order, `.npy` versions 1.0 to 3.0, stored or deflated members (`np.savez` and
 /// `np.savez_compressed`). Anything else is an [`Error::Format`] naming the array.
 pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
@@ -333,11 +450,14 @@ pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
         return Err(bad("Fortran-order arrays are not supported".into()));
     }
     let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).ok_or_else(|| bad("shape overflows".into()))?;
-    let item = match descr.as_str() {
-        "<f4" | "<i4" => 4,
-        "<f8" => 8,
-        "|b1" | "|u1" => 1,
-        d => return Err(bad(format!("unsupported dtype `{d}`"))),
+    let str_width = descr.strip_prefix("<U").and_then(|n| n.parse::<usize>().ok());
+    let item = match (descr.as_str(), str_width) {
+        ("<f4" | "<i4", _) => 4,
+        ("<f8", _) => 8,
+        ("<i2", _) => 2,
+        ("|b1" | "|u1", _) => 1,
+        (_, Some(n)) => n.checked_mul(4).ok_or_else(|| bad(format!("unsupported dtype `{descr}`")))?,
+        (d, None) => return Err(bad(format!("unsupported dtype `{d}`"))),
     };
     let bytes = count.checked_mul(item).ok_or_else(|| bad("shape overflows".into()))?;
     if bytes as u64 > entry.size() {
@@ -348,11 +468,23 @@ pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
     let values = match descr.as_str() {
         "<f4" => NpyValues::F32(raw.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),
         "<i4" => NpyValues::I32(raw.chunks_exact(4).map(|c| i32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),
+        "<i2" => NpyValues::I16(raw.chunks_exact(2).map(|c| i16::from_le_bytes([c[0], c[1]])).collect()),
         "<f8" => NpyValues::F64(
             raw.chunks_exact(8).map(|c| f64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])).collect(),
         ),
         "|b1" => NpyValues::Bool(raw.iter().map(|&b| b != 0).collect()),
-        _ => NpyValues::U8(raw),
+        "|u1" => NpyValues::U8(raw),
+        _ => NpyValues::Str(
+            raw.chunks_exact(item.max(1))
+                .map(|e| {
+                    e.chunks_exact(4)
+                        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                        .take_while(|&c| c != 0)
+                        .map(|c| char::from_u32(c).unwrap_or(char::REPLACEMENT_CHARACTER))
+                        .collect()
+                })
+                .collect(),
+        ),
     };
     Ok(NpyOwned { shape, values })
 }
@@ -421,188 +553,4 @@ fn parse_header(h: &str) -> std::result::Result<(String, bool, Vec<usize>), Stri
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use fusemap_core::geometry::Point2;
-    use fusemap_core::grid::{CellIndex, OccupancyParams};
-    use std::path::PathBuf;
-
-    fn temp_dir(tag: &str) -> PathBuf {
-        crate::testdata::temp_dir(&format!("npz-{tag}"))
-    }
-
-    /// A 3-row, 4-column raster whose log-odds encode their position, `(row * 10 + col) / 8
-    /// - 1`, unknown on the diagonal.
-    fn raster() -> Raster {
-        let (width, height) = (4, 3);
-        let mut log_odds = Vec::new();
-        let mut known = Vec::new();
-        for row in 0..height {
-            for col in 0..width {
-                // Multiples of 1/8: exact in float32 and float64 alike.
-                log_odds.push((row * 10 + col) as f32 / 8.0 - 1.0);
-                known.push(row != col);
-            }
-        }
-        Raster {
-            width,
-            height,
-            resolution: 0.05,
-            origin: Point2::new(-5.0, -2.5),
-            first_cell: CellIndex { x: -100, y: -50 },
-            log_odds,
-            known,
-            params: OccupancyParams::default(),
-        }
-    }
-
-    #[test]
-    fn header_is_aligned_and_exact() {
-        let data = [0f32; 6];
-        let a = NpyArray::new(&[2, 3], NpyData::F32(&data)).unwrap();
-        let h = a.header();
-        assert_eq!(h.len() % 64, 0);
-        assert_eq!(&h[..8], b"\x93NUMPY\x01\x00");
-        assert_eq!(u16::from_le_bytes([h[8], h[9]]) as usize, h.len() - 10);
-        let text = std::str::from_utf8(&h[10..]).unwrap();
-        assert!(text.starts_with("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }"));
-        assert!(text.ends_with(" \n"));
-        let s = [1.0f64];
-        let h0 = NpyArray::new(&[], NpyData::F64(&s)).unwrap().header();
-        assert!(std::str::from_utf8(&h0[10..]).unwrap().contains("'shape': (), }"));
-        let h1 = NpyArray::new(&[1], NpyData::F64(&s)).unwrap().header();
-        assert!(std::str::from_utf8(&h1[10..]).unwrap().contains("'shape': (1,), }"));
-        assert!(NpyArray::new(&[2, 2], NpyData::F32(&data)).is_none());
-        assert!(NpyArray::new(&[usize::MAX, 2], NpyData::F32(&data)).is_none());
-    }
-
-    #[test]
-    fn map_round_trips() {
-        let d = temp_dir("rt");
-        let p = d.join("map.npz");
-        let r = raster();
-        write_map_npz(&p, &r).unwrap();
-        let (shape, lo) = read_npz_f32(&p, "log_odds").unwrap();
-        assert_eq!(shape, [3, 4]);
-        assert_eq!(lo, r.log_odds);
-        // Row-major, row = y index: element [2, 1] is row 2, column 1.
-        assert_eq!(lo[2 * 4 + 1], 21.0 / 8.0 - 1.0);
-        let (shape, occ) = read_npz_f32(&p, "occupancy.npy").unwrap();
-        assert_eq!(shape, [3, 4]);
-        assert_eq!(occ, r.occupancy());
-        let known = read_npz(&p, "known").unwrap();
-        assert_eq!(known.shape, [3, 4]);
-        assert_eq!(known.values, NpyValues::Bool(r.known.clone()));
-        let res = read_npz(&p, "resolution").unwrap();
-        assert_eq!(res.shape, Vec::<usize>::new());
-        assert_eq!(res.values, NpyValues::F64(vec![0.05]));
-        let origin = read_npz(&p, "origin").unwrap();
-        assert_eq!(origin.shape, [2]);
-        assert_eq!(origin.values, NpyValues::F64(vec![-5.0, -2.5]));
-        // Wrong type and missing arrays are errors naming the array.
-        let e = read_npz_f32(&p, "known").unwrap_err();
-        assert!(e.to_string().contains("`known`"), "{e}");
-        let e = read_npz_f32(&p, "nope").unwrap_err();
-        assert!(e.to_string().contains("`nope`"), "{e}");
-        // Same map, same bytes.
-        let p2 = d.join("again.npz");
-        write_map_npz(&p2, &r).unwrap();
-        assert_eq!(std::fs::read(&p).unwrap(), std::fs::read(&p2).unwrap());
-        std::fs::remove_dir_all(&d).unwrap();
-    }
-
-    #[test]
-    fn members_are_stored_like_np_savez() {
-        let d = temp_dir("stored");
-        let p = d.join("map.npz");
-        write_map_npz(&p, &raster()).unwrap();
-        let mut z = ZipArchive::new(File::open(&p).unwrap()).unwrap();
-        let mut names = Vec::new();
-        for i in 0..z.len() {
-            let f = z.by_index(i).unwrap();
-            assert_eq!(f.compression(), CompressionMethod::Stored);
-            names.push(f.name().unwrap().to_string());
-        }
-        assert_eq!(names, ["occupancy.npy", "log_odds.npy", "known.npy", "resolution.npy", "origin.npy"]);
-        std::fs::remove_dir_all(&d).unwrap();
-    }
-
-    #[test]
-    fn bad_inputs_are_errors() {
-        let d = temp_dir("bad");
-        let p = d.join("not.npz");
-        std::fs::write(&p, b"hello").unwrap();
-        assert!(matches!(read_npz(&p, "x"), Err(Error::Format { location: Location::File, .. })));
-        assert!(matches!(read_npz(&d.join("missing.npz"), "x"), Err(Error::Io { .. })));
-        let mut r = raster();
-        r.known.pop();
-        let e = write_map_npz(&d.join("m.npz"), &r).unwrap_err();
-        assert!(e.to_string().contains("known flags"), "{e}");
-        assert!(!d.join("m.npz").exists());
-        let mut w = NpzWriter::new(io::Cursor::new(Vec::new()));
-        let one = [1u8];
-        let a = NpyArray::new(&[1], NpyData::U8(&one)).unwrap();
-        w.add("a", &a).unwrap();
-        assert!(w.add("a", &a).is_err());
-        assert!(w.add("x/y", &a).is_err());
-        std::fs::remove_dir_all(&d).unwrap();
-    }
-
-    #[test]
-    fn header_parser_accepts_numpys_spellings() {
-        let (d, f, s) = parse_header("{'descr': '<f8', 'fortran_order': False, 'shape': (3, 4), }   \n").unwrap();
-        assert_eq!((d.as_str(), f, s), ("<f8", false, vec![3, 4]));
-        let (_, _, s) = parse_header("{'descr': '|b1', 'fortran_order': True, 'shape': (7,), }").unwrap();
-        assert_eq!(s, [7]);
-        let (_, _, s) = parse_header("{'descr': '<f4', 'fortran_order': False, 'shape': (), }").unwrap();
-        assert!(s.is_empty());
-        assert!(parse_header("{'descr': '<f4'}").is_err());
-        assert!(parse_header("nonsense").is_err());
-        assert!(parse_header("{'descr': '<f4', 'fortran_order': 0, 'shape': ()}").is_err());
-        assert!(parse_header("{'descr': '<f4', 'fortran_order': False, 'shape': (x,)}").is_err());
-    }
-
-    /// NumPy itself loads the file with the documented names, shapes, dtypes and values.
-    #[test]
-    fn numpy_loads_the_map() {
-        let d = temp_dir("numpy");
-        let p = d.join("map.npz");
-        let r = raster();
-        write_map_npz(&p, &r).unwrap();
-        let script = r#"
-import sys
-import numpy as np
-m = np.load(sys.argv[1])
-assert sorted(m.files) == ['known', 'log_odds', 'occupancy', 'origin', 'resolution'], m.files
-for k in ('occupancy', 'log_odds'):
-    assert m[k].dtype == np.float32 and m[k].shape == (3, 4), (k, m[k].dtype, m[k].shape)
-assert m['known'].dtype == np.bool_ and m['known'].shape == (3, 4)
-assert m['resolution'].dtype == np.float64 and m['resolution'].shape == ()
-assert float(m['resolution']) == 0.05
-assert m['origin'].dtype == np.float64 and m['origin'].tolist() == [-5.0, -2.5]
-lo = m['log_odds']
-for iy in range(3):
-    for ix in range(4):
-        assert lo[iy, ix] == np.float32((iy * 10 + ix) / 8.0 - 1.0), (iy, ix, lo[iy, ix])
-        assert m['known'][iy, ix] == (iy != ix)
-occ = 1.0 - 1.0 / (1.0 + np.exp(lo.astype(np.float64)))
-assert np.allclose(m['occupancy'], occ, atol=1e-6)
-print('ok')
-"#;
-        let out = match std::process::Command::new("python3").arg("-c").arg(script).arg(&p).output() {
-            Ok(o) => o,
-            Err(e) => {
-                crate::testdata::skip(&format!("python3 is not available ({e})"));
-                return;
-            }
-        };
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        if !out.status.success() && stderr.contains("No module named 'numpy'") {
-            crate::testdata::skip("numpy is not installed for python3");
-            return;
-        }
-        assert!(out.status.success(), "numpy could not read the file:\n{stderr}");
-        assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "ok");
-        std::fs::remove_dir_all(&d).unwrap();
-    }
-}
+mod tests;
