@@ -3,13 +3,17 @@
 
 use crate::summary::{CellsUpdated, MapInfo, Summary};
 use anyhow::{Context, Result};
+use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
-use fusemap_core::grid::Raster;
+use fusemap_core::grid::{CellBox, CellIndex, CellRaster, DynamicParams, FusionGrid, Raster};
+use fusemap_core::measurement::SensorId;
 use fusemap_core::metrics::map_entropy;
 use fusemap_core::sensor::ReturnCounts;
 use fusemap_core::time::Stamp;
 use fusemap_io::atomic::{ensure_not_input, write_atomic};
+use fusemap_io::npz::NpzLayers;
+use fusemap_io::semantic::{ClassInfo, SemanticRaster};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -28,6 +32,12 @@ pub struct OutputFiles {
     pub summary: PathBuf,
     /// `trajectory.tum`.
     pub trajectory: PathBuf,
+    /// `semantic.yaml` (its `semantic.png` beside it), for a run with a camera.
+    pub semantic: PathBuf,
+    /// `semantic.png`.
+    pub semantic_png: PathBuf,
+    /// `dynamic.png`, for a run with a camera.
+    pub dynamic: PathBuf,
 }
 
 impl OutputFiles {
@@ -40,11 +50,24 @@ impl OutputFiles {
             png: dir.join("map.png"),
             summary: dir.join("summary.json"),
             trajectory: dir.join("trajectory.tum"),
+            semantic: dir.join("semantic.yaml"),
+            semantic_png: dir.join("semantic.png"),
+            dynamic: dir.join("dynamic.png"),
         }
     }
 
-    fn all(&self) -> [&PathBuf; 6] {
-        [&self.npz, &self.yaml, &self.pgm, &self.png, &self.summary, &self.trajectory]
+    fn all(&self) -> [&PathBuf; 9] {
+        [
+            &self.npz,
+            &self.yaml,
+            &self.pgm,
+            &self.png,
+            &self.summary,
+            &self.trajectory,
+            &self.semantic,
+            &self.semantic_png,
+            &self.dynamic,
+        ]
     }
 }
 
@@ -58,11 +81,52 @@ pub fn prepare(dir: &Path, inputs: &[PathBuf]) -> Result<OutputFiles> {
     Ok(files)
 }
 
+/// The semantic and dynamic layers of a run with a camera, over the occupancy raster's
+/// cells.
+pub struct Layers {
+    /// The semantic layer.
+    pub semantic: SemanticRaster,
+    /// The dynamic layer's probability at the run's last stamp.
+    pub dynamic: CellRaster<f32>,
+}
+
+/// The layers of `grid` over `raster`'s cells when the engine has a camera (its class
+/// table names the classes), `None` otherwise.
+pub fn layers_of(engine: &Engine, grid: &FusionGrid, raster: &Raster) -> Option<Layers> {
+    let camera = (0..u16::MAX)
+        .map(SensorId)
+        .take_while(|&id| engine.sensor_kind(id).is_some())
+        .find_map(|id| engine.camera_model(id))?;
+    let classes = camera.classes();
+    let area = CellBox {
+        min: raster.first_cell,
+        max: CellIndex::new(
+            raster.first_cell.x + raster.width as i64 - 1,
+            raster.first_cell.y + raster.height as i64 - 1,
+        ),
+    };
+    let cells = semantic_cells(grid, area, classes);
+    let semantic = SemanticRaster {
+        width: cells.best.width,
+        height: cells.best.height,
+        resolution: cells.best.resolution,
+        origin: [cells.best.origin.x, cells.best.origin.y],
+        classes: classes.iter().map(|c| ClassInfo { id: c.id, name: c.name.clone(), color: c.color }).collect(),
+        best: cells.best.cells,
+        prob: cells.prob,
+        probs: cells.probs,
+    };
+    let half_life = engine.dynamic_params().map_or(DynamicParams::default().half_life_s, |p| p.half_life_s);
+    let dynamic = dynamic_cells(grid, area, engine.last_stamp().unwrap_or_default(), half_life);
+    Some(Layers { semantic, dynamic })
+}
+
 /// Writes the map files (if anything is known), the trajectory (when there is one) and
 /// the summary.
 pub fn write(
     files: &OutputFiles,
     raster: Option<&Raster>,
+    layers: Option<&Layers>,
     summary: &Summary,
     trajectory: Option<&[(Stamp, Pose2)]>,
 ) -> Result<()> {
@@ -70,7 +134,15 @@ pub fn write(
         fusemap_io::trajectory::write_tum(&files.trajectory, t)?;
     }
     if let Some(r) = raster {
-        fusemap_io::npz::write_map_npz(&files.npz, r)?;
+        match layers {
+            Some(l) => {
+                let with = NpzLayers { semantic: Some(&l.semantic), dynamic: Some(&l.dynamic) };
+                fusemap_io::npz::write_map_npz_with(&files.npz, r, &with)?;
+                fusemap_io::semantic::write_semantic(&files.semantic, &l.semantic)?;
+                fusemap_io::semantic::write_dynamic_png(&files.dynamic, &l.dynamic)?;
+            }
+            None => fusemap_io::npz::write_map_npz(&files.npz, r)?,
+        }
         fusemap_io::map_server::write_map_server(&files.yaml, r)?;
         fusemap_io::picture::write_map_png(&files.png, r)?;
     }
@@ -93,6 +165,7 @@ pub fn finish(
 ) -> Result<Summary> {
     let grid = engine.grid();
     let raster = grid.known_raster();
+    let layers = raster.as_ref().and_then(|r| layers_of(engine, grid, r));
     let st = engine.stats();
     let mut returns = ReturnCounts::default();
     let mut scans = 0;
@@ -121,7 +194,7 @@ pub fn finish(
         summary.notes.push("no cell was observed: only summary.json was written".into());
     }
     summary.wall_time_s = started.elapsed().as_secs_f64();
-    write(files, raster.as_ref(), &summary, trajectory)?;
+    write(files, raster.as_ref(), layers.as_ref(), &summary, trajectory)?;
     summary.wall_time_s = started.elapsed().as_secs_f64();
     Ok(summary)
 }

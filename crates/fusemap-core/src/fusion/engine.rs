@@ -188,6 +188,11 @@ impl Engine {
         self.maps
     }
 
+    /// The stamp of the newest observation applied, `None` before the first.
+    pub fn last_stamp(&self) -> Option<Stamp> {
+        self.last
+    }
+
     /// Run counters.
     pub fn stats(&self) -> &EngineStats {
         &self.stats
