@@ -1,5 +1,6 @@
 //! A simulated run written as a user's robot would record it: a rosbag2 directory (MCAP
-//! storage, standard message types, CDR, `/tf_static` latched) with the ground truth
+//! storage, standard message types — scans, odometry, IMU, GNSS, the semantic camera's
+//! label and depth `sensor_msgs/Image`s and `CameraInfo` — CDR, `/tf_static` latched) with the ground truth
 //! beside it — the occupancy map as map_server PGM + YAML and the true trajectory as TUM.
 //!
 //! Scenario files are TOML mapping one to one onto
@@ -8,7 +9,7 @@
 use crate::config_file::{field_error, read_text, toml_error};
 use crate::log::ros2::writer::msgs::geometry_msgs::{PoseWithCovariance, TransformStamped, TwistWithCovariance};
 use crate::log::ros2::writer::msgs::nav_msgs::Odometry;
-use crate::log::ros2::writer::msgs::sensor_msgs::{Imu, LaserScan, NavSatFix, NavSatStatus};
+use crate::log::ros2::writer::msgs::sensor_msgs::{CameraInfo, Image, Imu, LaserScan, NavSatFix, NavSatStatus};
 use crate::log::ros2::writer::msgs::std_msgs::Header;
 use crate::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions, WrittenBag};
 use crate::Result;
@@ -75,6 +76,26 @@ pub fn to_out_message(m: &SimMessage) -> OutMessage {
             position_covariance_type: f.position_covariance_type,
         }),
         SimMessage::StaticTransform(t) => OutMessage::Tf { is_static: true, transforms: vec![transform(t)] },
+        SimMessage::Image(i) => OutMessage::Image(Image {
+            header: header(i.stamp, &i.frame_id),
+            height: i.height,
+            width: i.width,
+            encoding: i.encoding.clone(),
+            is_bigendian: i.is_bigendian,
+            step: i.step,
+            data: i.data.clone(),
+        }),
+        SimMessage::CameraInfo(c) => OutMessage::CameraInfo(CameraInfo {
+            header: header(c.stamp, &c.frame_id),
+            height: c.height,
+            width: c.width,
+            distortion_model: c.distortion_model.clone(),
+            d: c.d.clone(),
+            k: c.k,
+            r: c.r,
+            p: c.p,
+            ..CameraInfo::default()
+        }),
     }
 }
 

@@ -1,9 +1,12 @@
 //! The lidar: each beam is cast at its own time along the sweep from the true pose of
 //! that instant (the motion distortion de-skewing removes, design document §2.2, §4.1),
 //! then the failures of glass, polished steel, depth edges and dropouts are applied.
+//! The walking person is traced at the beam's own time too (a cheap circle test beside the
+//! static caster, which stays unchanged).
 
 use super::messages::SimScan;
 use super::path::Trajectory;
+use super::person::{ray_circle, PersonConfig};
 use super::sensors::LidarConfig;
 use super::world::{Caster, Material};
 use crate::geometry::Point2;
@@ -27,7 +30,12 @@ pub struct LidarStats {
     pub mixed_pixels: u64,
     /// Beams reported as NaN, inf or 0 by a dropout.
     pub dropouts: u64,
+    /// Beams whose return came from the walking person.
+    pub person_hits: u64,
 }
+
+/// Intensity of a return from the person (clothing: between machine and wall).
+const PERSON_INTENSITY: f32 = 30.0;
 
 fn intensity(m: Option<Material>) -> f32 {
     match m {
@@ -39,19 +47,30 @@ fn intensity(m: Option<Material>) -> f32 {
     }
 }
 
-/// The range one beam measures before noise, and the material that returned it.
+/// The range one beam measures before noise, and the intensity of what returned it.
+/// `person` is the person's circle (centre, radius) at the beam's time, if present: it
+/// returns the beam when it stands before the surface the beam would otherwise return
+/// from (also behind glass the beam passed).
 fn trace(
     caster: &Caster,
     cfg: &LidarConfig,
-    origin: Point2,
-    dir: (f64, f64),
+    (origin, dir): (Point2, (f64, f64)),
+    person: Option<(Point2, f64)>,
     rng: &mut SplitMix64,
     stats: &mut LidarStats,
-) -> (Option<f64>, Option<Material>) {
+) -> (Option<f64>, f32) {
+    let person_range = person.and_then(|(c, r)| ray_circle(origin, dir, c, r));
     let mut skip: Vec<usize> = Vec::new();
     let mut first = true;
     while skip.len() < 4 {
-        let Some(hit) = caster.cast(origin, dir, &skip) else { return (None, None) };
+        let hit = caster.cast(origin, dir, &skip);
+        if let Some(rp) = person_range {
+            if hit.is_none_or(|h| rp < h.range) {
+                stats.person_hits += 1;
+                return (Some(rp), PERSON_INTENSITY);
+            }
+        }
+        let Some(hit) = hit else { return (None, intensity(None)) };
         match hit.material {
             Material::Glass => {
                 if first {
@@ -75,14 +94,14 @@ fn trace(
                     let r = (dir.0 - 2.0 * dn * hit.normal.0, dir.1 - 2.0 * dn * hit.normal.1);
                     let at = Point2::new(origin.x + dir.0 * hit.range, origin.y + dir.1 * hit.range);
                     let bounce = caster.cast(at, r, &[hit.object]);
-                    return (bounce.map(|b| hit.range + b.range), bounce.map(|b| b.material));
+                    return (bounce.map(|b| hit.range + b.range), intensity(bounce.map(|b| b.material)));
                 }
             }
             Material::Wall | Material::Machine => {}
         }
-        return (Some(hit.range), Some(hit.material));
+        return (Some(hit.range), intensity(Some(hit.material)));
     }
-    (None, None)
+    (None, intensity(None))
 }
 
 /// Simulates every scan of the run. `start` is the clock at t = 0.
@@ -90,6 +109,7 @@ pub fn simulate_scans(
     cfg: &LidarConfig,
     frame_id: &str,
     caster: &Caster,
+    person: &PersonConfig,
     traj: &Trajectory,
     start: Stamp,
     rng: &mut SplitMix64,
@@ -106,12 +126,14 @@ pub fn simulate_scans(
         if t0 + cfg.sweep_time_s > traj.duration() {
             break;
         }
-        let mut truth: Vec<(Option<f64>, Option<Material>)> = Vec::with_capacity(cfg.beams);
+        let mut truth: Vec<(Option<f64>, f32)> = Vec::with_capacity(cfg.beams);
         for i in 0..cfg.beams {
-            let pose = traj.pose_at(t0 + i as f64 * ti);
+            let t = t0 + i as f64 * ti;
+            let pose = traj.pose_at(t);
             let origin = pose * mount.origin_in_base();
             let (s, c) = (pose.theta + mount.beam_angle_in_base(a0 + i as f64 * inc)).sin_cos();
-            truth.push(trace(caster, cfg, origin, (c, s), rng, &mut stats));
+            let who = person.position_at(t).map(|p| (p, person.radius_m));
+            truth.push(trace(caster, cfg, (origin, (c, s)), who, rng, &mut stats));
         }
         stats.beams += cfg.beams as u64;
         let mut ranges: Vec<Option<f64>> = truth.iter().map(|t| t.0).collect();
@@ -152,7 +174,7 @@ pub fn simulate_scans(
             range_min: cfg.range_min_m as f32,
             range_max: cfg.range_max_m as f32,
             ranges: out,
-            intensities: truth.iter().map(|t| intensity(t.1)).collect(),
+            intensities: truth.iter().map(|t| t.1).collect(),
         });
         k += 1;
     }

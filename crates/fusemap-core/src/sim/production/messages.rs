@@ -1,7 +1,7 @@
 //! Plain-Rust mirrors of the ROS messages a recording holds. Field names and meanings
 //! follow the `.msg` definitions so a writer fills `sensor_msgs/LaserScan`,
-//! `nav_msgs/Odometry`, `sensor_msgs/Imu`, `sensor_msgs/NavSatFix` and
-//! `tf2_msgs/TFMessage` one field at a time. Quaternions are `(x, y, z, w)`,
+//! `nav_msgs/Odometry`, `sensor_msgs/Imu`, `sensor_msgs/NavSatFix`, `sensor_msgs/Image`,
+//! `sensor_msgs/CameraInfo` and `tf2_msgs/TFMessage` one field at a time. Quaternions are `(x, y, z, w)`,
 //! covariances row-major.
 
 use crate::geometry::{quaternion_yaw, Mount3, Pose2};
@@ -192,6 +192,54 @@ impl SimStaticTransform {
     }
 }
 
+/// `sensor_msgs/Image`: an uncompressed image, row after row.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimImage {
+    /// Header stamp: the camera clock at exposure.
+    pub stamp: Stamp,
+    /// Topic.
+    pub topic: String,
+    /// Header frame (the camera's optical frame).
+    pub frame_id: String,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// `mono8`, `mono16` (labels), `32FC1`, `16UC1` (depth).
+    pub encoding: String,
+    /// 1 when multi-byte pixels are big-endian (here always 0).
+    pub is_bigendian: u8,
+    /// Bytes per row.
+    pub step: u32,
+    /// `step · height` bytes.
+    pub data: Vec<u8>,
+}
+
+/// `sensor_msgs/CameraInfo` of a pinhole camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimCameraInfo {
+    /// Header stamp: that of the images it describes.
+    pub stamp: Stamp,
+    /// Topic.
+    pub topic: String,
+    /// Header frame (the camera's optical frame).
+    pub frame_id: String,
+    /// Rows.
+    pub height: u32,
+    /// Columns.
+    pub width: u32,
+    /// `plumb_bob`.
+    pub distortion_model: String,
+    /// Distortion coefficients (k1, k2, t1, t2, k3): all zero.
+    pub d: Vec<f64>,
+    /// Intrinsic matrix, row-major 3×3.
+    pub k: [f64; 9],
+    /// Rectification rotation, row-major 3×3 (identity).
+    pub r: [f64; 9],
+    /// Projection matrix, row-major 3×4.
+    pub p: [f64; 12],
+}
+
 /// Any message of a recording.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SimMessage {
@@ -205,6 +253,10 @@ pub enum SimMessage {
     Fix(SimFix),
     /// A static mount.
     StaticTransform(SimStaticTransform),
+    /// A camera image (labels or depth).
+    Image(SimImage),
+    /// A camera calibration (boxed: its matrices would make every message 300 bytes).
+    CameraInfo(Box<SimCameraInfo>),
 }
 
 impl SimMessage {
@@ -216,6 +268,8 @@ impl SimMessage {
             SimMessage::Imu(m) => m.stamp,
             SimMessage::Fix(m) => m.stamp,
             SimMessage::StaticTransform(m) => m.stamp,
+            SimMessage::Image(m) => m.stamp,
+            SimMessage::CameraInfo(m) => m.stamp,
         }
     }
 
@@ -227,6 +281,8 @@ impl SimMessage {
             SimMessage::Imu(m) => &m.topic,
             SimMessage::Fix(m) => &m.topic,
             SimMessage::StaticTransform(m) => &m.topic,
+            SimMessage::Image(m) => &m.topic,
+            SimMessage::CameraInfo(m) => &m.topic,
         }
     }
 
@@ -238,6 +294,8 @@ impl SimMessage {
             SimMessage::Imu(m) => &m.frame_id,
             SimMessage::Fix(m) => &m.frame_id,
             SimMessage::StaticTransform(m) => &m.frame_id,
+            SimMessage::Image(m) => &m.frame_id,
+            SimMessage::CameraInfo(m) => &m.frame_id,
         }
     }
 }

@@ -1,14 +1,17 @@
 //! The design document's opening picture as a simulator: a robot drives along a
 //! production line; the lidar produces flying points on a glass fence and stainless-steel
 //! pillars, the wheel odometry slips over floor grooves, and RTK GNSS has good, degraded
-//! and dropout zones.
+//! and dropout zones; a semantic RGB-D camera sees the hall in 2.5D, with backlight from
+//! the windows, and a person walks across the robot's loop.
 //!
 //! A [`Scenario`] (readable from TOML) describes the hall, the robot's loop and every
 //! sensor; [`simulate`] turns it into a [`SimRecording`]: one time-ordered list of
 //! messages mirroring the ROS types (`sensor_msgs/LaserScan`, `nav_msgs/Odometry`,
-//! `sensor_msgs/Imu`, `sensor_msgs/NavSatFix`, `/tf_static`) plus the ground truth an
-//! estimator and a map are scored against (the true trajectory, the injected outliers,
-//! the dropout intervals, the gyro bias and odometry scale, a truth occupancy raster).
+//! `sensor_msgs/Imu`, `sensor_msgs/NavSatFix`, `sensor_msgs/Image`,
+//! `sensor_msgs/CameraInfo`, `/tf_static`) plus the ground truth an estimator and a map
+//! are scored against (the true trajectory, the injected outliers, the dropout intervals,
+//! the gyro bias and odometry scale, truth occupancy and semantic rasters, the person's
+//! track, the camera's true stamps and backlit floor).
 //!
 //! Frames (REP 105): `map` is ENU at the GNSS datum, x east, y north, and the world's
 //! coordinates are given in it; the robot starts at rest on its loop (where the first
@@ -43,32 +46,42 @@
 //! assert!(run.messages.windows(2).all(|w| w[0].stamp() <= w[1].stamp()));
 //! ```
 
+mod camera;
 mod gnss;
 mod imu;
 mod lidar;
 mod messages;
 mod odometry;
 mod path;
+mod person;
 mod recording;
 mod scenario;
+mod semantic_truth;
 mod sensors;
 mod world;
 
 #[cfg(test)]
 mod tests;
 
+pub use camera::{
+    class_id, optical_rotation, BacklightConfig, CameraConfig, CameraTruth, DepthEncoding, LabelEncoding,
+    CLASS_CEILING, CLASS_FLOOR, CLASS_GLASS, CLASS_MACHINE, CLASS_NAMES, CLASS_PERSON, CLASS_PILLAR, CLASS_UNLABELED,
+    CLASS_WALL, MAX_BACKLIT_POINTS, MAX_CAMERA_BYTES,
+};
 pub use imu::STANDARD_GRAVITY;
 pub use lidar::LidarStats;
 pub use messages::{
-    rpy_to_quaternion, SimFix, SimImu, SimMessage, SimOdometry, SimScan, SimStaticTransform,
+    rpy_to_quaternion, SimCameraInfo, SimFix, SimImage, SimImu, SimMessage, SimOdometry, SimScan, SimStaticTransform,
     COVARIANCE_TYPE_DIAGONAL_KNOWN, COVARIANCE_TYPE_UNKNOWN, SERVICE_GALILEO, SERVICE_GPS, STATUS_FIX, STATUS_GBAS_FIX,
     STATUS_NO_FIX, STATUS_SBAS_FIX,
 };
 pub use path::{rounded_loop, Approach, Trajectory, TruthSample, TRUTH_RATE_HZ};
+pub use person::{ray_circle, PersonConfig};
 pub use recording::{segment_meets_box, SimRecording, TruthRaster, TruthRasterError, MAX_TRUTH_CELLS};
 pub use scenario::{FramesConfig, RobotConfig, Scenario, WorldConfig};
+pub use semantic_truth::TruthSemantic;
 pub use sensors::{DropoutMode, GnssConfig, GnssZone, ImuConfig, LidarConfig, OdometryConfig, ZoneKind};
-pub use world::{production_hall_objects, Caster, Hit, Material, Rect, Shape, WorldObject};
+pub use world::{production_hall_objects, Caster, EdgeHit, Hit, Material, Rect, Shape, WorldObject};
 
 use crate::sim::SplitMix64;
 use crate::time::Stamp;
@@ -98,6 +111,7 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
     let mut rng_odom = SplitMix64::new(seeds.next_u64());
     let mut rng_imu = SplitMix64::new(seeds.next_u64());
     let mut rng_gnss = SplitMix64::new(seeds.next_u64());
+    let camera_seed = seeds.next_u64();
     let f = &scenario.frames;
 
     let mut messages = Vec::new();
@@ -113,7 +127,21 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
             mount,
         )));
     }
-    let (scans, lidar_stats) = lidar::simulate_scans(&scenario.lidar, &f.laser, &caster, &traj, start, &mut rng_lidar);
+    let camera_run = camera::CameraRun {
+        cfg: &scenario.camera,
+        frame_id: &f.camera_optical,
+        base_link: &f.base_link,
+        objects: &scenario.world.objects,
+        caster: &caster,
+        person: &scenario.person,
+        traj: &traj,
+        start,
+    };
+    if scenario.camera.enabled {
+        messages.push(SimMessage::StaticTransform(camera_run.mount_message()));
+    }
+    let (scans, lidar_stats) =
+        lidar::simulate_scans(&scenario.lidar, &f.laser, &caster, &scenario.person, &traj, start, &mut rng_lidar);
     messages.extend(scans.into_iter().map(SimMessage::Scan));
     let (odom, slipping_steps) = odometry::simulate_odometry(
         &scenario.odometry,
@@ -128,6 +156,13 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
     messages.extend(imu.into_iter().map(|m| SimMessage::Imu(Box::new(m))));
     let gnss = gnss::simulate_gnss(&scenario.gnss, &datum, &f.gps, &traj, start, &mut rng_gnss);
     messages.extend(gnss.fixes.into_iter().map(SimMessage::Fix));
+    let camera_truth = if scenario.camera.enabled {
+        let (images, truth) = camera_run.simulate(camera_seed);
+        messages.extend(images);
+        truth
+    } else {
+        CameraTruth::default()
+    };
     messages.sort_by_key(|m| m.stamp());
 
     let mut truth_trajectory = Vec::new();
@@ -137,6 +172,13 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
         truth_trajectory.push((Stamp(start.0 + (t * 1e9).round() as i64), traj.pose_at(t)));
         k += 1;
     }
+    let person_track = (0..=(traj.duration() * TRUTH_OUTPUT_RATE_HZ).floor() as usize)
+        .filter_map(|k| {
+            let t = k as f64 / TRUTH_OUTPUT_RATE_HZ;
+            let p = scenario.person.position_at(t)?;
+            Some((Stamp(start.0 + (t * 1e9).round() as i64), p))
+        })
+        .collect();
     Ok(SimRecording {
         messages,
         truth_trajectory,
@@ -149,5 +191,8 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
         datum,
         objects: scenario.world.objects.clone(),
         extent: scenario.world.extent,
+        person_track,
+        person_radius_m: scenario.person.radius_m,
+        camera_truth,
     })
 }

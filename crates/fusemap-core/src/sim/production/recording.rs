@@ -1,6 +1,7 @@
 //! What a run produces: the time-ordered messages and the ground truth to score an
 //! estimator and a map against.
 
+use super::camera::CameraTruth;
 use super::lidar::LidarStats;
 use super::messages::SimMessage;
 use super::world::{polygon_contains, Rect, WorldObject};
@@ -12,7 +13,7 @@ use crate::time::Stamp;
 #[derive(Clone, Debug)]
 pub struct SimRecording {
     /// Every message, sorted by header stamp (ties keep the order static transforms,
-    /// scans, odometry, IMU, fixes).
+    /// scans, odometry, IMU, fixes, camera images and calibration).
     pub messages: Vec<SimMessage>,
     /// `map_from_base` at 50 Hz, true clock (no sensor offset). The map frame is ENU at
     /// the GNSS datum: x east, y north.
@@ -35,6 +36,13 @@ pub struct SimRecording {
     pub objects: Vec<WorldObject>,
     /// The world's extent.
     pub extent: Rect,
+    /// Where the walking person stood, true clock, at 50 Hz while present (empty when
+    /// disabled). It is never part of the truth rasters.
+    pub person_track: Vec<(Stamp, Point2)>,
+    /// The person's radius, metres.
+    pub person_radius_m: f64,
+    /// What the camera truly did (empty when disabled).
+    pub camera_truth: CameraTruth,
 }
 
 /// Largest truth raster [`SimRecording::truth_occupancy`] builds: 2²⁸ cells (256 MB of
@@ -49,6 +57,14 @@ pub enum TruthRasterError {
     TooLarge {
         /// Cells the extent needs (saturated when beyond the grid's index range).
         cells: u128,
+    },
+    /// An object's class is not one of the class table's object classes.
+    #[error("object `{object}` has class `{class}`, not an object class of the table (wall, glass, pillar, machine)")]
+    UnknownClass {
+        /// The object's name.
+        object: String,
+        /// Its class.
+        class: String,
     },
 }
 
@@ -98,6 +114,25 @@ impl SimRecording {
     /// an outline edge (so an ideal, zero-thickness line marks every cell it crosses).
     /// Refuses rasters above [`MAX_TRUTH_CELLS`] cells instead of exhausting memory.
     pub fn truth_occupancy(&self, geometry: GridGeometry) -> Result<TruthRaster, TruthRasterError> {
+        let mut occupied = Vec::new();
+        let (first_cell, width, height) = self.raster_objects(geometry, |n, _, i, _| {
+            occupied.resize(n, false);
+            occupied[i] = true;
+        })?;
+        occupied.resize(width * height, false);
+        Ok(TruthRaster { geometry, first_cell, width, height, occupied })
+    }
+
+    /// Walks every cell every object covers (as [`SimRecording::truth_occupancy`] defines
+    /// it) over the world's extent: `visit(cells, object, index, centre_inside)` with the
+    /// raster's cell count, the row-major index into it and whether the cell's centre lies
+    /// inside the object's closed outline (a body cell). Returns the raster's first cell,
+    /// width and height.
+    pub(crate) fn raster_objects(
+        &self,
+        geometry: GridGeometry,
+        mut visit: impl FnMut(usize, usize, usize, bool),
+    ) -> Result<(CellIndex, usize, usize), TruthRasterError> {
         let e = &self.extent;
         let (Some(lo), Some(hi)) =
             (geometry.cell_of(Point2::new(e.min[0], e.min[1])), geometry.cell_of(Point2::new(e.max[0], e.max[1])))
@@ -109,9 +144,8 @@ impl SimRecording {
             return Err(TruthRasterError::TooLarge { cells: w * h });
         }
         let (width, height) = (w as usize, h as usize);
-        let mut occupied = vec![false; width * height];
         let res = geometry.resolution();
-        for o in &self.objects {
+        for (k, o) in self.objects.iter().enumerate() {
             let edges = o.outline();
             let corners: Vec<[f64; 2]> = edges.iter().map(|(a, _)| [a.x, a.y]).collect();
             let (mut bx0, mut by0, mut bx1, mut by1) =
@@ -131,15 +165,14 @@ impl SimRecording {
                     let cell = CellIndex::new(x, y);
                     let corner = geometry.cell_corner(cell);
                     let far = Point2::new(corner.x + res, corner.y + res);
-                    let hit = (corners.len() >= 3 && polygon_contains(&corners, geometry.cell_center(cell)))
-                        || edges.iter().any(|&(a, b)| segment_meets_box(a, b, corner, far));
-                    if hit {
-                        occupied[(y - lo.y) as usize * width + (x - lo.x) as usize] = true;
+                    let inside = corners.len() >= 3 && polygon_contains(&corners, geometry.cell_center(cell));
+                    if inside || edges.iter().any(|&(a, b)| segment_meets_box(a, b, corner, far)) {
+                        visit(width * height, k, (y - lo.y) as usize * width + (x - lo.x) as usize, inside);
                     }
                 }
             }
         }
-        Ok(TruthRaster { geometry, first_cell: lo, width, height, occupied })
+        Ok((lo, width, height))
     }
 
     /// The true `map_from_base` at `stamp` (true clock), interpolated; `None` outside the run.

@@ -4,6 +4,8 @@
 //! a missing key takes the production line's value. [`Scenario::validate`] names the
 //! offending field in the TOML path form (`lidar.glass_pass_probability`).
 
+use super::camera::{class_id, CameraConfig};
+use super::person::PersonConfig;
 use super::sensors::{GnssConfig, ImuConfig, LidarConfig, OdometryConfig};
 use super::world::{production_hall_objects, Rect, WorldObject};
 use serde::{Deserialize, Serialize};
@@ -24,6 +26,10 @@ pub struct Scenario {
     pub imu: ImuConfig,
     /// The RTK GNSS receiver.
     pub gnss: GnssConfig,
+    /// The semantic RGB-D camera.
+    pub camera: CameraConfig,
+    /// The walking person.
+    pub person: PersonConfig,
     /// Frame names (REP 105).
     pub frames: FramesConfig,
 }
@@ -113,6 +119,8 @@ pub struct FramesConfig {
     pub imu_link: String,
     /// The GNSS antenna.
     pub gps: String,
+    /// The camera's optical frame (REP 103 optical axes: z forward, x right, y down).
+    pub camera_optical: String,
 }
 
 impl Default for FramesConfig {
@@ -124,6 +132,7 @@ impl Default for FramesConfig {
             laser: "laser".into(),
             imu_link: "imu_link".into(),
             gps: "gps".into(),
+            camera_optical: "camera_optical".into(),
         }
     }
 }
@@ -177,6 +186,12 @@ impl Scenario {
         }
         for (i, o) in w.objects.iter().enumerate() {
             o.check(&format!("world.objects[{i}]"))?;
+            if class_id(&o.class).is_none_or(|c| c == 0 || c > 5) {
+                return Err(format!(
+                    "world.objects[{i}].class `{}` is not an object class of the table (wall, glass, pillar, machine)",
+                    o.class
+                ));
+            }
         }
         for (i, g) in w.grooves.iter().enumerate() {
             g.check(&format!("world.grooves[{i}]"))?;
@@ -211,6 +226,8 @@ impl Scenario {
         self.odometry.validate()?;
         self.imu.validate()?;
         self.gnss.validate()?;
+        self.camera.validate(r.duration_s)?;
+        self.person.validate()?;
         let f = &self.frames;
         for (field, name) in [
             ("frames.map", &f.map),
@@ -219,6 +236,7 @@ impl Scenario {
             ("frames.laser", &f.laser),
             ("frames.imu_link", &f.imu_link),
             ("frames.gps", &f.gps),
+            ("frames.camera_optical", &f.camera_optical),
         ] {
             if name.is_empty() {
                 return Err(format!("{field} must not be empty"));
@@ -263,5 +281,21 @@ mod tests {
         let mut s = Scenario::default();
         s.odometry.rate_hz = f64::NAN;
         assert!(s.validate().unwrap_err().starts_with("odometry.rate_hz"));
+        let mut s = Scenario::default();
+        s.world.objects[6].class = "fence".into();
+        assert!(s.validate().unwrap_err().starts_with("world.objects[6].class"));
+        let mut s = Scenario::default();
+        s.camera.hfov_deg = 180.0;
+        assert!(s.validate().unwrap_err().starts_with("camera.hfov_deg"));
+        let mut s = Scenario::default();
+        s.camera.backlight.class = "sky".into();
+        assert!(s.validate().unwrap_err().starts_with("camera.backlight.class"));
+        let mut s = Scenario::default();
+        s.camera.width = 4096;
+        s.camera.height = 4096;
+        assert!(s.validate().unwrap_err().starts_with("camera.width × camera.height"));
+        let mut s = Scenario::default();
+        s.person.speed_mps = 0.0;
+        assert!(s.validate().unwrap_err().starts_with("person.speed_mps"));
     }
 }

@@ -25,6 +25,9 @@ fn clean(duration_s: f64) -> Scenario {
     s.odometry.slip_factor_right = 1.0;
     s.odometry.wheel_noise_std_mps = 0.0;
     s.gnss.good_sigma_m = 0.0;
+    // Exact lidar comparisons need the static world only; the camera has its own tests.
+    s.person.enabled = false;
+    s.camera.enabled = false;
     s
 }
 
@@ -47,6 +50,7 @@ fn counts_rates_order_and_frames() {
             SimMessage::Imu(_) => "imu_link",
             SimMessage::Fix(_) => "gps",
             SimMessage::StaticTransform(_) => "base_link",
+            SimMessage::Image(_) | SimMessage::CameraInfo(_) => "camera_optical",
         };
         assert_eq!(m.frame_id(), expected);
     }
@@ -61,13 +65,17 @@ fn counts_rates_order_and_frames() {
     assert_eq!(count("/scan"), ((d - s.lidar.sweep_time_s) * s.lidar.rate_hz).floor() as usize + 1);
     assert_eq!(count("/odom"), (d * s.odometry.rate_hz) as usize + 1);
     assert_eq!(count("/imu/data"), (d * s.imu.rate_hz) as usize + 1);
-    assert_eq!(count("/tf_static"), 3);
+    assert_eq!(count("/tf_static"), 4);
+    let frames = (d * s.camera.rate_hz) as usize + 1;
+    for topic in ["/camera/labels", "/camera/depth", "/camera/camera_info"] {
+        assert_eq!(count(topic), frames, "{topic}");
+    }
     // Silent dropouts: fewer fixes than 5 Hz over the whole run, exactly the missing ones.
     let fixes = count("/gnss/fix");
     let dropped: f64 = run.dropouts.iter().map(|(a, b)| secs(*b, *a)).sum();
     let expected = d * s.gnss.rate_hz + 1.0 - dropped * s.gnss.rate_hz;
     assert!((fixes as f64 - expected).abs() <= 1.0 + run.dropouts.len() as f64, "{fixes} vs {expected}");
-    for (topic, rate) in [("/scan", 10.0), ("/odom", 50.0), ("/imu/data", 100.0)] {
+    for (topic, rate) in [("/scan", 10.0), ("/odom", 50.0), ("/imu/data", 100.0), ("/camera/labels", 10.0)] {
         let st = &by_topic[topic];
         assert!(st.windows(2).all(|w| (secs(w[1], w[0]) - 1.0 / rate).abs() < 1e-6), "{topic} not periodic");
     }
@@ -507,4 +515,59 @@ fn the_failures_reach_a_map_built_from_true_poses() {
     assert!(fp_faulty > 5 * fp_clean.max(10), "{fp_faulty} vs {fp_clean}");
     // ...and glass that passes 60 % of the beams fades from the map.
     assert!(fence_faulty < fence_clean - 0.2, "{fence_faulty} vs {fence_clean}");
+}
+
+/// The walking person: in the scans and the label images on more than one meeting, and
+/// never in the truth.
+#[test]
+fn the_person_is_seen_by_lidar_and_camera_and_absent_from_the_truth() {
+    let run = default_run();
+    let s = Scenario::default();
+    assert!(run.lidar_stats.person_hits > 100, "{:?}", run.lidar_stats);
+    assert!(!run.person_track.is_empty() && run.person_radius_m == s.person.radius_m);
+    // Person pixels in the label images per presence window (plus salt noise, which
+    // gives every class about 1/600 of the pixels).
+    let start = Stamp(s.world.start_time_s * 1_000_000_000);
+    let mut per_window = vec![0usize; s.person.windows.len()];
+    let mut absent = 0usize;
+    let mut absent_frames = 0usize;
+    for m in &run.messages {
+        let SimMessage::Image(img) = m else { continue };
+        if img.topic != s.camera.label_topic {
+            continue;
+        }
+        let t = secs(img.stamp, start) - s.camera.time_offset_s;
+        let n = img.data.iter().filter(|&&l| u16::from(l) == CLASS_PERSON).count();
+        match s.person.windows.iter().position(|w| t >= w[0] && t <= w[1]) {
+            Some(k) => per_window[k] += n,
+            None => {
+                absent += n;
+                absent_frames += 1;
+            }
+        }
+    }
+    let pixels = (s.camera.width * s.camera.height) as f64;
+    let salt_per_frame = pixels * s.camera.label_noise_probability / 6.0;
+    eprintln!(
+        "person: {} lidar returns; label pixels per window {per_window:?}, {absent} in {absent_frames} frames without it",
+        run.lidar_stats.person_hits
+    );
+    assert!((absent as f64) < 1.5 * salt_per_frame * absent_frames as f64, "{absent}");
+    for (k, n) in per_window.iter().enumerate() {
+        let w = s.person.windows[k];
+        let salt = salt_per_frame * (w[1] - w[0]) * s.camera.rate_hz;
+        assert!(*n as f64 > salt + 2_000.0, "window {k}: {n} person pixels, salt alone gives {salt:.0}");
+    }
+    // The truth is that of the objects alone.
+    let g = GridGeometry::centered(0.05).unwrap();
+    let truth = run.truth_occupancy(g).unwrap();
+    for (stamp, p) in &run.person_track {
+        assert!(!truth.is_occupied(g.cell_of(*p).unwrap()), "the person at {p:?} ({stamp:?}) is in the truth");
+    }
+    let mut without = run.clone();
+    without.person_track.clear();
+    assert_eq!(without.truth_occupancy(g).unwrap(), truth);
+    // It leaves: the track stops before the end of the run.
+    let last = run.person_track.last().unwrap().0;
+    assert!(secs(*run.truth_trajectory.last().map(|(s, _)| s).unwrap(), last) > 30.0);
 }

@@ -78,7 +78,8 @@ pub enum Shape {
 pub struct WorldObject {
     /// A name for reports (`pillar_3`).
     pub name: String,
-    /// Semantic class a camera would report (`wall`, `fence`, `pillar`, `machine`).
+    /// Semantic class a camera would report, one of the class table's names (`wall`, `glass`,
+    /// `pillar`, `machine`; see [`super::camera::class_id`]).
     pub class: String,
     /// Surface material.
     pub material: Material,
@@ -220,7 +221,7 @@ pub fn production_hall_objects() -> Vec<WorldObject> {
         machine("machine_welder", Rect::new(17.0, 5.5, 24.0, 9.0)),
         obj(
             "glass_fence",
-            "fence",
+            "glass",
             Material::Glass,
             2.0,
             Shape::Segment { a: [5.0, 10.5], b: [25.0, 10.5], thickness_m: 0.02 },
@@ -307,6 +308,41 @@ impl Caster {
     }
 }
 
+/// One crossing of a ray with an object's outline edge, for renderers that need every
+/// surface along the ray (a low machine in front of a tall wall).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeHit {
+    /// Distance along the ray, metres.
+    pub range: f64,
+    /// Index of the object in the world's object list.
+    pub object: usize,
+    /// The edge's ends (its vertical face spans the object's height above it).
+    pub edge: (Point2, Point2),
+}
+
+impl Caster {
+    /// Every crossing of `origin + t·dir` (`dir` a unit vector) with an outline edge,
+    /// `0 < t ≤ max_range`, nearest first, appended to `out` (cleared first; a buffer the
+    /// caller reuses, so a renderer allocates nothing per ray).
+    pub fn cast_all(&self, origin: Point2, dir: (f64, f64), max_range: f64, out: &mut Vec<EdgeHit>) {
+        out.clear();
+        let inv = (1.0 / dir.0, 1.0 / dir.1);
+        for (k, o) in self.objects.iter().enumerate() {
+            if !ray_hits_box(origin, inv, &o.bbox, max_range) {
+                continue;
+            }
+            for &(a, b) in &o.edges {
+                if let Some(t) = ray_segment(origin, dir, a, b) {
+                    if t <= max_range {
+                        out.push(EdgeHit { range: t, object: k, edge: (a, b) });
+                    }
+                }
+            }
+        }
+        out.sort_by(|x, y| x.range.total_cmp(&y.range));
+    }
+}
+
 /// Slab test: does the ray meet the box `[x0, y0, x1, y1]` before `limit`?
 fn ray_hits_box(o: Point2, inv: (f64, f64), bb: &[f64; 4], limit: f64) -> bool {
     let (tx0, tx1) = ((bb[0] - o.x) * inv.0, (bb[2] - o.x) * inv.0);
@@ -355,6 +391,25 @@ mod tests {
         assert_eq!(w.material, Material::Wall);
         assert!((w.range - 2.9).abs() < 1e-9);
         assert!((w.normal.0.abs() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn cast_all_lists_every_surface_in_order() {
+        let objects = production_hall_objects();
+        let caster = Caster::new(&objects);
+        let mut hits = Vec::new();
+        // South from (10, 12.5): the fence's two faces, the press's two faces, the south wall's two.
+        caster.cast_all(Point2::new(10.0, 12.5), (0.0, -1.0), 100.0, &mut hits);
+        let names: Vec<&str> = hits.iter().map(|h| objects[h.object].name.as_str()).collect();
+        assert_eq!(
+            names,
+            ["glass_fence", "glass_fence", "machine_press", "machine_press", "wall_south", "wall_south"],
+            "{hits:?}"
+        );
+        assert!(hits.windows(2).all(|w| w[0].range <= w[1].range));
+        assert_eq!(hits[0].range, caster.cast(Point2::new(10.0, 12.5), (0.0, -1.0), &[]).unwrap().range);
+        caster.cast_all(Point2::new(10.0, 12.5), (0.0, -1.0), 3.0, &mut hits);
+        assert_eq!(hits.len(), 2, "the range limit drops the far faces");
     }
 
     #[test]
