@@ -10,7 +10,7 @@
 //! | time stamps, pose buffers and the pose-track trait | [`time`] |
 //! | grid geometry, log-odds, tiles, ray traversal | [`grid`] |
 //! | the measurement every sensor model produces | [`measurement`] |
-//! | sensor models (lidar inverse model) | [`sensor`] |
+//! | sensor models (lidar inverse model, semantic camera) | [`sensor`] |
 //! | the engine taking time-ordered measurements | [`fusion`] |
 //! | the `map → base_link` track from odometry, gyro, GNSS (EKF + RTS smoother) | [`estimator`] |
 //! | entropy, precision / recall | [`metrics`] |

@@ -25,7 +25,9 @@ pub enum SensorKind {
     /// A 2D range scanner ([`LidarModel`](crate::sensor::LidarModel)).
     #[default]
     Lidar,
-    /// A camera (its semantic model comes next; its range evidence uses [`RangeData`]).
+    /// A camera: label + depth frames become a
+    /// [`CameraObservation`](crate::sensor::CameraObservation) through its
+    /// [`CameraModel`](crate::sensor::CameraModel).
     Camera,
 }
 

@@ -5,9 +5,9 @@
 //! `base_from_sensor` is `base_from_camera_optical`, the optical frame of REP 103 (x right,
 //! y down, z forward).
 
-use crate::geometry::Mount3;
+use crate::geometry::{Mount3, Pose3};
 use crate::sensor::camera::optical_mount;
-use crate::sensor::{CameraError, CameraParams, ClassSpec, ClassTable};
+use crate::sensor::{CameraError, CameraModel, CameraParams, ClassSpec, ClassTable, Pinhole};
 use serde::{Deserialize, Serialize};
 
 use super::{err, finite, ConfigError, SensorConfig};
@@ -44,6 +44,20 @@ pub struct PlannedCamera {
     pub pair_tolerance_s: f64,
     /// `true`: written in the config (always: cameras are not auto-detected).
     pub explicit: bool,
+}
+
+impl PlannedCamera {
+    /// The mount as the camera model takes it: `base_from_optical`.
+    pub fn base_from_optical(&self) -> Pose3 {
+        let m = &self.mount;
+        Pose3::new([m.x, m.y, m.z], m.quaternion())
+    }
+
+    /// The camera's model, once its intrinsics are known (from the log's `CameraInfo`),
+    /// with the map's cell size and the plan's classes.
+    pub fn model(&self, pinhole: Pinhole, cell_size_m: f64, classes: ClassTable) -> Result<CameraModel, CameraError> {
+        CameraModel::new(pinhole, self.base_from_optical(), self.params, cell_size_m, classes)
+    }
 }
 
 /// The key a [`CameraParams`] field is written as in a `[[sensor]]` table.
@@ -211,6 +225,9 @@ mod tests {
         assert_eq!(cam.pair_tolerance_s, 0.01);
         assert_eq!(cam.time_offset_s, -0.03);
         assert!(cam.mount_given && cam.mount.z == 1.1 && cam.explicit);
+        let written = Mount3 { z: 1.1, roll: -2.0, yaw: -1.5, ..Default::default() };
+        assert!(cam.base_from_optical().angle_to(&Pose3::new([0.0; 3], written.quaternion())) < 1e-12);
+        assert_eq!(cam.base_from_optical().translation, [0.0, 0.0, 1.1]);
         // Defaults, and the default mount is a level forward optical frame.
         let p = camera(|_| {}).validate().unwrap();
         let cam = &p.cameras[0];
@@ -218,9 +235,11 @@ mod tests {
         assert_eq!(cam.params, CameraParams::default());
         assert_eq!(cam.pair_tolerance_s, DEFAULT_PAIR_TOLERANCE_S);
         assert!(!cam.mount_given);
-        let q = crate::geometry::Pose3::new([0.0; 3], cam.mount.quaternion());
-        let fwd = q.rotate([0.0, 0.0, 1.0]);
+        let fwd = cam.base_from_optical().rotate([0.0, 0.0, 1.0]);
         assert!((fwd[0] - 1.0).abs() < 1e-12, "{fwd:?}");
+        let pinhole = Pinhole::new(64, 48, 50.0, 50.0, 32.0, 24.0).unwrap();
+        let m = cam.model(pinhole, p.geometry.resolution(), p.classes.clone()).unwrap();
+        assert_eq!(m.params(), &cam.params);
         // Disabled: not planned; its kind is listed as disabled.
         let p = camera(|s| s.enabled = false).validate().unwrap();
         assert!(p.cameras.is_empty() && p.disabled_kinds == [SensorKind::Camera]);

@@ -1,6 +1,7 @@
-//! Sensor models: each turns one sensor's raw reading into the sensor-agnostic
-//! [`RangeData`](crate::measurement::RangeData) the grid consumes. The model, not the
-//! grid, holds the sensor's parameters, so one map can take many sensors.
+//! Sensor models: each turns one sensor's raw reading into evidence in the map frame —
+//! the lidar into the sensor-agnostic [`RangeData`](crate::measurement::RangeData), the
+//! semantic camera into a [`CameraObservation`] of class-labelled points. The model, not
+//! the grid, holds the sensor's parameters, so one map can take many sensors.
 
 pub mod camera;
 pub mod lidar;
