@@ -18,14 +18,20 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Map the design document's corridor (40 poses, 181 beams, 0.05 m) end to end.
+    /// The design document's scenario end to end: the production line simulated (built
+    /// in), mapped lidar-only, camera-only and fused, each scored against ground truth and
+    /// drawn side by side (DIR/comparison.png). --corridor: the document's §3.3 corridor.
     Demo {
         /// Output directory (created if needed).
         #[arg(long)]
         out: PathBuf,
-        /// A config file (TOML) instead of the built-in defaults.
+        /// A config file (TOML) instead of the built-in one (configs/production_line.toml,
+        /// or the defaults for --corridor).
         #[arg(long)]
         config: Option<PathBuf>,
+        /// Map the design document's corridor (40 poses, 181 beams, 0.05 m) instead.
+        #[arg(long)]
+        corridor: bool,
     },
     /// Map a robot log (CARMEN .log/.clf/.gz, ROS 1 .bag, .mcap, rosbag2 directory) or a
     /// simulated run of a world file.
@@ -90,7 +96,13 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Demo { out, config } => commands::map::demo(&out, config.as_deref()),
+        Command::Demo { out, config, corridor } => {
+            if corridor {
+                commands::demo::corridor(&out, config.as_deref())
+            } else {
+                commands::demo::production(&out, config.as_deref())
+            }
+        }
         Command::Map { config, world, out, log } => {
             commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out)
         }

@@ -226,16 +226,14 @@ impl MappedCamera {
         self.report.depths_unpaired += self.pending_depth.take().is_some() as u64;
     }
 
-    /// Decodes and inserts one frame taken at `stamp`.
+    /// Decodes and inserts one frame: its stamp, label image and depth image.
     pub(crate) fn insert(
         &mut self,
         engine: &mut Engine,
         track: &Track,
         mode: SyncMode,
         id: ObservationId,
-        stamp: Stamp,
-        label: &ImageMessage,
-        depth: &ImageMessage,
+        (stamp, label, depth): (Stamp, &ImageMessage, &ImageMessage),
     ) -> Result<(), PipelineError> {
         let Track::Timed(track) = track else {
             // Poses written on scan lines (CARMEN) cannot place a camera frame.

@@ -32,6 +32,7 @@ pub mod pose_sensors_report;
 pub mod recording;
 pub mod report;
 pub mod run;
+pub mod scenario;
 pub mod sensors;
 pub mod track;
 

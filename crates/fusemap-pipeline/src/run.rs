@@ -487,7 +487,7 @@ fn release(
             if let Some((t, label, depth)) = c.take(stream, key, image) {
                 let id = ObservationId(inserter.next_id);
                 inserter.next_id += 1;
-                c.insert(inserter.engine, inserter.track, inserter.mode, id, t, &label, &depth)?;
+                c.insert(inserter.engine, inserter.track, inserter.mode, id, (t, &label, &depth))?;
             }
             Ok(())
         }

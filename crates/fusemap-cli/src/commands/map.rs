@@ -8,7 +8,7 @@ use fusemap_core::config::{Config, Plan};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::grid::FusionGrid;
-use fusemap_core::sim::{ScannerSpec, SimulatedRun, World};
+use fusemap_core::sim::{ScannerSpec, World};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -47,29 +47,6 @@ pub fn run_simulated(
     }
     pb.finish_and_clear();
     finish(&engine, &files, "world", source, started, Vec::new(), None, None)
-}
-
-/// `fusemap demo --out DIR`: the design document's corridor with the default config.
-pub fn demo(out: &Path, config: Option<&Path>) -> Result<()> {
-    let cfg = match config {
-        Some(p) => fusemap_io::config_file::load_config(p)?,
-        None => Config::default(),
-    };
-    let plan = cfg.validate().map_err(|e| anyhow::anyhow!("configuration: {e}"))?;
-    let run = SimulatedRun::document_corridor();
-    let inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
-    let summary = run_simulated(
-        &plan,
-        &fusemap_core::sim::corridor(),
-        &ScannerSpec::document(),
-        run.poses,
-        out,
-        "built-in corridor (design document §3.3)",
-        &inputs,
-    )?;
-    summary.print();
-    println!("outputs       {}", out.display());
-    Ok(())
 }
 
 /// `fusemap map`: a world file (simulated) or a robot log.

@@ -143,6 +143,7 @@ impl FrameCells {
             if let Some(dy) = &dynamic {
                 if e.dynamic > 0.0 {
                     dy.apply(&mut tile.layers_mut().dynamic, offset, e.dynamic * dy.d_hit());
+                    stats.dynamic_updates += 1;
                 } else if e.floor.1 > 0 {
                     dy.clear(&mut tile.layers_mut().dynamic, offset);
                 }

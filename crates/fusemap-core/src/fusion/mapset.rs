@@ -187,7 +187,9 @@ impl MapSet {
         for m in std::iter::once(&mut self.primary).chain(&mut self.others) {
             if m.sensors.includes(data.sensor, kind) {
                 let mut v = FusedUpdate::new(*m.grid.table(), data.evidence, ctx.group, ctx.dynamic, ctx.route_hits);
-                let s = m.grid.insert_visited(&data.rays, &mut v);
+                let mut s = m.grid.insert_visited(&data.rays, &mut v);
+                s.routed_to_dynamic += v.routed;
+                s.dynamic_updates += v.routed;
                 m.stats.add(&s);
                 total.add(&s);
                 fed += 1;

@@ -16,7 +16,7 @@ use crate::measurement::Evidence;
 ///
 /// With neither a group nor a dynamic layer the update is the plain occupancy update,
 /// branch-free, bit for bit [`OccupancyUpdate`](super::OccupancyUpdate)'s.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct FusedUpdate {
     table: LogOddsTable,
     d_hit: f32,
@@ -25,6 +25,8 @@ pub struct FusedUpdate {
     dynamic: Option<DynamicUpdate>,
     route_hits: bool,
     plain: bool,
+    /// Hits routed to the dynamic layer so far.
+    pub routed: u64,
 }
 
 impl FusedUpdate {
@@ -44,6 +46,7 @@ impl FusedUpdate {
             dynamic,
             route_hits,
             plain: group.is_none() && dynamic.is_none(),
+            routed: 0,
         }
     }
 
@@ -79,6 +82,7 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
         if let Some(dy) = &self.dynamic {
             if self.route_hits && dy.is_dynamic(tile.layers().dynamic(), offset) {
                 dy.apply(&mut tile.layers_mut().dynamic, offset, dy.d_hit());
+                self.routed += 1;
                 return;
             }
         }

@@ -85,6 +85,11 @@ pub struct InsertStats {
     pub hit_updates: u64,
     /// Cells updated as free (once per observation).
     pub miss_updates: u64,
+    /// Cells whose dynamic layer took evidence of a moving object (a camera's dynamic
+    /// class, or a lidar hit routed there).
+    pub dynamic_updates: u64,
+    /// Of those, lidar hits routed from the static layer to the dynamic one.
+    pub routed_to_dynamic: u64,
 }
 
 impl InsertStats {
@@ -95,6 +100,8 @@ impl InsertStats {
         self.cell_visits += o.cell_visits;
         self.hit_updates += o.hit_updates;
         self.miss_updates += o.miss_updates;
+        self.dynamic_updates += o.dynamic_updates;
+        self.routed_to_dynamic += o.routed_to_dynamic;
     }
 }
 

@@ -1,0 +1,131 @@
+//! The design document's scenario (its opening picture and §2.4): the production line
+//! with a lidar that sees through glass and bounces off steel, a camera that takes a
+//! backlit floor for a wall, and a person walking through, mapped lidar-only, camera-only
+//! and fused in one pass with poses from the estimator (odometry + IMU + RTK, no true
+//! poses) and scored against the simulator's ground truth.
+
+use fusemap_core::grid::Ternary;
+use fusemap_core::sim::production::{simulate, Scenario, SimRecording};
+use fusemap_core::time::Stamp;
+use fusemap_pipeline::recording::Inventory;
+use fusemap_pipeline::run::prepare;
+use fusemap_pipeline::scenario::{production_line_plan, score, three_maps, MapScore, Truth};
+use fusemap_pipeline::{map_with_track, MapRun};
+use std::sync::OnceLock;
+
+struct Fixture {
+    rec: SimRecording,
+    run: MapRun,
+    scores: Vec<MapScore>,
+}
+
+fn map(bag: &std::path::Path, plan: &fusemap_core::config::Plan, maps: fusemap_core::fusion::MapSet) -> MapRun {
+    let inv = Inventory::read(bag).expect("the bag reads back");
+    let (bound, chosen, track_s) = prepare(plan, &inv).expect("the sensors bind");
+    map_with_track(plan, &inv, &bound, chosen, track_s, Some(maps), &mut |_| {}).expect("the bag maps")
+}
+
+fn scores_of(rec: &SimRecording, run: &MapRun, plan: &fusemap_core::config::Plan) -> Vec<MapScore> {
+    let occupancy = rec.truth_occupancy(plan.geometry).unwrap();
+    let semantic = rec.truth_semantic(plan.geometry).unwrap();
+    let truth = Truth {
+        occupancy: &occupancy,
+        semantic: &semantic,
+        person: &rec.person_track,
+        person_radius_m: rec.person_radius_m,
+    };
+    run.engine.maps().iter().map(|m| score(m.name(), m.grid(), &plan.classes, &truth)).collect()
+}
+
+/// The default production line, mapped once with the three maps.
+fn fixture() -> &'static Fixture {
+    static F: OnceLock<Fixture> = OnceLock::new();
+    F.get_or_init(|| {
+        let rec = simulate(&Scenario::default()).expect("the default scenario simulates");
+        let bag = fusemap_io::testdata::temp_dir("camera-scenario").join("bag");
+        fusemap_io::simulation::write_bag(&rec, &bag, true).expect("the bag is written");
+        let plan = production_line_plan().unwrap();
+        let run = map(&bag, &plan, three_maps(&plan));
+        let scores = scores_of(&rec, &run, &plan);
+        for s in &scores {
+            eprintln!("{}", serde_json::to_string(s).unwrap());
+        }
+        Fixture { rec, run, scores }
+    })
+}
+
+fn by_name<'a>(f: &'a Fixture, name: &str) -> &'a MapScore {
+    f.scores.iter().find(|s| s.name == name).unwrap()
+}
+
+#[test]
+fn fusion_beats_each_sensor_alone() {
+    let f = fixture();
+    let (fused, lidar, camera) = (by_name(f, "fused"), by_name(f, "lidar"), by_name(f, "camera"));
+    assert!(
+        fused.occupied.f1 > lidar.occupied.f1 && fused.occupied.f1 > camera.occupied.f1,
+        "F1 fused {:.3}, lidar {:.3}, camera {:.3}",
+        fused.occupied.f1,
+        lidar.occupied.f1,
+        camera.occupied.f1
+    );
+    let cam = &f.run.report.cameras[0];
+    assert_eq!(cam.frames_used, cam.frames_paired);
+    assert!(cam.frames_used > 1500, "{cam:?}");
+    assert!(f.run.report.correlated_merged > 1500, "{}", f.run.report.correlated_merged);
+}
+
+#[test]
+fn the_glass_fence_stands_and_the_backlit_shadow_does_not() {
+    let f = fixture();
+    let fused = by_name(f, "fused");
+    assert!(fused.glass_occupied_share >= 0.9, "glass fence occupied along {:.3}", fused.glass_occupied_share);
+    assert!(!f.rec.camera_truth.backlit_floor_points.is_empty(), "the scenario has a backlit shadow");
+    assert_eq!(fused.backlit_occupied_cells, 0);
+}
+
+#[test]
+fn the_semantic_layer_knows_walls_glass_and_pillars() {
+    let f = fixture();
+    let fused = by_name(f, "fused");
+    let plan = production_line_plan().unwrap();
+    for class in ["wall", "glass", "pillar"] {
+        let a = fused.semantic_of(&plan.classes, class).unwrap_or(0.0);
+        assert!(a >= 0.85, "semantic accuracy of {class}: {a:.3} ({:?})", fused.semantic);
+    }
+}
+
+#[test]
+fn the_person_stays_out_of_the_static_map_and_its_trail_decays() {
+    let f = fixture();
+    assert_eq!(by_name(f, "fused").person_static_cells, 0);
+    let fused = f.run.engine.maps().by_name("fused").unwrap().grid();
+    let p = f.run.engine.dynamic_params().copied().unwrap();
+    // While the person walks, the dynamic layer holds it; two half-lives after it leaves,
+    // its trail is below the occupied threshold everywhere.
+    let g = fused.geometry();
+    let left = f.rec.person_track.last().unwrap().0;
+    let area = fused.known_box().unwrap();
+    let later = Stamp(left.0 + (2.0 * p.half_life_s * 1e9) as i64);
+    let layer = fusemap_core::fusion::rasters::dynamic_cells(fused, area, later, p.half_life_s);
+    for &(_, pos) in &f.rec.person_track {
+        let Some(c) = g.cell_of(pos) else { continue };
+        if !area.contains(c) {
+            continue;
+        }
+        let i = ((c.y - area.min.y) as usize) * layer.width + (c.x - area.min.x) as usize;
+        assert!(
+            layer.cells[i] < p.occupied_threshold as f32,
+            "cell {c:?} at {:.3} two half-lives after",
+            layer.cells[i]
+        );
+    }
+    let stats = f.run.engine.maps().by_name("fused").unwrap().stats();
+    eprintln!(
+        "person pixels {}, dynamic updates {}, lidar hits routed {}",
+        f.rec.camera_truth.person_pixels, stats.dynamic_updates, stats.routed_to_dynamic
+    );
+    assert!(stats.dynamic_updates > 100, "the dynamic layer took the person: {stats:?}");
+    assert!(stats.routed_to_dynamic > 0, "lidar hits on the person went to the dynamic layer: {stats:?}");
+    assert_ne!(fused.ternary(g.cell_of(f.rec.person_track[0].1).unwrap()), Ternary::Occupied);
+}
