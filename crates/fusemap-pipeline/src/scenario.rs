@@ -63,6 +63,13 @@ pub struct MapScore {
     pub occupied: TolerantScore,
     /// Semantic accuracy per class id, 1-cell tolerance.
     pub semantic: SemanticAccuracy,
+    /// The same without tolerance: the class must be right in the true cell itself.
+    pub semantic_strict: SemanticAccuracy,
+    /// Every cell of the hall with semantic evidence, free ones included (their true class
+    /// is the floor), no tolerance: `held` cells with evidence, `matched` whose most likely
+    /// class is the true one. A misplaced label (a wall class on the floor in front of the
+    /// wall) counts against it.
+    pub semantic_all_cells: fusemap_core::metrics::ClassAccuracy,
     /// Share of the glass fence's cells with an occupied map cell within one cell.
     pub glass_occupied_share: f64,
     /// Cells under the backlit shadow (floor the camera mislabelled) that the map holds
@@ -97,6 +104,15 @@ pub fn score(name: &str, grid: &FusionGrid, classes: &ClassTable, truth: &Truth)
     let occupied_score = TolerantScore::new(&occupied, &truth_cells, 1);
 
     let mut predicted: HashMap<CellIndex, u16> = HashMap::new();
+    let mut all_cells = fusemap_core::metrics::ClassAccuracy::default();
+    let floor = classes.index_by_name("floor").map(|i| classes.get(i).id);
+    let t = truth.occupancy;
+    let inside = |c: CellIndex| {
+        c.x >= t.first_cell.x
+            && c.y >= t.first_cell.y
+            && c.x < t.first_cell.x + t.width as i64
+            && c.y < t.first_cell.y + t.height as i64
+    };
     if let Some(b) = grid.known_box() {
         let s = semantic_cells(grid, b, classes);
         for (i, &best) in s.best.cells.iter().enumerate() {
@@ -104,14 +120,28 @@ pub fn score(name: &str, grid: &FusionGrid, classes: &ClassTable, truth: &Truth)
                 s.best.first_cell.x + (i % s.best.width) as i64,
                 s.best.first_cell.y + (i / s.best.width) as i64,
             );
-            if best >= 0 && occupied.contains(&c) {
-                predicted.insert(c, classes.get(best as u8).id);
+            if best < 0 {
+                continue;
+            }
+            let id = classes.get(best as u8).id;
+            if occupied.contains(&c) {
+                predicted.insert(c, id);
+            }
+            if inside(c) {
+                let true_id = match truth.semantic.class_at(c) {
+                    0 => floor,
+                    k => Some(k as u16),
+                };
+                all_cells.truth += 1;
+                all_cells.held += 1;
+                all_cells.matched += (Some(id) == true_id) as usize;
             }
         }
     }
     let truth_classes: HashMap<CellIndex, u16> =
         truth_cells.iter().map(|&c| (c, truth.semantic.class_at(c) as u16)).filter(|(_, k)| *k != 0).collect();
     let semantic = SemanticAccuracy::new(&predicted, &truth_classes, 1);
+    let semantic_strict = SemanticAccuracy::new(&predicted, &truth_classes, 0);
 
     let glass = &truth.semantic.glass_cells;
     let glass_hit = glass.iter().filter(|&&c| neighbours(c, 1).any(|n| occupied.contains(&n))).count();
@@ -137,6 +167,8 @@ pub fn score(name: &str, grid: &FusionGrid, classes: &ClassTable, truth: &Truth)
         name: name.to_string(),
         occupied: occupied_score,
         semantic,
+        semantic_strict,
+        semantic_all_cells: all_cells,
         glass_occupied_share: if glass.is_empty() { 0.0 } else { glass_hit as f64 / glass.len() as f64 },
         backlit_occupied_cells,
         pillar_body_free_share: free_share(&truth.semantic.pillar_body_cells),
