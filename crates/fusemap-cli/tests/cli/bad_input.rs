@@ -43,7 +43,7 @@ fn config_error(name: &str, text: &str) -> (String, String) {
     let dir = temp_dir(&format!("config-{name}"));
     let config = write_file(&dir, "robot.toml", text);
     let out = dir.join("out");
-    let line = one_line_error(&run(&["demo", "--config", path_str(&config), "--out", path_str(&out)]));
+    let line = one_line_error(&run(&["demo", "--corridor", "--config", path_str(&config), "--out", path_str(&out)]));
     let config = path_str(&config).to_string();
     assert!(line.contains(&config), "the error does not name the config file: {line}");
     assert_no_map(&out);
@@ -125,7 +125,7 @@ fn config_missing_file_names_the_path() {
     let config = dir.join("no-such-config.toml");
     let out = dir.join("out");
     for args in [
-        vec!["demo", "--config", path_str(&config), "--out", path_str(&out)],
+        vec!["demo", "--corridor", "--config", path_str(&config), "--out", path_str(&out)],
         vec!["map", "--config", path_str(&config), "--out", path_str(&out), "--world", "unused.toml"],
     ] {
         let line = one_line_error(&run(&args));

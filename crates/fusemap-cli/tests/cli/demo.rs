@@ -15,7 +15,7 @@ use std::process::Output;
 /// Runs `fusemap demo --out <temp>/out` and returns the output directory and the run.
 fn demo(name: &str) -> (PathBuf, Output) {
     let out = temp_dir(name).join("out");
-    let o = run(&["demo", "--out", path_str(&out)]);
+    let o = run(&["demo", "--corridor", "--out", path_str(&out)]);
     assert_success(&o);
     (out, o)
 }
@@ -607,7 +607,7 @@ fn outputs_never_overwrite_inputs() {
         ["map", "--out", path_str(out), path_str(&spelled)].map(String::from).to_vec()
     };
     let config_case = |input: &Path, out: &Path| {
-        ["demo", "--config", path_str(input), "--out", path_str(out)].map(String::from).to_vec()
+        ["demo", "--corridor", "--config", path_str(input), "--out", path_str(out)].map(String::from).to_vec()
     };
     let cases: [Case; 3] = [
         ("summary.json", &world_bytes, &world_case),

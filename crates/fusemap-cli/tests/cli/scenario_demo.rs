@@ -1,0 +1,77 @@
+//! `fusemap demo`: the design document's scenario through the real binary — the
+//! production line simulated, mapped lidar-only, camera-only and fused, scored and drawn —
+//! checked on the files a user gets.
+
+use crate::util::{assert_success, python_with, read_json, run, run_python, stdout, temp_dir};
+
+const NUMPY_SCRIPT: &str = r#"
+import json, sys
+import numpy as np
+z = np.load(sys.argv[1])
+names = [str(n) for n in z["semantic_class_names"]]
+cls = z["semantic_class"]
+print(json.dumps({
+    "shape": list(z["occupancy"].shape),
+    "class_shape": list(cls.shape),
+    "class_dtype": str(cls.dtype),
+    "probs_shape": list(z["semantic_probs"].shape),
+    "names": names,
+    "dynamic_shape": list(z["dynamic"].shape),
+    "wall_cells": int((cls == names.index("wall")).sum()),
+}))
+"#;
+
+#[test]
+fn the_scenario_demo_writes_three_scored_maps_and_their_layers() {
+    let out = temp_dir("scenario-demo").join("out");
+    let o = run(&["demo", "--out", out.to_str().unwrap()]);
+    assert_success(&o);
+    for f in [
+        "map.npz",
+        "map.pgm",
+        "map.yaml",
+        "map.png",
+        "semantic.png",
+        "semantic.yaml",
+        "dynamic.png",
+        "summary.json",
+        "trajectory.tum",
+        "comparison.png",
+        "lidar/map.png",
+        "camera/map.png",
+        "camera/semantic.yaml",
+        "sim/truth.yaml",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    assert!(out.join("sim/bag/metadata.yaml").is_file());
+    assert!(!out.join("lidar/semantic.yaml").exists(), "a lidar-only map has no semantic layer");
+    let text = stdout(&o);
+    assert!(text.contains("fused") && text.contains("comparison"), "{text}");
+
+    let summary = read_json(&out.join("summary.json"));
+    let scores = summary["log"]["scenario_scores"].as_array().unwrap();
+    let f1 = |name: &str| scores.iter().find(|s| s["name"] == name).unwrap()["occupied"]["f1"].as_f64().unwrap();
+    assert!(f1("fused") > f1("lidar") && f1("fused") > f1("camera"), "{scores:?}");
+    assert!(summary["log"]["cameras"][0]["frames_used"].as_u64().unwrap() > 1000);
+
+    let yaml = std::fs::read_to_string(out.join("semantic.yaml")).unwrap();
+    assert!(yaml.contains("image: semantic.png") && yaml.contains("name: wall"), "{yaml}");
+
+    let png = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(out.join("comparison.png")).unwrap()));
+    let info = png.read_info().unwrap();
+    let (w, h) = (info.info().width, info.info().height);
+    assert!(w > 4 * h, "five panels side by side: {w} x {h}");
+
+    if python_with(&["numpy"]) {
+        let npz = out.join("map.npz");
+        let js: serde_json::Value =
+            serde_json::from_str(&run_python(NUMPY_SCRIPT, &[npz.as_os_str()])).expect("the script prints JSON");
+        assert_eq!(js["class_shape"], js["shape"]);
+        assert_eq!(js["dynamic_shape"], js["shape"]);
+        assert_eq!(js["class_dtype"], "int16");
+        assert_eq!(js["probs_shape"][2], 8);
+        assert!(js["wall_cells"].as_u64().unwrap() > 1000, "{js}");
+    }
+    std::fs::remove_dir_all(out.parent().unwrap()).unwrap();
+}
