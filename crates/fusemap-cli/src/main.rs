@@ -74,9 +74,11 @@ enum Command {
         overwrite: bool,
     },
     /// Insertion throughput on fixed synthetic workloads (a: corridor, b: corridor x500,
-    /// c: 39 m box with 1,081-beam scans).
+    /// c: 39 m box with 1,081-beam scans, d and e: 640 x 480 camera frames projected and
+    /// fused at stride 4 and 1).
     Bench {
-        /// Run one workload in this process (a, b or c); default: each in a child process.
+        /// Run one workload in this process (a, b, c, d or e); default: each in a child
+        /// process.
         #[arg(long)]
         workload: Option<char>,
         /// Insert the scans of a SCAN2D01 scan file instead (the baselines' format), on

@@ -70,10 +70,44 @@ impl BenchRow {
     }
 }
 
+/// The camera workloads: a 640 × 480 label + depth pair of a box room, projected and
+/// fused at stride 4 (`d`) and 1 (`e`), 200 frames from poses walking and turning.
+pub const CAMERA_WORKLOADS: [char; 2] = ['d', 'e'];
+
+/// Runs camera workload `name` (`d`: stride 4, `e`: stride 1). Beams are pixels looked at.
+pub fn run_camera(name: char) -> Result<BenchRow> {
+    use fusemap_core::sensor::camera::{optical_mount, CameraModel, CameraParams, ClassTable, Pinhole};
+    let stride = if name == 'd' { 4 } else { 1 };
+    let t0 = Instant::now();
+    let pinhole = Pinhole { width: 640, height: 480, fx: 457.0, fy: 457.0, cx: 319.5, cy: 239.5 };
+    let mount = optical_mount([0.25, 0.0, 1.0], 0.0, 25f64.to_radians());
+    let params = CameraParams { stride, ..Default::default() };
+    let model = CameraModel::new(pinhole, mount, params, 0.05, ClassTable::production_default())?;
+    let (labels, depth) = fusemap_core::sim::camera_frame::room_frame(&model, 4.0, 3.0);
+    let simulate_s = t0.elapsed().as_secs_f64();
+    let mut engine = Engine::new(FusionGrid::new(GridGeometry::centered(0.05)?, OccupancyParams::default()));
+    let camera = engine.add_camera("camera", model);
+    engine.set_dynamic(fusemap_core::grid::DynamicParams::default(), true);
+    let frames = 200;
+    let t1 = Instant::now();
+    for k in 0..frames {
+        let pose = fusemap_core::geometry::Pose2::new(0.01 * k as f64, 0.0, 0.02 * k as f64);
+        let stamp = fusemap_core::time::Stamp(k as i64 * 33_000_000);
+        engine.insert_camera_frame(camera, None, stamp, &labels, &depth, pose)?;
+    }
+    let insert_s = t1.elapsed().as_secs_f64();
+    let pixels = engine.sensor_stats().map(|s| s.pixels.seen).sum();
+    let description = format!("{frames} camera frames 640 x 480 label + depth, stride {stride} (beams = pixels)");
+    Ok(BenchRow::new(name.to_string(), description, &engine, pixels, simulate_s, insert_s))
+}
+
 /// Runs workload `name` in this process.
 pub fn run_one(name: char) -> Result<BenchRow> {
+    if CAMERA_WORKLOADS.contains(&name) {
+        return run_camera(name);
+    }
     let t0 = Instant::now();
-    let Some(w) = workload(name) else { bail!("unknown workload `{name}` (expected a, b or c)") };
+    let Some(w) = workload(name) else { bail!("unknown workload `{name}` (expected a, b, c, d or e)") };
     let simulate_s = t0.elapsed().as_secs_f64();
     let grid = FusionGrid::new(GridGeometry::centered(w.resolution)?, OccupancyParams::default());
     let mut engine = Engine::new(grid);
@@ -149,7 +183,7 @@ pub fn run(
         (None, None) => {
             let exe = std::env::current_exe().context("cannot find the fusemap executable to run workloads")?;
             let mut rows = Vec::new();
-            for w in WORKLOADS {
+            for w in WORKLOADS.into_iter().chain(CAMERA_WORKLOADS) {
                 let out = std::process::Command::new(&exe)
                     .args(["bench", "--json", "--workload", &w.to_string()])
                     .output()

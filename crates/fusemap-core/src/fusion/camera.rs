@@ -14,7 +14,7 @@
 //! * **dynamic**: pixels of a dynamic class there write the dynamic layer (never the static
 //!   occupancy); floor seen there clears it.
 //!
-//! Then the cells between the camera and each cell that received a pixel get the
+//! Then the cells between the camera and each cell that received an obstacle pixel get the
 //! camera's weak free evidence once (§3.4: the camera's free-space evidence is poor),
 //! except cells that received pixels themselves.
 
@@ -102,9 +102,16 @@ impl FrameCells {
             }
             self.cells.push(e);
         }
+        // Free evidence along the rays to the obstacle points only: the floor between the
+        // camera and a floor point is seen by the floor pixels themselves (the rows below),
+        // and a ray to an obstacle crosses the floor cells a stride skips.
         let origin = obs.origin;
         self.rays.clear();
-        self.rays.extend(self.cells.iter().map(|e| Ray { origin, end: g.cell_center(e.cell), hit: false }));
+        self.rays.extend(self.cells.iter().filter(|e| e.obstacle.1 > 0 || e.dynamic > 0.0).map(|e| Ray {
+            origin,
+            end: g.cell_center(e.cell),
+            hit: false,
+        }));
     }
 
     /// Writes the frame into `grid` as observation number `obs` (begun by the caller).

@@ -1,6 +1,7 @@
 //! Simulated worlds and scanners: the design document's corridor (§3.1) and the larger
 //! worlds benchmarks and tests need, with exact ground truth.
 
+pub mod camera_frame;
 pub mod production;
 mod rng;
 mod scanner;
