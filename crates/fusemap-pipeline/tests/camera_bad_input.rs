@@ -1,0 +1,143 @@
+//! A camera's bad input in a real bag: images of the wrong size, unknown class ids, depth
+//! holes, an unsupported encoding, frames without a pose, a missing or late CameraInfo,
+//! a distorted one. Each is a counted skip or one clear error, never a panic.
+
+use fusemap_core::sim::production::{simulate, Scenario, SimMessage, SimRecording};
+use fusemap_core::time::Stamp;
+use fusemap_pipeline::camera::CameraReport;
+use fusemap_pipeline::recording::Inventory;
+use fusemap_pipeline::run::map_inventory;
+use fusemap_pipeline::scenario::production_line_plan;
+use fusemap_pipeline::PipelineError;
+
+fn short() -> SimRecording {
+    let mut s = Scenario::default();
+    s.robot.duration_s = 12.0;
+    s.person.enabled = false;
+    simulate(&s).unwrap()
+}
+
+fn run(name: &str, rec: &SimRecording) -> Result<fusemap_pipeline::MapRun, PipelineError> {
+    let bag = fusemap_io::testdata::temp_dir(name).join("bag");
+    fusemap_io::simulation::write_bag(rec, &bag, true).unwrap();
+    let inv = Inventory::read(&bag).unwrap();
+    map_inventory(&production_line_plan().unwrap(), &inv, &mut |_| {})
+}
+
+fn camera(run: &fusemap_pipeline::MapRun) -> &CameraReport {
+    &run.report.cameras[0]
+}
+
+/// Applies `f` to every `k`-th image of `topic`.
+fn every(
+    rec: &mut SimRecording,
+    topic: &str,
+    k: usize,
+    mut f: impl FnMut(&mut fusemap_core::sim::production::SimImage),
+) -> usize {
+    let mut n = 0;
+    for m in rec.messages.iter_mut() {
+        if let SimMessage::Image(i) = m {
+            if i.topic == topic {
+                if n % k == 0 {
+                    f(i);
+                }
+                n += 1;
+            }
+        }
+    }
+    n.div_ceil(k)
+}
+
+#[test]
+fn a_clean_short_run_uses_every_frame() {
+    let rec = short();
+    let r = run("camera-clean", &rec).unwrap();
+    let c = camera(&r);
+    assert_eq!(c.frames_used, c.labels_read);
+    assert_eq!((c.undecodable, c.frames_refused, c.labels_unpaired, c.depths_unpaired), (0, 0, 0, 0));
+    assert_eq!(c.pixels.unknown_class, 0);
+}
+
+#[test]
+fn bad_images_are_counted_and_skipped() {
+    let mut rec = short();
+    // Every 10th label image is half the size of its depth image.
+    let resized = every(&mut rec, "/camera/labels", 10, |i| {
+        i.width /= 2;
+        i.height /= 2;
+        i.step = i.width;
+        i.data.truncate((i.width * i.height) as usize);
+    });
+    // Every 7th label image carries an unknown class id (200) in its first row.
+    every(&mut rec, "/camera/labels", 7, |i| i.data[..i.width as usize].fill(200));
+    // Every 5th depth image has NaN, 0 and negative depths in its last rows.
+    every(&mut rec, "/camera/depth", 5, |i| {
+        let n = i.data.len();
+        for (k, px) in i.data[n - 3 * i.step as usize..].chunks_exact_mut(4).enumerate() {
+            px.copy_from_slice(&[f32::NAN, 0.0, -1.0][k % 3].to_le_bytes());
+        }
+    });
+    // Every 13th depth image claims an encoding we do not read.
+    let rgb = every(&mut rec, "/camera/depth", 13, |i| i.encoding = "rgb8".into());
+    let r = run("camera-bad-images", &rec).unwrap();
+    let c = camera(&r);
+    assert!(c.frames_refused >= resized as u64 - 1, "{c:?}");
+    assert!(c.refused_example.as_deref().unwrap_or("").contains("size"), "{c:?}");
+    assert_eq!(c.undecodable, rgb as u64, "{c:?}");
+    assert!(c.undecodable_example.as_deref().unwrap().contains("rgb8"), "{c:?}");
+    assert!(c.pixels.unknown_class > 0 && c.pixels.no_depth > 0, "{:?}", c.pixels);
+    assert!(c.frames_used > 0 && c.frames_used < c.labels_read);
+}
+
+#[test]
+fn frames_without_a_pose_are_counted() {
+    let mut rec = short();
+    let last = rec.messages.iter().map(|m| m.stamp()).max().unwrap();
+    // The last three label and depth images are stamped a minute after the log ends.
+    for topic in ["/camera/labels", "/camera/depth"] {
+        let mut imgs: Vec<&mut fusemap_core::sim::production::SimImage> = rec
+            .messages
+            .iter_mut()
+            .filter_map(|m| match m {
+                SimMessage::Image(i) if i.topic == topic => Some(i),
+                _ => None,
+            })
+            .collect();
+        let n = imgs.len();
+        for (k, i) in imgs[n - 3..].iter_mut().enumerate() {
+            i.stamp = Stamp(last.0 + 60_000_000_000 + k as i64 * 100_000_000);
+        }
+    }
+    rec.messages.sort_by_key(|m| m.stamp());
+    let r = run("camera-no-pose", &rec).unwrap();
+    assert_eq!(camera(&r).frames_skipped.after_last_pose, 3, "{:?}", camera(&r));
+}
+
+#[test]
+fn a_missing_or_distorted_camera_info_is_one_clear_error() {
+    let mut rec = short();
+    rec.messages.retain(|m| !matches!(m, SimMessage::CameraInfo(_)));
+    let e = run("camera-no-info", &rec).err().expect("refused").to_string();
+    assert!(e.contains("/camera/camera_info") && e.contains("camera info"), "{e}");
+
+    let mut rec = short();
+    for m in rec.messages.iter_mut() {
+        if let SimMessage::CameraInfo(i) = m {
+            i.d = vec![0.1, 0.0, 0.0, 0.0, 0.0];
+        }
+    }
+    let e = run("camera-distorted", &rec).err().expect("refused").to_string();
+    assert!(e.contains("rectified") && e.contains("plumb_bob"), "{e}");
+}
+
+#[test]
+fn a_late_camera_info_is_noted_and_used() {
+    let mut rec = short();
+    // Only camera-info messages after the first five seconds survive.
+    let start = rec.messages.iter().map(|m| m.stamp()).min().unwrap();
+    rec.messages.retain(|m| !matches!(m, SimMessage::CameraInfo(i) if i.stamp.0 < start.0 + 5_000_000_000));
+    let r = run("camera-late-info", &rec).unwrap();
+    assert!(r.notes.iter().any(|n| n.contains("after the first image")), "{:?}", r.notes);
+    assert_eq!(camera(&r).frames_used, camera(&r).labels_read);
+}
