@@ -16,7 +16,7 @@ use crate::report::{LidarReport, LogReport, Skipped};
 use crate::sensors::{bind, Bound};
 use crate::track::{choose, count_reordered, ChosenTrack, Track};
 use crate::PipelineError;
-use fusemap_core::config::{LogConfig, Plan, SensorKind, SyncConfig};
+use fusemap_core::config::{default_camera, LogConfig, Plan, PlannedCamera, SensorKind, SyncConfig};
 use fusemap_core::fusion::{Correlation, Engine, MapSet};
 use fusemap_core::geometry::{PlanarMount, Pose2};
 use fusemap_core::grid::FusionGrid;
@@ -118,6 +118,26 @@ pub fn sync_mode(cfg: &LogConfig, stamps: &[Stamp]) -> SyncMode {
 /// The timing limits of the config.
 pub fn limits(cfg: &LogConfig) -> TimingLimits {
     TimingLimits { gap_s: cfg.max_pose_gap_s, far_delay_s: cfg.far_delay_s }
+}
+
+/// The cameras to map: the configured ones, else a default camera when the log carries
+/// the usual camera topics (and the camera kind is not disabled).
+fn planned_cameras(plan: &Plan, inv: &Inventory, notes: &mut Vec<String>) -> Result<Vec<PlannedCamera>, PipelineError> {
+    if !plan.cameras.is_empty() || plan.disabled_kinds.contains(&SensorKind::Camera) {
+        return Ok(plan.cameras.clone());
+    }
+    let c = default_camera(plan.occupancy.prior).map_err(|e| PipelineError::Refused(e.to_string()))?;
+    let present = inv.images.contains_key(&c.topic)
+        && inv.images.contains_key(&c.depth_topic)
+        && inv.camera_info.contains_key(&c.info_topic);
+    if !present {
+        return Ok(Vec::new());
+    }
+    notes.push(format!(
+        "camera found on `{}`, `{}` and `{}` and mapped with the default camera parameters (list it as a [[sensor]] of kind \"camera\" to change them, or disable it)",
+        c.topic, c.depth_topic, c.info_topic
+    ));
+    Ok(vec![c])
 }
 
 /// One lidar as the second pass uses it.
@@ -241,7 +261,8 @@ pub fn map_with_track(
     }
 
     let mut cameras: Vec<MappedCamera> = Vec::new();
-    for c in &plan.cameras {
+    let planned = planned_cameras(plan, inv, &mut notes)?;
+    for c in &planned {
         let (model, report) = build_camera(c, &plan.classes, plan.geometry.resolution(), inv, &tree, cfg, &mut notes)?;
         let id = engine.add_camera(c.name.clone(), model);
         let label_stream = merge.add_stream(c.topic.clone());
@@ -285,8 +306,7 @@ pub fn map_with_track(
     // order (file order for poses on the scan lines, which do not depend on the stamps:
     // some corrected CARMEN logs have broken or all-zero stamps).
     let topics: Vec<String> = bound.lidars.iter().map(|b| b.topic.clone()).collect();
-    let image_topics: Vec<String> =
-        plan.cameras.iter().flat_map(|c| [c.topic.clone(), c.depth_topic.clone()]).collect();
+    let image_topics: Vec<String> = planned.iter().flat_map(|c| [c.topic.clone(), c.depth_topic.clone()]).collect();
     let total: u64 = lidars.iter().map(|l| l.report.scans_read).sum::<u64>()
         + image_topics.iter().map(|t| inv.images.get(t).map_or(0, |i| i.stamps.len() as u64)).sum::<u64>();
     progress(Progress::Phase { name: "mapping", total });
@@ -411,7 +431,7 @@ pub fn map_with_track(
                 r.name,
                 r.labels_unpaired,
                 r.depths_unpaired,
-                plan.cameras.iter().find(|c| c.name == r.name).map_or(0.0, |c| c.pair_tolerance_s)
+                planned.iter().find(|c| c.name == r.name).map_or(0.0, |c| c.pair_tolerance_s)
             ));
         }
     }

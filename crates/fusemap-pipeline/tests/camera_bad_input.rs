@@ -141,3 +141,23 @@ fn a_late_camera_info_is_noted_and_used() {
     assert!(r.notes.iter().any(|n| n.contains("after the first image")), "{:?}", r.notes);
     assert_eq!(camera(&r).frames_used, camera(&r).labels_read);
 }
+
+#[test]
+fn a_camera_on_the_usual_topics_is_found_and_can_be_switched_off() {
+    use fusemap_core::config::{Config, SensorConfig, SensorKind};
+    let rec = short();
+    let bag = fusemap_io::testdata::temp_dir("camera-auto").join("bag");
+    fusemap_io::simulation::write_bag(&rec, &bag, true).unwrap();
+    let inv = Inventory::read(&bag).unwrap();
+    let plan = Config::default().validate().unwrap();
+    let r = map_inventory(&plan, &inv, &mut |_| {}).unwrap();
+    assert_eq!(r.report.cameras.len(), 1);
+    assert!(r.report.cameras[0].frames_used > 0);
+    assert!(r.notes.iter().any(|n| n.contains("camera found on `/camera/labels`")), "{:?}", r.notes);
+    let off = Config {
+        sensor: vec![SensorConfig { enabled: false, ..SensorConfig::new(SensorKind::Camera) }],
+        ..Default::default()
+    };
+    let r = map_inventory(&off.validate().unwrap(), &inv, &mut |_| {}).unwrap();
+    assert!(r.report.cameras.is_empty());
+}

@@ -120,6 +120,15 @@ pub(super) fn plan_camera(i: usize, s: &SensorConfig, name: String, prior: f64) 
     })
 }
 
+/// The camera a log run plans when the config lists none and the log carries the usual
+/// topics (`/camera/labels`, `/camera/depth`, `/camera/camera_info`): every parameter at
+/// its default, the mount from the log's TF.
+pub fn default_camera(prior: f64) -> Result<PlannedCamera, ConfigError> {
+    let mut c = plan_camera(0, &SensorConfig::new(super::SensorKind::Camera), "camera".into(), prior)?;
+    c.explicit = false;
+    Ok(c)
+}
+
 /// One `[[class]]` table: a semantic class of the label images.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

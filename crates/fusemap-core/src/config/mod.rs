@@ -10,7 +10,7 @@ mod camera;
 mod fusion;
 mod sensor;
 
-pub use camera::{ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
+pub use camera::{default_camera, ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
 pub use fusion::FusionConfig;
 pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 
