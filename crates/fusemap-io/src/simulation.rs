@@ -194,4 +194,96 @@ mod tests {
         let e = load_scenario(&write("bad.toml", "[gnss]\nrate_hz = 0.0\n")).unwrap_err().to_string();
         assert!(e.contains("bad.toml") && e.contains("gnss.rate_hz"), "{e}");
     }
+
+    /// The camera's topics read back by a reader that is not ours: the python `rosbags`
+    /// library decodes a label image, a depth image and a CameraInfo of a simulated bag.
+    #[test]
+    fn rosbags_decodes_the_simulated_camera() {
+        use fusemap_core::sim::production::{simulate, SimImage};
+        let Some(python) = crate::testdata::python_with(&["rosbags.rosbag2", "rosbags.typesys", "numpy"]) else {
+            return;
+        };
+        let mut s = Scenario::default();
+        s.robot.duration_s = 1.0;
+        (s.camera.width, s.camera.height) = (64, 48);
+        let rec = simulate(&s).unwrap();
+        let dir = crate::testdata::temp_dir("sim-camera").join("bag");
+        write_bag(&rec, &dir, false).unwrap();
+        let first = |topic: &str| {
+            rec.messages
+                .iter()
+                .find_map(|m| match m {
+                    SimMessage::Image(i) if i.topic == topic => Some(i.clone()),
+                    _ => None,
+                })
+                .unwrap()
+        };
+        let (labels, depth): (SimImage, SimImage) = (first("/camera/labels"), first("/camera/depth"));
+        let script = r#"
+import json, sys
+import numpy as np
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import Stores, get_typestore
+store = get_typestore(Stores.ROS2_HUMBLE)
+out = {}
+with Reader(sys.argv[1]) as reader:
+    for conn, t, raw in reader.messages():
+        if conn.topic in out:
+            continue
+        msg = store.deserialize_cdr(raw, conn.msgtype)
+        if conn.topic in ("/camera/labels", "/camera/depth"):
+            dtype = np.uint8 if msg.encoding == "mono8" else np.float32
+            px = np.frombuffer(msg.data.tobytes(), dtype=dtype).reshape(msg.height, msg.width)
+            out[conn.topic] = {"type": conn.msgtype, "frame": msg.header.frame_id, "stamp": [msg.header.stamp.sec, msg.header.stamp.nanosec],
+                "width": int(msg.width), "height": int(msg.height), "encoding": msg.encoding, "step": int(msg.step),
+                "bytes": len(msg.data), "pixels": [None if np.isnan(v) else float(v) for v in (px[0, 0], px[24, 32], px[47, 63], px[40, 10])]}
+        elif conn.topic == "/camera/camera_info":
+            out[conn.topic] = {"type": conn.msgtype, "model": msg.distortion_model, "d": [float(v) for v in msg.d],
+                "k": [float(v) for v in msg.k], "width": int(msg.width), "height": int(msg.height)}
+print(json.dumps(out))
+"#;
+        let run = std::process::Command::new(&python).args(["-c", script]).arg(&dir).output().unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        let got: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        let px = |img: &SimImage, bytes: usize, (v, u): (usize, usize)| {
+            let i = (v * img.width as usize + u) * bytes;
+            let b = &img.data[i..i + bytes];
+            let x = if bytes == 1 { f64::from(b[0]) } else { f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])) };
+            if x.is_nan() {
+                serde_json::Value::Null
+            } else {
+                serde_json::json!(x)
+            }
+        };
+        for (topic, img, bytes, enc, ty) in [
+            ("/camera/labels", &labels, 1, "mono8", "sensor_msgs/msg/Image"),
+            ("/camera/depth", &depth, 4, "32FC1", "sensor_msgs/msg/Image"),
+        ] {
+            let g = &got[topic];
+            assert_eq!(g["type"], ty, "{topic}");
+            assert_eq!((g["width"].as_u64(), g["height"].as_u64()), (Some(64), Some(48)), "{topic}");
+            assert_eq!((g["encoding"].as_str(), g["step"].as_u64()), (Some(enc), Some(64 * bytes as u64)), "{topic}");
+            assert_eq!(g["bytes"].as_u64(), Some(64 * 48 * bytes as u64), "{topic}");
+            assert_eq!(g["frame"], "camera_optical");
+            assert_eq!(g["stamp"][0].as_i64(), Some(img.stamp.0.div_euclid(1_000_000_000)));
+            for (k, p) in [(0, 0), (24, 32), (47, 63), (40, 10)].into_iter().enumerate() {
+                let (want, read) = (px(img, bytes, p), &g["pixels"][k]);
+                // JSON floats need not round-trip to the last bit: compare f32 values.
+                let same = match (want.as_f64(), read.as_f64()) {
+                    (Some(a), Some(b)) => (a as f32) == (b as f32),
+                    (None, None) => read.is_null(),
+                    _ => false,
+                };
+                assert!(same, "{topic} pixel {p:?}: wrote {want}, rosbags read {read}");
+            }
+        }
+        // The floor fills the lower image at a depth of a few metres.
+        assert!(got["/camera/depth"]["pixels"][2].as_f64().is_some_and(|d| d > 0.5 && d < 8.5));
+        let info = &got["/camera/camera_info"];
+        assert_eq!(info["type"], "sensor_msgs/msg/CameraInfo");
+        assert_eq!((info["model"].as_str(), info["d"].as_array().map(Vec::len)), (Some("plumb_bob"), Some(5)));
+        let k = s.camera.k_matrix();
+        assert_eq!(info["k"], serde_json::json!(k));
+        assert_eq!((info["width"].as_u64(), info["height"].as_u64()), (Some(64), Some(48)));
+    }
 }
