@@ -193,6 +193,15 @@ mod tests {
         assert!(e.contains("typo.toml:3") && e.contains("speeed"), "{e}");
         let e = load_scenario(&write("bad.toml", "[gnss]\nrate_hz = 0.0\n")).unwrap_err().to_string();
         assert!(e.contains("bad.toml") && e.contains("gnss.rate_hz"), "{e}");
+        let cam = "[camera]\ndepth_encoding = \"16UC1\"\nlabel_encoding = \"mono16\"\ntime_offset_s = 0.04\n\
+                   [camera.backlight]\nfloor_share = 0.4\n[person]\nwindows = [[0.0, 30.0]]\n";
+        let s = load_scenario(&write("camera.toml", cam)).unwrap();
+        assert_eq!(s.camera.depth_encoding, fusemap_core::sim::production::DepthEncoding::U16Millimetres);
+        assert_eq!(s.camera.label_encoding, fusemap_core::sim::production::LabelEncoding::Mono16);
+        assert_eq!((s.camera.time_offset_s, s.camera.backlight.floor_share), (0.04, 0.4));
+        assert_eq!((s.person.windows.clone(), s.camera.width), (vec![[0.0, 30.0]], 320));
+        let e = load_scenario(&write("enc.toml", "[camera]\ndepth_encoding = \"rgb8\"\n")).unwrap_err().to_string();
+        assert!(e.contains("enc.toml:2"), "{e}");
     }
 
     /// The camera's topics read back by a reader that is not ours: the python `rosbags`
