@@ -47,6 +47,18 @@ pub const CLASS_CEILING: u16 = 7;
 /// The default class table's names, indexed by class id.
 pub const CLASS_NAMES: [&str; 8] = ["unlabeled", "floor", "wall", "glass", "pillar", "machine", "person", "ceiling"];
 
+/// The default class table's colours (RGB), indexed by class id.
+pub const CLASS_COLORS: [[u8; 3]; 8] = [
+    [0, 0, 0],
+    [170, 170, 170],
+    [90, 90, 200],
+    [80, 200, 230],
+    [230, 150, 40],
+    [60, 170, 60],
+    [230, 40, 40],
+    [255, 255, 255],
+];
+
 /// The class id of a class name of the default table.
 pub fn class_id(name: &str) -> Option<u16> {
     CLASS_NAMES.iter().position(|n| *n == name).map(|i| i as u16)
