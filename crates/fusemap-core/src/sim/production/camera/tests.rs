@@ -342,3 +342,23 @@ mod props {
         }
     }
 }
+
+#[test]
+fn bottom_k_keeps_the_smallest_keys() {
+    let mut rng = SplitMix64::new(5);
+    let all: Vec<(u64, Point2)> = (0..1000).map(|i| (rng.next_u64(), Point2::new(f64::from(i), 0.0))).collect();
+    let mut keys: Vec<u64> = all.iter().map(|a| a.0).collect();
+    keys.sort_unstable();
+    // Fed in pieces, as the threads and the per-frame pruning do.
+    let mut kept = Vec::new();
+    for piece in all.chunks(37) {
+        kept.extend_from_slice(piece);
+        bottom_k(&mut kept, 100);
+    }
+    let threshold = bottom_k(&mut kept, 100);
+    let mut got: Vec<u64> = kept.iter().map(|k| k.0).collect();
+    got.sort_unstable();
+    assert_eq!(got, keys[..100]);
+    assert_eq!(threshold, keys[99]);
+    assert_eq!(bottom_k(&mut vec![(3, Point2::default())], 100), u64::MAX);
+}
