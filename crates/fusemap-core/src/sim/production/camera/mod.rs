@@ -64,8 +64,9 @@ pub fn class_id(name: &str) -> Option<u16> {
     CLASS_NAMES.iter().position(|n| *n == name).map(|i| i as u16)
 }
 
-/// Most backlit floor points [`CameraTruth::backlit_floor_points`] keeps (a uniform
-/// reservoir sample, Vitter 1985, of all of them).
+/// Most backlit floor points [`CameraTruth::backlit_floor_points`] keeps: a uniform
+/// sample without replacement of all of them, taken as the points with the smallest hash
+/// keys (bottom-k sampling, Cohen & Kaplan 2007), which merges across threads.
 pub const MAX_BACKLIT_POINTS: usize = 20_000;
 
 /// What the camera really did, for scoring a semantic map.
