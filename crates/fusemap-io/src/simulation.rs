@@ -1,7 +1,8 @@
 //! A simulated run written as a user's robot would record it: a rosbag2 directory (MCAP
 //! storage, standard message types — scans, odometry, IMU, GNSS, the semantic camera's
 //! label and depth `sensor_msgs/Image`s and `CameraInfo` — CDR, `/tf_static` latched) with the ground truth
-//! beside it — the occupancy map as map_server PGM + YAML and the true trajectory as TUM.
+//! beside it — the occupancy map as map_server PGM + YAML, the class of every occupied
+//! cell as a palette PNG + YAML, and the true trajectory as TUM.
 //!
 //! Scenario files are TOML mapping one to one onto
 //! [`fusemap_core::sim::production::Scenario`]; unknown keys are errors naming their line.
@@ -15,7 +16,7 @@ use crate::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions, 
 use crate::Result;
 use fusemap_core::grid::logodds::logit;
 use fusemap_core::grid::{GridGeometry, OccupancyParams, Raster};
-use fusemap_core::sim::production::{Scenario, SimMessage, SimRecording};
+use fusemap_core::sim::production::{Scenario, SimMessage, SimRecording, TruthSemantic, CLASS_COLORS, CLASS_NAMES};
 use std::path::{Path, PathBuf};
 
 /// Reads and validates a scenario file.
@@ -150,18 +151,67 @@ pub fn truth_raster(rec: &SimRecording, geometry: GridGeometry) -> Option<Raster
     })
 }
 
+/// Writes the semantic truth as a palette PNG (one pixel per cell, north up, the palette
+/// the class table's colours, so the pixel value is the class id) and a YAML beside it
+/// naming the image, resolution, origin (lower-left corner of the lower-left cell, as
+/// map_server's) and the classes. Returns the YAML's path.
+pub fn write_truth_semantic(yaml_path: &Path, t: &TruthSemantic) -> Result<PathBuf> {
+    let png_path = yaml_path.with_extension("png");
+    let fail = |m: String| crate::Error::format(yaml_path, crate::Location::File, m);
+    let (Ok(w), Ok(h)) = (u32::try_from(t.width), u32::try_from(t.height)) else {
+        return Err(fail(format!("a {} × {} raster is too large for PNG", t.width, t.height)));
+    };
+    if w == 0 || h == 0 || w > i32::MAX as u32 || h > i32::MAX as u32 {
+        return Err(fail(format!("a {} × {} raster cannot be a PNG", t.width, t.height)));
+    }
+    let name = png_path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .ok_or_else(|| fail("the image's file name is not valid UTF-8".into()))?
+        .to_string();
+    crate::atomic::write_atomic(&png_path, |out| {
+        let mut e = png::Encoder::new(out, w, h);
+        e.set_color(png::ColorType::Indexed);
+        e.set_depth(png::BitDepth::Eight);
+        e.set_palette(CLASS_COLORS.concat());
+        let mut writer = e.write_header().map_err(std::io::Error::from)?;
+        let mut data = Vec::with_capacity(t.width * t.height);
+        for row in (0..t.height).rev() {
+            data.extend_from_slice(&t.class_ids[row * t.width..(row + 1) * t.width]);
+        }
+        writer.write_image_data(&data).map_err(std::io::Error::from)?;
+        writer.finish().map_err(std::io::Error::from)
+    })?;
+    let origin = t.geometry.cell_corner(t.first_cell);
+    let mut yaml = format!(
+        "# fusemap simulator: true class of every occupied cell (pixel value = class id, 0 free)\n\
+         image: {name}\nresolution: {}\norigin: [{}, {}, 0.0]\nclasses:\n",
+        t.geometry.resolution(),
+        origin.x,
+        origin.y
+    );
+    for (id, (n, c)) in CLASS_NAMES.iter().zip(CLASS_COLORS).enumerate() {
+        yaml += &format!("  - {{id: {id}, name: {n}, color: [{}, {}, {}]}}\n", c[0], c[1], c[2]);
+    }
+    crate::atomic::write_atomic(yaml_path, |out| std::io::Write::write_all(out, yaml.as_bytes()))?;
+    Ok(yaml_path.to_path_buf())
+}
+
 /// What [`write_simulation`] wrote.
 pub struct SimulationFiles {
     /// The rosbag2 directory.
     pub bag: WrittenBag,
     /// `truth.yaml` (map_server; `truth.pgm` beside it).
     pub truth_map: Option<PathBuf>,
+    /// `truth_semantic.yaml` (`truth_semantic.png` beside it).
+    pub truth_semantic: Option<PathBuf>,
     /// `truth.tum`.
     pub truth_trajectory: PathBuf,
 }
 
-/// Writes the bag (`out/bag`), the true map (`out/truth.yaml` + `.pgm`, at `resolution`)
-/// and the true trajectory (`out/truth.tum`).
+/// Writes the bag (`out/bag`), the true map (`out/truth.yaml` + `.pgm`, at `resolution`),
+/// the true classes (`out/truth_semantic.yaml` + `.png`) and the true trajectory
+/// (`out/truth.tum`).
 pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwrite: bool) -> Result<SimulationFiles> {
     std::fs::create_dir_all(out).map_err(|e| crate::Error::io(out, e))?;
     let bag = write_bag(rec, &out.join("bag"), overwrite)?;
@@ -169,9 +219,13 @@ pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwri
         Some(r) => Some(crate::map_server::write_map_server(&out.join("truth.yaml"), &r)?),
         None => None,
     };
+    let truth_semantic = match GridGeometry::centered(resolution).ok().and_then(|g| rec.truth_semantic(g).ok()) {
+        Some(t) => Some(write_truth_semantic(&out.join("truth_semantic.yaml"), &t)?),
+        None => None,
+    };
     let truth_trajectory = out.join("truth.tum");
     crate::trajectory::write_tum(&truth_trajectory, &rec.truth_trajectory)?;
-    Ok(SimulationFiles { bag, truth_map, truth_trajectory })
+    Ok(SimulationFiles { bag, truth_map, truth_semantic, truth_trajectory })
 }
 
 #[cfg(test)]
@@ -193,5 +247,132 @@ mod tests {
         assert!(e.contains("typo.toml:3") && e.contains("speeed"), "{e}");
         let e = load_scenario(&write("bad.toml", "[gnss]\nrate_hz = 0.0\n")).unwrap_err().to_string();
         assert!(e.contains("bad.toml") && e.contains("gnss.rate_hz"), "{e}");
+        let cam = "[camera]\ndepth_encoding = \"16UC1\"\nlabel_encoding = \"mono16\"\ntime_offset_s = 0.04\n\
+                   [camera.backlight]\nfloor_share = 0.4\n[person]\nwindows = [[0.0, 30.0]]\n";
+        let s = load_scenario(&write("camera.toml", cam)).unwrap();
+        assert_eq!(s.camera.depth_encoding, fusemap_core::sim::production::DepthEncoding::U16Millimetres);
+        assert_eq!(s.camera.label_encoding, fusemap_core::sim::production::LabelEncoding::Mono16);
+        assert_eq!((s.camera.time_offset_s, s.camera.backlight.floor_share), (0.04, 0.4));
+        assert_eq!((s.person.windows.clone(), s.camera.width), (vec![[0.0, 30.0]], 320));
+        let e = load_scenario(&write("enc.toml", "[camera]\ndepth_encoding = \"rgb8\"\n")).unwrap_err().to_string();
+        assert!(e.contains("enc.toml:2"), "{e}");
+    }
+
+    #[test]
+    fn the_semantic_truth_is_a_palette_png_with_its_yaml() {
+        let mut s = Scenario::default();
+        s.robot.duration_s = 0.5;
+        s.camera.enabled = false;
+        let rec = fusemap_core::sim::production::simulate(&s).unwrap();
+        let dir = crate::testdata::temp_dir("sim-semantic");
+        let files = write_simulation(&rec, &dir, 0.1, false).unwrap();
+        let yaml = std::fs::read_to_string(files.truth_semantic.unwrap()).unwrap();
+        assert!(yaml.contains("image: truth_semantic.png\nresolution: 0.1\n"), "{yaml}");
+        assert!(yaml.contains("{id: 3, name: glass, color: [80, 200, 230]}"), "{yaml}");
+        let t = rec.truth_semantic(GridGeometry::centered(0.1).unwrap()).unwrap();
+        let mut reader =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.join("truth_semantic.png")).unwrap()))
+                .read_info()
+                .unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!((info.width as usize, info.height as usize), (t.width, t.height));
+        assert_eq!(info.color_type, png::ColorType::Indexed);
+        // The top row is the highest y: the last raster row.
+        let top = &buf[..t.width];
+        assert_eq!(top, &t.class_ids[(t.height - 1) * t.width..]);
+        assert!(buf.contains(&3) && buf.contains(&4) && buf.contains(&5) && buf.contains(&2));
+    }
+
+    /// The camera's topics read back by a reader that is not ours: the python `rosbags`
+    /// library decodes a label image, a depth image and a CameraInfo of a simulated bag.
+    #[test]
+    fn rosbags_decodes_the_simulated_camera() {
+        use fusemap_core::sim::production::{simulate, SimImage};
+        let Some(python) = crate::testdata::python_with(&["rosbags.rosbag2", "rosbags.typesys", "numpy"]) else {
+            return;
+        };
+        let mut s = Scenario::default();
+        s.robot.duration_s = 1.0;
+        (s.camera.width, s.camera.height) = (64, 48);
+        let rec = simulate(&s).unwrap();
+        let dir = crate::testdata::temp_dir("sim-camera").join("bag");
+        write_bag(&rec, &dir, false).unwrap();
+        let first = |topic: &str| {
+            rec.messages
+                .iter()
+                .find_map(|m| match m {
+                    SimMessage::Image(i) if i.topic == topic => Some(i.clone()),
+                    _ => None,
+                })
+                .unwrap()
+        };
+        let (labels, depth): (SimImage, SimImage) = (first("/camera/labels"), first("/camera/depth"));
+        let script = r#"
+import json, sys
+import numpy as np
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import Stores, get_typestore
+store = get_typestore(Stores.ROS2_HUMBLE)
+out = {}
+with Reader(sys.argv[1]) as reader:
+    for conn, t, raw in reader.messages():
+        if conn.topic in out:
+            continue
+        msg = store.deserialize_cdr(raw, conn.msgtype)
+        if conn.topic in ("/camera/labels", "/camera/depth"):
+            dtype = np.uint8 if msg.encoding == "mono8" else np.float32
+            px = np.frombuffer(msg.data.tobytes(), dtype=dtype).reshape(msg.height, msg.width)
+            out[conn.topic] = {"type": conn.msgtype, "frame": msg.header.frame_id, "stamp": [msg.header.stamp.sec, msg.header.stamp.nanosec],
+                "width": int(msg.width), "height": int(msg.height), "encoding": msg.encoding, "step": int(msg.step),
+                "bytes": len(msg.data), "pixels": [None if np.isnan(v) else float(v) for v in (px[0, 0], px[24, 32], px[47, 63], px[40, 10])]}
+        elif conn.topic == "/camera/camera_info":
+            out[conn.topic] = {"type": conn.msgtype, "model": msg.distortion_model, "d": [float(v) for v in msg.d],
+                "k": [float(v) for v in msg.k], "width": int(msg.width), "height": int(msg.height)}
+print(json.dumps(out))
+"#;
+        let run = std::process::Command::new(&python).args(["-c", script]).arg(&dir).output().unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        let got: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        let px = |img: &SimImage, bytes: usize, (v, u): (usize, usize)| {
+            let i = (v * img.width as usize + u) * bytes;
+            let b = &img.data[i..i + bytes];
+            let x = if bytes == 1 { f64::from(b[0]) } else { f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])) };
+            if x.is_nan() {
+                serde_json::Value::Null
+            } else {
+                serde_json::json!(x)
+            }
+        };
+        for (topic, img, bytes, enc, ty) in [
+            ("/camera/labels", &labels, 1, "mono8", "sensor_msgs/msg/Image"),
+            ("/camera/depth", &depth, 4, "32FC1", "sensor_msgs/msg/Image"),
+        ] {
+            let g = &got[topic];
+            assert_eq!(g["type"], ty, "{topic}");
+            assert_eq!((g["width"].as_u64(), g["height"].as_u64()), (Some(64), Some(48)), "{topic}");
+            assert_eq!((g["encoding"].as_str(), g["step"].as_u64()), (Some(enc), Some(64 * bytes as u64)), "{topic}");
+            assert_eq!(g["bytes"].as_u64(), Some(64 * 48 * bytes as u64), "{topic}");
+            assert_eq!(g["frame"], "camera_optical");
+            assert_eq!(g["stamp"][0].as_i64(), Some(img.stamp.0.div_euclid(1_000_000_000)));
+            for (k, p) in [(0, 0), (24, 32), (47, 63), (40, 10)].into_iter().enumerate() {
+                let (want, read) = (px(img, bytes, p), &g["pixels"][k]);
+                // JSON floats need not round-trip to the last bit: compare f32 values.
+                let same = match (want.as_f64(), read.as_f64()) {
+                    (Some(a), Some(b)) => (a as f32) == (b as f32),
+                    (None, None) => read.is_null(),
+                    _ => false,
+                };
+                assert!(same, "{topic} pixel {p:?}: wrote {want}, rosbags read {read}");
+            }
+        }
+        // The floor fills the lower image at a depth of a few metres.
+        assert!(got["/camera/depth"]["pixels"][2].as_f64().is_some_and(|d| d > 0.5 && d < 8.5));
+        let info = &got["/camera/camera_info"];
+        assert_eq!(info["type"], "sensor_msgs/msg/CameraInfo");
+        assert_eq!((info["model"].as_str(), info["d"].as_array().map(Vec::len)), (Some("plumb_bob"), Some(5)));
+        let k = s.camera.k_matrix();
+        assert_eq!(info["k"], serde_json::json!(k));
+        assert_eq!((info["width"].as_u64(), info["height"].as_u64()), (Some(64), Some(48)));
     }
 }

@@ -5,7 +5,8 @@ use anyhow::{Context, Result};
 use fusemap_core::sim::production::{simulate, Scenario};
 use std::path::Path;
 
-/// Runs the simulator and writes `DIR/bag`, `DIR/truth.yaml` + `.pgm`, `DIR/truth.tum`.
+/// Runs the simulator and writes `DIR/bag`, `DIR/truth.yaml` + `.pgm`,
+/// `DIR/truth_semantic.yaml` + `.png`, `DIR/truth.tum`.
 pub fn run(scenario: Option<&Path>, out: &Path, resolution: f64, overwrite: bool) -> Result<()> {
     let s = match scenario {
         Some(p) => fusemap_io::simulation::load_scenario(p)?,
@@ -24,6 +25,9 @@ pub fn run(scenario: Option<&Path>, out: &Path, resolution: f64, overwrite: bool
     if let Some(m) = &files.truth_map {
         println!("true map      {}", m.display());
     }
+    if let Some(m) = &files.truth_semantic {
+        println!("true classes  {}", m.display());
+    }
     println!("true track    {}", files.truth_trajectory.display());
     println!(
         "injected      gyro bias {:.4} rad/s, odometry scale {:.3}, {} GNSS outliers, {} GNSS dropouts",
@@ -32,5 +36,16 @@ pub fn run(scenario: Option<&Path>, out: &Path, resolution: f64, overwrite: bool
         rec.injected_outliers.len(),
         rec.dropouts.len()
     );
+    let c = &rec.camera_truth;
+    if !c.stamps.is_empty() {
+        println!(
+            "camera        {} frames, {} facing the windows ({} backlit floor pixels), {} person pixels, {} lidar returns off the person",
+            c.stamps.len(),
+            c.backlit_frames,
+            c.backlit_pixels,
+            c.person_pixels,
+            rec.lidar_stats.person_hits
+        );
+    }
     Ok(())
 }

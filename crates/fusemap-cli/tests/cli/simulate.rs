@@ -16,10 +16,21 @@ fn a_simulated_bag_maps_with_the_estimator_and_a_third_party_copy_maps_the_same(
     let o = run(&["simulate", "--out", d.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);
-    for t in ["/scan", "/odom", "/imu/data", "/gnss/fix", "/tf_static", "sensor_msgs/msg/NavSatFix"] {
+    for t in [
+        "/scan",
+        "/odom",
+        "/imu/data",
+        "/gnss/fix",
+        "/tf_static",
+        "sensor_msgs/msg/NavSatFix",
+        "/camera/labels",
+        "/camera/depth",
+        "sensor_msgs/msg/CameraInfo",
+    ] {
         assert!(text.contains(t), "{t} missing from:\n{text}");
     }
-    for f in ["bag/metadata.yaml", "truth.yaml", "truth.pgm", "truth.tum"] {
+    for f in ["bag/metadata.yaml", "truth.yaml", "truth.pgm", "truth_semantic.yaml", "truth_semantic.png", "truth.tum"]
+    {
         assert!(d.join(f).exists(), "{f} missing");
     }
     // Refuses to write over the bag without --overwrite.
@@ -69,6 +80,9 @@ fn a_simulated_bag_maps_with_the_estimator_and_a_third_party_copy_maps_the_same(
         ("/imu/data", "sensor_msgs/msg/Imu", 18001),
         ("/gnss/fix", "sensor_msgs/msg/NavSatFix", 751),
         ("/tf_static", "tf2_msgs/msg/TFMessage", 1),
+        ("/camera/labels", "sensor_msgs/msg/Image", 1801),
+        ("/camera/depth", "sensor_msgs/msg/Image", 1801),
+        ("/camera/camera_info", "sensor_msgs/msg/CameraInfo", 1801),
     ] {
         assert_eq!(topics[topic]["type"], ty, "{topics}");
         assert_eq!(topics[topic]["count"], n, "{topic}");

@@ -20,7 +20,8 @@
 //! The same scenario (same `world.seed`) always gives the same recording.
 //!
 //! A scenario file overrides only what it names; a list it names (`[[world.objects]]`,
-//! `[[gnss.zones]]`, `world.grooves`, `robot.waypoints`) replaces the default list whole:
+//! `[[gnss.zones]]`, `world.grooves`, `robot.waypoints`, `person.windows`) replaces the default
+//! list whole:
 //!
 //! ```toml
 //! [world]
@@ -36,6 +37,13 @@
 //! name = "loading_bay"
 //! kind = "degraded"             # or "dropout"
 //! area = { min = [20.0, 0.0], max = [30.0, 9.0] }
+//! [camera]
+//! time_offset_s = 0.04          # image stamps 40 ms late
+//! depth_encoding = "16UC1"      # millimetres instead of 32FC1 metres
+//! [camera.backlight]
+//! floor_share = 0.4
+//! [person]
+//! windows = [[0.0, 30.0]]       # seconds since the start
 //! ```
 //!
 //! ```
@@ -65,8 +73,8 @@ mod tests;
 
 pub use camera::{
     class_id, optical_rotation, BacklightConfig, CameraConfig, CameraTruth, DepthEncoding, LabelEncoding,
-    CLASS_CEILING, CLASS_FLOOR, CLASS_GLASS, CLASS_MACHINE, CLASS_NAMES, CLASS_PERSON, CLASS_PILLAR, CLASS_UNLABELED,
-    CLASS_WALL, MAX_BACKLIT_POINTS, MAX_CAMERA_BYTES,
+    CLASS_CEILING, CLASS_COLORS, CLASS_FLOOR, CLASS_GLASS, CLASS_MACHINE, CLASS_NAMES, CLASS_PERSON, CLASS_PILLAR,
+    CLASS_UNLABELED, CLASS_WALL, MAX_BACKLIT_POINTS, MAX_CAMERA_BYTES,
 };
 pub use imu::STANDARD_GRAVITY;
 pub use lidar::LidarStats;

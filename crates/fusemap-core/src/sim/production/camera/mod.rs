@@ -47,13 +47,26 @@ pub const CLASS_CEILING: u16 = 7;
 /// The default class table's names, indexed by class id.
 pub const CLASS_NAMES: [&str; 8] = ["unlabeled", "floor", "wall", "glass", "pillar", "machine", "person", "ceiling"];
 
+/// The default class table's colours (RGB), indexed by class id.
+pub const CLASS_COLORS: [[u8; 3]; 8] = [
+    [0, 0, 0],
+    [170, 170, 170],
+    [90, 90, 200],
+    [80, 200, 230],
+    [230, 150, 40],
+    [60, 170, 60],
+    [230, 40, 40],
+    [255, 255, 255],
+];
+
 /// The class id of a class name of the default table.
 pub fn class_id(name: &str) -> Option<u16> {
     CLASS_NAMES.iter().position(|n| *n == name).map(|i| i as u16)
 }
 
-/// Most backlit floor points [`CameraTruth::backlit_floor_points`] keeps (a uniform
-/// reservoir sample, Vitter 1985, of all of them).
+/// Most backlit floor points [`CameraTruth::backlit_floor_points`] keeps: a uniform
+/// sample without replacement of all of them, taken as the points with the smallest hash
+/// keys (bottom-k sampling, Cohen & Kaplan 2007), which merges across threads.
 pub const MAX_BACKLIT_POINTS: usize = 20_000;
 
 /// What the camera really did, for scoring a semantic map.
@@ -96,6 +109,7 @@ pub(crate) struct CameraSim<'a> {
     cfg: &'a CameraConfig,
     renderer: Renderer<'a>,
     rng: SplitMix64,
+    noise_seed: u64,
     blob_seed: u64,
     backlight_class: u16,
     blobs: render::BlobField,
@@ -105,12 +119,13 @@ pub(crate) struct CameraSim<'a> {
 impl<'a> CameraSim<'a> {
     pub fn new(cfg: &'a CameraConfig, objects: &[WorldObject], caster: &'a Caster, seed: u64) -> Self {
         let mut seeds = SplitMix64::new(seed);
-        let rng = SplitMix64::new(seeds.next_u64());
+        let noise_seed = seeds.next_u64();
         let blob_seed = seeds.next_u64();
         Self {
             cfg,
             renderer: Renderer::new(cfg, objects, caster),
-            rng,
+            rng: SplitMix64::new(noise_seed),
+            noise_seed,
             blob_seed,
             backlight_class: class_id(&cfg.backlight.class).unwrap_or(CLASS_WALL),
             blobs: render::BlobField::new(cfg.width as usize, cfg.height as usize, cfg.backlight.blob_scale_px),
@@ -122,9 +137,12 @@ impl<'a> CameraSim<'a> {
         &self.renderer
     }
 
-    /// Renders the frame of true time `t` (seconds since the start) from `pose`.
+    /// Renders the frame of true time `t` (seconds since the start) from `pose`. Each
+    /// frame draws its noise from its own stream, seeded by its time, so frames can be
+    /// rendered in any order and on any thread with the same result.
     pub fn frame(&mut self, t: f64, pose: Pose2, person: Option<(Point2, f64, f64)>, out: &mut NoisyFrame) {
         let cfg = self.cfg;
+        self.rng = SplitMix64::new(self.noise_seed ^ t.to_bits().wrapping_mul(0x9E37_79B9_7F4A_7C15));
         self.renderer.render(pose, person, &mut self.rng, &mut out.truth);
         out.labels.clear();
         out.labels.extend_from_slice(&out.truth.labels);
@@ -259,13 +277,49 @@ impl CameraRun<'_> {
         }
     }
 
+    /// Every frame of the run, split over the machine's cores (frames are independent:
+    /// each has its own noise stream), then joined in time order.
     pub fn simulate(&self, seed: u64) -> (Vec<SimMessage>, CameraTruth) {
-        let cfg = self.cfg;
+        let mut frames = 0u64;
+        while frames as f64 / self.cfg.rate_hz <= self.traj.duration() {
+            frames += 1;
+        }
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 4) as u64;
+        let chunk = frames.div_ceil(threads).max(1);
+        let parts: Vec<Part> = std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..threads)
+                .map(|k| {
+                    let range = (k * chunk).min(frames)..((k + 1) * chunk).min(frames);
+                    scope.spawn(move || self.simulate_frames(seed, range))
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
+        });
         let mut truth = CameraTruth::default();
         let mut messages = Vec::new();
+        let mut sample = Vec::new();
+        for p in parts {
+            messages.extend(p.messages);
+            truth.stamps.extend(p.truth.stamps);
+            truth.backlit_frames += p.truth.backlit_frames;
+            truth.backlit_pixels += p.truth.backlit_pixels;
+            truth.salt_pixels += p.truth.salt_pixels;
+            truth.person_pixels += p.truth.person_pixels;
+            sample.extend(p.sample);
+            bottom_k(&mut sample, MAX_BACKLIT_POINTS);
+        }
+        sample.sort_unstable_by_key(|s| s.0);
+        truth.backlit_floor_points = sample.into_iter().map(|s| s.1).collect();
+        (messages, truth)
+    }
+
+    /// The frames `range` (frame `n` shows true time `n / rate_hz`).
+    fn simulate_frames(&self, seed: u64, range: std::ops::Range<u64>) -> Part {
+        let cfg = self.cfg;
+        let mut part = Part::default();
         let mut sim = CameraSim::new(cfg, self.objects, self.caster, seed);
-        let mut reservoir = SplitMix64::new(seed ^ 0x5EED_BAC1_1175_0000);
-        let mut seen = 0u64;
+        let sample_seed = SplitMix64::new(seed ^ 0x5EED_BAC1_1175_0000).next_u64();
+        let mut threshold = u64::MAX;
         let k = cfg.k_matrix();
         let (w, h) = (cfg.width, cfg.height);
         let label_bytes = match cfg.label_encoding {
@@ -277,39 +331,32 @@ impl CameraRun<'_> {
             DepthEncoding::U16Millimetres => 2,
         };
         let mut frame = NoisyFrame::default();
-        let mut n = 0u64;
-        loop {
+        for n in range {
             let t = n as f64 / cfg.rate_hz;
-            if t > self.traj.duration() {
-                break;
-            }
-            n += 1;
             let pose = self.traj.pose_at(t);
             let person = self.person.position_at(t).map(|p| (p, self.person.radius_m, self.person.height_m));
             sim.frame(t, pose, person, &mut frame);
             let true_stamp = Stamp(self.start.0 + (t * 1e9).round() as i64);
             let stamp = Stamp(self.start.0 + ((t + cfg.time_offset_s) * 1e9).round() as i64);
+            let truth = &mut part.truth;
             truth.stamps.push((true_stamp, stamp));
             truth.backlit_frames += u64::from(frame.facing_window);
             truth.backlit_pixels += frame.backlit.len() as u64;
             truth.person_pixels += frame.truth.labels.iter().filter(|&&l| l == CLASS_PERSON).count() as u64;
             truth.salt_pixels += frame.salted;
+            // A bottom-k sample (the points with the smallest hash keys) is uniform, and
+            // the same whichever thread saw which frame.
             let c = sim.renderer().centre_in_map(pose);
             for &i in &frame.backlit {
+                let key = SplitMix64::new(sample_seed ^ (n << 24) ^ i as u64).next_u64();
                 let s = f64::from(frame.truth.floor_depth[i]);
-                if s.is_nan() || s > cfg.max_depth_m {
+                if key >= threshold || s.is_nan() || s > cfg.max_depth_m {
                     continue;
                 }
                 let d = sim.renderer().ray_in_map(pose, i);
-                let p = Point2::new(c[0] + s * d[0], c[1] + s * d[1]);
-                seen += 1;
-                if truth.backlit_floor_points.len() < MAX_BACKLIT_POINTS {
-                    truth.backlit_floor_points.push(p);
-                } else {
-                    let j = reservoir.next_u64() % seen;
-                    if (j as usize) < MAX_BACKLIT_POINTS {
-                        truth.backlit_floor_points[j as usize] = p;
-                    }
+                part.sample.push((key, Point2::new(c[0] + s * d[0], c[1] + s * d[1])));
+                if part.sample.len() >= 2 * MAX_BACKLIT_POINTS {
+                    threshold = bottom_k(&mut part.sample, MAX_BACKLIT_POINTS);
                 }
             }
             let image = |topic: &str, encoding: &str, bytes: u32, data: Vec<u8>| SimImage {
@@ -323,19 +370,19 @@ impl CameraRun<'_> {
                 step: w * bytes,
                 data,
             };
-            messages.push(SimMessage::Image(image(
+            part.messages.push(SimMessage::Image(image(
                 &cfg.label_topic,
                 cfg.label_encoding.as_str(),
                 label_bytes,
                 encode_labels(&frame.labels, cfg.label_encoding),
             )));
-            messages.push(SimMessage::Image(image(
+            part.messages.push(SimMessage::Image(image(
                 &cfg.depth_topic,
                 cfg.depth_encoding.as_str(),
                 depth_bytes,
                 encode_depth(&frame.depth, cfg.depth_encoding),
             )));
-            messages.push(SimMessage::CameraInfo(Box::new(SimCameraInfo {
+            part.messages.push(SimMessage::CameraInfo(Box::new(SimCameraInfo {
                 stamp,
                 topic: cfg.info_topic.clone(),
                 frame_id: self.frame_id.into(),
@@ -348,6 +395,28 @@ impl CameraRun<'_> {
                 p: [k[0], 0.0, k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0],
             })));
         }
-        (messages, truth)
+        part
     }
+}
+
+/// What one thread rendered.
+#[derive(Default)]
+struct Part {
+    messages: Vec<SimMessage>,
+    truth: CameraTruth,
+    /// Backlit floor points with their sampling keys.
+    sample: Vec<(u64, Point2)>,
+}
+
+/// Keeps the `k` entries with the smallest keys (in no order) and returns the largest
+/// key kept (`u64::MAX` while fewer than `k`): entries at or above it can be skipped.
+fn bottom_k(v: &mut Vec<(u64, Point2)>, k: usize) -> u64 {
+    if v.len() > k {
+        v.select_nth_unstable_by_key(k - 1, |s| s.0);
+        v.truncate(k);
+    }
+    if v.len() < k {
+        return u64::MAX;
+    }
+    v.iter().map(|s| s.0).max().unwrap_or(u64::MAX)
 }

@@ -183,13 +183,14 @@ impl<'a> Renderer<'a> {
                     continue;
                 }
                 let s = ((a.x - c.x) * e.1 - (a.y - c.y) * e.0) / den;
+                // Nothing beyond the floor point or the person is visible.
+                if nearest_plain < s {
+                    break;
+                }
                 let o = self.objects[h.object];
                 let z = c3[2] + s * d.2;
                 if !(s > 0.0 && (0.0..=o.height).contains(&z)) {
                     continue;
-                }
-                if nearest_plain < s {
-                    break;
                 }
                 if o.glass {
                     label.get_or_insert(CLASS_GLASS);

@@ -306,3 +306,59 @@ fn the_fast_blob_field_is_the_value_noise() {
         }
     }
 }
+
+mod props {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(32))]
+        /// Any pitch, height and pose: a pixel whose ray drops reaches the floor at depth
+        /// `z / (sin p + b cos p)` (`b` its normalised image row), and its map point lies on
+        /// the ray from the optical centre.
+        #[test]
+        fn floor_depth_for_any_pitch_and_height(
+            pitch in 5.0..60.0f64, z in 0.3..2.0f64, x in -5.0..5.0f64, y in -5.0..5.0f64, yaw in -3.1..3.1f64,
+        ) {
+            let mut cfg = exact(21, 15, pitch);
+            cfg.mount.z = z;
+            cfg.max_depth_m = 1e6;
+            let f = render(&cfg, &[], Pose2::new(x, y, yaw), None);
+            let k = cfg.k_matrix();
+            let p = pitch.to_radians();
+            for v in 0..15usize {
+                let drop = p.sin() + (v as f64 - k[5]) / k[4] * p.cos();
+                for u in 0..21usize {
+                    let i = v * 21 + u;
+                    if drop > 1e-3 {
+                        prop_assert_eq!(f.labels[i], CLASS_FLOOR);
+                        let want = z / drop;
+                        prop_assert!((f64::from(f.depth[i]) - want).abs() < 1e-5 * want.max(1.0));
+                    } else if drop < -1e-9 {
+                        prop_assert_eq!(f.labels[i], CLASS_CEILING);
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn bottom_k_keeps_the_smallest_keys() {
+    let mut rng = SplitMix64::new(5);
+    let all: Vec<(u64, Point2)> = (0..1000).map(|i| (rng.next_u64(), Point2::new(f64::from(i), 0.0))).collect();
+    let mut keys: Vec<u64> = all.iter().map(|a| a.0).collect();
+    keys.sort_unstable();
+    // Fed in pieces, as the threads and the per-frame pruning do.
+    let mut kept = Vec::new();
+    for piece in all.chunks(37) {
+        kept.extend_from_slice(piece);
+        bottom_k(&mut kept, 100);
+    }
+    let threshold = bottom_k(&mut kept, 100);
+    let mut got: Vec<u64> = kept.iter().map(|k| k.0).collect();
+    got.sort_unstable();
+    assert_eq!(got, keys[..100]);
+    assert_eq!(threshold, keys[99]);
+    assert_eq!(bottom_k(&mut vec![(3, Point2::default())], 100), u64::MAX);
+}
