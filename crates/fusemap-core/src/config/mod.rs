@@ -12,7 +12,7 @@ pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSen
 
 use crate::estimator::EstimatorConfig;
 use crate::geometry::Point2;
-use crate::grid::{GridGeometry, OccupancyParams};
+use crate::grid::{GridGeometry, OccupancyParams, PassThroughParams};
 use serde::{Deserialize, Serialize};
 
 /// The whole configuration.
@@ -152,6 +152,9 @@ pub struct MapConfig {
     pub occupied_threshold: f64,
     /// A cell is free below this probability.
     pub free_threshold: f64,
+    /// Free evidence behind confidently occupied cells (`[map.pass_through]`).
+    #[serde(default)]
+    pub pass_through: PassThroughParams,
 }
 
 impl Default for MapConfig {
@@ -165,6 +168,7 @@ impl Default for MapConfig {
             clamp_max: p.clamp_max,
             occupied_threshold: p.occupied_threshold,
             free_threshold: p.free_threshold,
+            pass_through: p.pass_through,
         }
     }
 }
@@ -250,12 +254,30 @@ impl Config {
         if free_t >= occ_t {
             return Err(err("map.free_threshold", format!("must be below occupied_threshold ({occ_t}), got {free_t}")));
         }
+        let pt = m.pass_through;
+        probability("map.pass_through.threshold", pt.threshold)?;
+        if pt.threshold <= prior {
+            return Err(err(
+                "map.pass_through.threshold",
+                format!("must be above the prior {prior}, got {}", pt.threshold),
+            ));
+        }
+        if !(0.0..=1.0).contains(&finite("map.pass_through.weight", pt.weight)?) {
+            return Err(err("map.pass_through.weight", format!("must be within [0, 1], got {}", pt.weight)));
+        }
+        if pt.margin_cells > 10_000 {
+            return Err(err(
+                "map.pass_through.margin_cells",
+                format!("must be at most 10000, got {}", pt.margin_cells),
+            ));
+        }
         let occupancy = OccupancyParams {
             prior,
             clamp_min: cmin,
             clamp_max: cmax,
             occupied_threshold: occ_t,
             free_threshold: free_t,
+            pass_through: pt,
         };
 
         let (mut lidars, sensors) = sensor::plan_sensors(&self.sensor, prior)?;

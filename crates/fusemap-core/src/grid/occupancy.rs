@@ -18,11 +18,11 @@
 
 use super::{
     walk_observation, CellBox, CellIndex, CellRaster, CellVisitor, ExtraLayers, GridGeometry, InsertStats,
-    LogOddsTable, MapTile, OccupancyParams, Raster, Ternary, TileKey, TileMap, TILE_SIZE,
+    LogOddsTable, MapTile, OccupancyParams, PassThroughParams, Raster, Ternary, TileKey, TileMap, TILE_SIZE,
 };
 #[cfg(test)]
 use super::{CellRay, TILE_CELLS};
-use crate::grid::logodds::probability;
+use crate::grid::logodds::{logit, probability};
 use crate::measurement::RangeData;
 
 /// One tile of a map with occupancy only.
@@ -47,18 +47,57 @@ pub struct LayeredGrid<L = ()> {
 }
 
 /// The occupancy layer's per-cell update: the hit or the miss increment, kept on fresh
-/// visits only.
+/// visits only, with the pass-through rule of [`PassThroughParams`] on the misses.
 #[derive(Clone, Copy, Debug)]
 pub struct OccupancyUpdate {
     table: LogOddsTable,
     d_hit: f32,
     d_miss: f32,
+    /// The miss increment behind a confidently occupied cell (`weight · d_miss`).
+    d_pass: f32,
+    /// Log-odds at or above which a crossed cell is confidently occupied; `+inf` when the
+    /// rule is off, so the comparison never holds and the update is the plain one.
+    confident: f32,
+    margin: u64,
+    /// Cells of the current ray still to visit after the current one.
+    left: u64,
+    /// The current ray has passed through a confidently occupied cell with more than
+    /// `margin` cells to go.
+    through: bool,
+    attenuated: u64,
 }
 
 impl OccupancyUpdate {
-    /// The update for evidence `(p_hit, p_miss)` against the layer's `table`.
+    /// The update for evidence `(p_hit, p_miss)` against the layer's `table`, without the
+    /// pass-through rule.
     pub fn new(table: LogOddsTable, evidence: crate::measurement::Evidence) -> Self {
-        Self { table, d_hit: table.increment(evidence.p_hit), d_miss: table.increment(evidence.p_miss) }
+        let d_miss = table.increment(evidence.p_miss);
+        Self {
+            table,
+            d_hit: table.increment(evidence.p_hit),
+            d_miss,
+            d_pass: d_miss,
+            confident: f32::INFINITY,
+            margin: 0,
+            left: 0,
+            through: false,
+            attenuated: 0,
+        }
+    }
+
+    /// This update with the pass-through rule `rule` (off when `rule.is_off()`).
+    pub fn with_pass_through(mut self, rule: &PassThroughParams) -> Self {
+        if !rule.is_off() {
+            self.confident = logit(rule.threshold) as f32;
+            self.d_pass = (rule.weight * self.d_miss as f64) as f32;
+            self.margin = rule.margin_cells as u64;
+        }
+        self
+    }
+
+    /// Fresh miss updates applied at the reduced weight so far.
+    pub fn attenuated(&self) -> u64 {
+        self.attenuated
     }
 }
 
@@ -70,7 +109,19 @@ impl<L> CellVisitor<MapTile<L>> for OccupancyUpdate {
 
     #[inline(always)]
     fn pass(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
-        tile.update_log_odds(offset, self.d_miss, &self.table, fresh);
+        self.left = self.left.saturating_sub(1);
+        // A never-observed cell is NaN and `>=` is false for it.
+        let confident = tile.log_odds(offset).is_some_and(|v| v >= self.confident);
+        self.through |= confident & (self.left > self.margin);
+        let d = if self.through { self.d_pass } else { self.d_miss };
+        self.attenuated += (self.through & fresh) as u64;
+        tile.update_log_odds(offset, d, &self.table, fresh);
+    }
+
+    #[inline(always)]
+    fn begin_ray(&mut self, cells: u64) {
+        self.left = cells;
+        self.through = false;
     }
 }
 
@@ -157,8 +208,18 @@ impl<L: ExtraLayers> LayeredGrid<L> {
     /// extra layers `layers` writes (occupancy first on each cell, then `layers`).
     pub fn insert_with<V: CellVisitor<MapTile<L>>>(&mut self, data: &RangeData, layers: &mut V) -> InsertStats {
         self.observations += 1;
-        let mut visitor = (OccupancyUpdate::new(self.table, data.evidence), layers);
-        walk_observation(&mut self.tiles, &self.geometry, self.observations, &data.rays, &mut self.known, &mut visitor)
+        let update = OccupancyUpdate::new(self.table, data.evidence).with_pass_through(&self.params.pass_through);
+        let mut visitor = (update, layers);
+        let mut stats = walk_observation(
+            &mut self.tiles,
+            &self.geometry,
+            self.observations,
+            &data.rays,
+            &mut self.known,
+            &mut visitor,
+        );
+        stats.miss_updates_attenuated = visitor.0.attenuated();
+        stats
     }
 
     /// A dense copy of one layer's cells over `area` (row 0 = lowest y): `cell` reads a
@@ -245,8 +306,11 @@ mod tests {
     use proptest::prelude::*;
     use std::collections::{HashMap, HashSet};
 
+    /// The map without the pass-through rule: these tests pin the plain semantics, bit
+    /// for bit (the rule has its own tests in `pass_through`).
     fn grid() -> OccupancyGrid {
-        OccupancyGrid::new(GridGeometry::centered(1.0).unwrap(), OccupancyParams::default())
+        let params = OccupancyParams { pass_through: PassThroughParams::OFF, ..OccupancyParams::default() };
+        OccupancyGrid::new(GridGeometry::centered(1.0).unwrap(), params)
     }
 
     fn data(rays: Vec<Ray>) -> RangeData {

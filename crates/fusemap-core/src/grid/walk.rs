@@ -36,6 +36,15 @@ pub trait CellVisitor<T> {
     fn hit(&mut self, tile: &mut T, offset: usize, fresh: bool);
     /// A cell a ray crosses, its end cell included (pass 2).
     fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool);
+    /// Called in pass 2 before the first [`pass`](Self::pass) of each ray, with the
+    /// number of cells the ray will visit (its end cell included), so that a visitor can
+    /// tell how far each visited cell lies from the ray's end: the `k`-th visit (from 0)
+    /// is `cells - 1 - k` cells before it. The default does nothing, and a visitor that
+    /// does not need it pays nothing.
+    #[inline(always)]
+    fn begin_ray(&mut self, cells: u64) {
+        let _ = cells;
+    }
 }
 
 /// No layer: the walk alone (its counts and marks).
@@ -55,6 +64,10 @@ impl<T, V: CellVisitor<T> + ?Sized> CellVisitor<T> for &mut V {
     fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool) {
         (**self).pass(tile, offset, fresh)
     }
+    #[inline(always)]
+    fn begin_ray(&mut self, cells: u64) {
+        (**self).begin_ray(cells)
+    }
 }
 
 /// Two layers fed by one walk, first `A` then `B` on each cell.
@@ -68,6 +81,11 @@ impl<T, A: CellVisitor<T>, B: CellVisitor<T>> CellVisitor<T> for (A, B) {
     fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool) {
         self.0.pass(tile, offset, fresh);
         self.1.pass(tile, offset, fresh);
+    }
+    #[inline(always)]
+    fn begin_ray(&mut self, cells: u64) {
+        self.0.begin_ray(cells);
+        self.1.begin_ray(cells);
     }
 }
 
@@ -85,6 +103,10 @@ pub struct InsertStats {
     pub hit_updates: u64,
     /// Cells updated as free (once per observation).
     pub miss_updates: u64,
+    /// Of `miss_updates`, those the occupancy layer applied at a reduced weight because
+    /// the ray had passed through a cell the map held as confidently occupied (see
+    /// [`PassThroughParams`](super::PassThroughParams)).
+    pub miss_updates_attenuated: u64,
 }
 
 impl InsertStats {
@@ -95,6 +117,7 @@ impl InsertStats {
         self.cell_visits += o.cell_visits;
         self.hit_updates += o.hit_updates;
         self.miss_updates += o.miss_updates;
+        self.miss_updates_attenuated += o.miss_updates_attenuated;
     }
 }
 
@@ -142,6 +165,7 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
         let n = walk.len_cells();
         stats.rays += 1;
         stats.cell_visits += n;
+        visitor.begin_ray(n);
         // The union with the known box, written out so that it inlines into the loop.
         let (lo, hi) = known_box.map_or((ca, ca), |k| (k.min, k.max));
         known_box = Some(CellBox {
