@@ -168,7 +168,9 @@ impl Default for MapConfig {
             clamp_max: p.clamp_max,
             occupied_threshold: p.occupied_threshold,
             free_threshold: p.free_threshold,
-            pass_through: p.pass_through,
+            // The configured map handles the lidar's pass-throughs; the core type's
+            // default is the plain model.
+            pass_through: PassThroughParams::default(),
         }
     }
 }

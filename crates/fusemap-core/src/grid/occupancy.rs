@@ -58,6 +58,9 @@ pub struct OccupancyUpdate {
     /// Log-odds at or above which a crossed cell is confidently occupied; `+inf` when the
     /// rule is off, so the comparison never holds and the update is the plain one.
     confident: f32,
+    /// Log-odds below which a crossed cell is known free: the ray has left the object it
+    /// passed through, and the full update resumes.
+    known_free: f32,
     margin: u64,
     /// Cells of the current ray still to visit after the current one.
     left: u64,
@@ -78,6 +81,7 @@ impl OccupancyUpdate {
             d_miss,
             d_pass: d_miss,
             confident: f32::INFINITY,
+            known_free: f32::NEG_INFINITY,
             margin: 0,
             left: 0,
             through: false,
@@ -85,10 +89,12 @@ impl OccupancyUpdate {
         }
     }
 
-    /// This update with the pass-through rule `rule` (off when `rule.is_off()`).
-    pub fn with_pass_through(mut self, rule: &PassThroughParams) -> Self {
+    /// This update with the pass-through rule `rule` (off when `rule.is_off()`); a cell
+    /// below `free_threshold` (probability) ends the attenuation.
+    pub fn with_pass_through(mut self, rule: &PassThroughParams, free_threshold: f64) -> Self {
         if !rule.is_off() {
             self.confident = logit(rule.threshold) as f32;
+            self.known_free = logit(free_threshold) as f32;
             self.d_pass = (rule.weight * self.d_miss as f64) as f32;
             self.margin = rule.margin_cells as u64;
         }
@@ -110,9 +116,10 @@ impl<L> CellVisitor<MapTile<L>> for OccupancyUpdate {
     #[inline(always)]
     fn pass(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
         self.left = self.left.saturating_sub(1);
-        // A never-observed cell is NaN and `>=` is false for it.
-        let confident = tile.log_odds(offset).is_some_and(|v| v >= self.confident);
-        self.through |= confident & (self.left > self.margin);
+        // A never-observed cell is NaN: neither comparison holds for it.
+        let v = tile.log_odds(offset).unwrap_or(f32::NAN);
+        let (confident, free) = (v >= self.confident, v < self.known_free);
+        self.through = (self.through & !free) | (confident & (self.left > self.margin));
         let d = if self.through { self.d_pass } else { self.d_miss };
         self.attenuated += (self.through & fresh) as u64;
         tile.update_log_odds(offset, d, &self.table, fresh);
@@ -208,7 +215,8 @@ impl<L: ExtraLayers> LayeredGrid<L> {
     /// extra layers `layers` writes (occupancy first on each cell, then `layers`).
     pub fn insert_with<V: CellVisitor<MapTile<L>>>(&mut self, data: &RangeData, layers: &mut V) -> InsertStats {
         self.observations += 1;
-        let update = OccupancyUpdate::new(self.table, data.evidence).with_pass_through(&self.params.pass_through);
+        let update = OccupancyUpdate::new(self.table, data.evidence)
+            .with_pass_through(&self.params.pass_through, self.params.free_threshold);
         let mut visitor = (update, layers);
         let mut stats = walk_observation(
             &mut self.tiles,

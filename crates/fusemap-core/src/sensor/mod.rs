@@ -4,6 +4,8 @@
 
 pub mod camera;
 pub mod lidar;
+pub mod lidar_filters;
 
 pub use camera::{DepthImage, ImageError, LabelImage};
 pub use lidar::{LaserScan, LidarModel, LidarParams, MaxRangePolicy, ReturnCounts};
+pub use lidar_filters::{AngularBounds, ScanFilters, SelfBox, ShadowFilter, SpeckleFilter};

@@ -135,6 +135,7 @@ fn reference(observations: &[Vec<Ray>], table: &LogOddsTable, rule: &PassThrough
     let (d_hit, d_miss) = (table.increment(0.9), table.increment(0.4));
     let d_pass = (rule.weight * d_miss as f64) as f32;
     let confident = logit(rule.threshold) as f32;
+    let free = logit(OccupancyParams::default().free_threshold) as f32;
     for rays in observations {
         let mut done: HashSet<CellIndex> = HashSet::new();
         for r in rays.iter().filter(|r| r.hit) {
@@ -149,7 +150,9 @@ fn reference(observations: &[Vec<Ray>], table: &LogOddsTable, rule: &PassThrough
             let mut through = false;
             for (k, c) in walk.iter().enumerate() {
                 let after = walk.len() - 1 - k;
-                through |= cells.get(c).is_some_and(|&v| v >= confident) && after > rule.margin_cells as usize;
+                let v = cells.get(c).copied();
+                through = (through && !v.is_some_and(|v| v < free))
+                    || (v.is_some_and(|v| v >= confident) && after > rule.margin_cells as usize);
                 if done.insert(*c) {
                     let v = cells.get(c).copied().unwrap_or(table.prior);
                     cells.insert(*c, table.update(v, if through { d_pass } else { d_miss }));
