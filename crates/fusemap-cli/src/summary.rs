@@ -26,6 +26,9 @@ pub struct Summary {
     pub rays_rejected: u64,
     /// Cells visited by the walks (a cell counts once per ray crossing it).
     pub cell_visits: u64,
+    /// Of `cell_visits`, those whose free evidence had the reduced weight of the
+    /// pass-through rule (`[map.pass_through]`): behind a confidently occupied cell.
+    pub cell_visits_attenuated: u64,
     /// Cell updates applied (at most one per cell per scan).
     pub cells_updated: CellsUpdated,
     /// The exported raster.
@@ -48,21 +51,13 @@ pub struct CellsUpdated {
     pub occupied: u64,
     /// Free (miss) updates.
     pub free: u64,
-    /// Of `free`, those applied at the reduced weight of the pass-through rule
-    /// (`[map.pass_through]`): the ray had passed through a confidently occupied cell.
-    pub free_attenuated: u64,
     /// Both.
     pub total: u64,
 }
 
 impl From<&InsertStats> for CellsUpdated {
     fn from(s: &InsertStats) -> Self {
-        Self {
-            occupied: s.hit_updates,
-            free: s.miss_updates,
-            free_attenuated: s.miss_updates_attenuated,
-            total: s.hit_updates + s.miss_updates,
-        }
+        Self { occupied: s.hit_updates, free: s.miss_updates, total: s.hit_updates + s.miss_updates }
     }
 }
 

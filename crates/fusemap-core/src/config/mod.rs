@@ -439,5 +439,41 @@ mod tests {
         let mut c = Config::default();
         c.log.gap_bridge_motion_m = -1.0;
         assert_eq!(field_of(c), "log.gap_bridge_motion_m");
+        let map = |f: fn(&mut PassThroughParams)| {
+            let mut c = Config::default();
+            f(&mut c.map.pass_through);
+            field_of(c)
+        };
+        assert_eq!(map(|p| p.weight = 1.5), "map.pass_through.weight");
+        assert_eq!(map(|p| p.threshold = 0.3), "map.pass_through.threshold");
+        assert_eq!(map(|p| p.threshold = f64::NAN), "map.pass_through.threshold");
+        assert_eq!(map(|p| p.margin_cells = 1_000_000), "map.pass_through.margin_cells");
+        let filters = |f: fn(&mut crate::sensor::ScanFilters)| {
+            let mut filters = crate::sensor::ScanFilters::default();
+            f(&mut filters);
+            let mut c = Config::default();
+            c.sensor.push(SensorConfig { filters: Some(filters), ..SensorConfig::new(SensorKind::Lidar) });
+            field_of(c)
+        };
+        assert_eq!(filters(|f| f.speckle.window = 0), "sensor[0].filters.speckle.window");
+        assert_eq!(filters(|f| f.self_box.max = [-1.0, 0.0]), "sensor[0].filters.box");
+        let c = Config {
+            sensor: vec![SensorConfig {
+                filters: Some(crate::sensor::ScanFilters::default()),
+                ..SensorConfig::new(SensorKind::Imu)
+            }],
+            ..Default::default()
+        };
+        assert_eq!(field_of(c), "sensor[0].filters");
+    }
+
+    #[test]
+    fn a_configured_map_handles_pass_throughs_and_the_core_default_does_not() {
+        let plan = Config::default().validate().unwrap();
+        assert_eq!(plan.occupancy.pass_through, PassThroughParams::default());
+        assert!(!plan.occupancy.pass_through.is_off());
+        assert!(OccupancyParams::default().pass_through.is_off());
+        // Filters are off by default everywhere (lossless on the corrected CARMEN logs).
+        assert!(!plan.lidars[0].model.params().filters.any());
     }
 }

@@ -48,6 +48,12 @@ pub struct LayeredGrid<L = ()> {
 
 /// The occupancy layer's per-cell update: the hit or the miss increment, kept on fresh
 /// visits only, with the pass-through rule of [`PassThroughParams`] on the misses.
+///
+/// The rule costs the common path one comparison: a crossed cell goes to the rule's own
+/// code only when its log-odds reach `hi` — the confidence threshold while the ray is in
+/// the open (`+inf` when the rule is off, so never), `-inf` while it is behind a
+/// confident cell (every observed cell then, to find where it leaves the object); cells
+/// never observed (NaN) always take the common path with the current increment `d_cur`.
 #[derive(Clone, Copy, Debug)]
 pub struct OccupancyUpdate {
     table: LogOddsTable,
@@ -55,18 +61,21 @@ pub struct OccupancyUpdate {
     d_miss: f32,
     /// The miss increment behind a confidently occupied cell (`weight · d_miss`).
     d_pass: f32,
+    /// The miss increment of the common path: `d_miss`, or `d_pass` behind a confident cell.
+    d_cur: f32,
     /// Log-odds at or above which a crossed cell is confidently occupied; `+inf` when the
-    /// rule is off, so the comparison never holds and the update is the plain one.
+    /// rule is off.
     confident: f32,
     /// Log-odds below which a crossed cell is known free: the ray has left the object it
     /// passed through, and the full update resumes.
     known_free: f32,
+    /// The common path's bound (see the type docs).
+    hi: f32,
     margin: u64,
-    /// Cells of the current ray still to visit after the current one.
-    left: u64,
-    /// The current ray has passed through a confidently occupied cell with more than
-    /// `margin` cells to go.
+    /// The current ray is behind a confident cell; `since` is that cell's distance to the
+    /// ray's end, in cells.
     through: bool,
+    since: u64,
     attenuated: u64,
 }
 
@@ -80,11 +89,13 @@ impl OccupancyUpdate {
             d_hit: table.increment(evidence.p_hit),
             d_miss,
             d_pass: d_miss,
+            d_cur: d_miss,
             confident: f32::INFINITY,
             known_free: f32::NEG_INFINITY,
+            hi: f32::INFINITY,
             margin: 0,
-            left: 0,
             through: false,
+            since: 0,
             attenuated: 0,
         }
     }
@@ -94,6 +105,7 @@ impl OccupancyUpdate {
     pub fn with_pass_through(mut self, rule: &PassThroughParams, free_threshold: f64) -> Self {
         if !rule.is_off() {
             self.confident = logit(rule.threshold) as f32;
+            self.hi = self.confident;
             self.known_free = logit(free_threshold) as f32;
             self.d_pass = (rule.weight * self.d_miss as f64) as f32;
             self.margin = rule.margin_cells as u64;
@@ -101,9 +113,47 @@ impl OccupancyUpdate {
         self
     }
 
-    /// Fresh miss updates applied at the reduced weight so far.
+    /// Cell visits so far at which the reduced weight applied (counted like
+    /// [`InsertStats::cell_visits`]); call [`finish`](Self::finish) after the last ray.
     pub fn attenuated(&self) -> u64 {
         self.attenuated
+    }
+
+    /// Ends the current ray (counts its attenuated visits).
+    #[inline(always)]
+    pub fn finish(&mut self) {
+        if self.through {
+            self.attenuated += self.since + 1;
+        }
+        self.through = false;
+        self.hi = self.confident;
+        self.d_cur = self.d_miss;
+    }
+
+    /// The rule on an observed cell at or above `hi`: updates the ray's state and returns
+    /// the miss increment for the cell.
+    #[inline(always)]
+    fn rule(&mut self, v: f32, cells_after: u64) -> f32 {
+        if self.through {
+            if v < self.known_free {
+                // Out of the object: this cell and the rest at full weight.
+                self.attenuated += self.since - cells_after;
+                self.through = false;
+                self.hi = self.confident;
+                self.d_cur = self.d_miss;
+                return self.d_miss;
+            }
+            self.d_pass
+        } else if cells_after > self.margin {
+            // A confident cell with more than the margin to go: a probable pass-through.
+            self.through = true;
+            self.since = cells_after;
+            self.hi = f32::NEG_INFINITY;
+            self.d_cur = self.d_pass;
+            self.d_pass
+        } else {
+            self.d_miss
+        }
     }
 }
 
@@ -115,20 +165,37 @@ impl<L> CellVisitor<MapTile<L>> for OccupancyUpdate {
 
     #[inline(always)]
     fn pass(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
-        self.left = self.left.saturating_sub(1);
-        // A never-observed cell is NaN: neither comparison holds for it.
+        // Without the distance to the ray's end the rule cannot be judged: a plain miss.
+        tile.update_log_odds(offset, self.d_miss, &self.table, fresh);
+    }
+
+    #[inline(always)]
+    fn pass_at(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool, cells_after: u64) {
+        // NaN (never observed) fails the comparison and takes the common path.
         let v = tile.log_odds(offset).unwrap_or(f32::NAN);
-        let (confident, free) = (v >= self.confident, v < self.known_free);
-        self.through = (self.through & !free) | (confident & (self.left > self.margin));
-        let d = if self.through { self.d_pass } else { self.d_miss };
-        self.attenuated += (self.through & fresh) as u64;
+        let d = if v >= self.hi { self.rule(v, cells_after) } else { self.d_cur };
         tile.update_log_odds(offset, d, &self.table, fresh);
     }
 
     #[inline(always)]
-    fn begin_ray(&mut self, cells: u64) {
-        self.left = cells;
-        self.through = false;
+    fn begin_ray(&mut self, _cells: u64) {
+        self.finish();
+    }
+}
+
+/// The occupancy update with the rule off: `pass_at` is the default (a plain miss), so a
+/// map without the rule runs exactly the walk it ran before the rule existed, at its cost.
+struct PlainUpdate(OccupancyUpdate);
+
+impl<L> CellVisitor<MapTile<L>> for PlainUpdate {
+    #[inline(always)]
+    fn hit(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
+        self.0.hit(tile, offset, fresh);
+    }
+
+    #[inline(always)]
+    fn pass(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
+        CellVisitor::<MapTile<L>>::pass(&mut self.0, tile, offset, fresh);
     }
 }
 
@@ -215,18 +282,17 @@ impl<L: ExtraLayers> LayeredGrid<L> {
     /// extra layers `layers` writes (occupancy first on each cell, then `layers`).
     pub fn insert_with<V: CellVisitor<MapTile<L>>>(&mut self, data: &RangeData, layers: &mut V) -> InsertStats {
         self.observations += 1;
-        let update = OccupancyUpdate::new(self.table, data.evidence)
-            .with_pass_through(&self.params.pass_through, self.params.free_threshold);
-        let mut visitor = (update, layers);
-        let mut stats = walk_observation(
-            &mut self.tiles,
-            &self.geometry,
-            self.observations,
-            &data.rays,
-            &mut self.known,
-            &mut visitor,
-        );
-        stats.miss_updates_attenuated = visitor.0.attenuated();
+        let update = OccupancyUpdate::new(self.table, data.evidence);
+        let (tiles, known, obs) = (&mut self.tiles, &mut self.known, self.observations);
+        if self.params.pass_through.is_off() {
+            let mut visitor = (PlainUpdate(update), layers);
+            return walk_observation(tiles, &self.geometry, obs, &data.rays, known, &mut visitor);
+        }
+        let rule = update.with_pass_through(&self.params.pass_through, self.params.free_threshold);
+        let mut visitor = (rule, layers);
+        let mut stats = walk_observation(tiles, &self.geometry, obs, &data.rays, known, &mut visitor);
+        visitor.0.finish();
+        stats.cell_visits_attenuated = visitor.0.attenuated();
         stats
     }
 

@@ -36,14 +36,20 @@ pub trait CellVisitor<T> {
     fn hit(&mut self, tile: &mut T, offset: usize, fresh: bool);
     /// A cell a ray crosses, its end cell included (pass 2).
     fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool);
-    /// Called in pass 2 before the first [`pass`](Self::pass) of each ray, with the
-    /// number of cells the ray will visit (its end cell included), so that a visitor can
-    /// tell how far each visited cell lies from the ray's end: the `k`-th visit (from 0)
-    /// is `cells - 1 - k` cells before it. The default does nothing, and a visitor that
-    /// does not need it pays nothing.
+    /// Called in pass 2 before the first visit of each ray, with the number of cells the
+    /// ray will visit (its end cell included). The default does nothing.
     #[inline(always)]
     fn begin_ray(&mut self, cells: u64) {
         let _ = cells;
+    }
+    /// [`pass`](Self::pass) with the number of cells the ray still visits after this one
+    /// (0 at its end cell), which the walk knows for free; what pass 2 calls. A visitor that
+    /// needs to know how far each cell lies from the ray's end (the occupancy layer's
+    /// pass-through rule) overrides this; the default forgets it and calls `pass`.
+    #[inline(always)]
+    fn pass_at(&mut self, tile: &mut T, offset: usize, fresh: bool, cells_after: u64) {
+        let _ = cells_after;
+        self.pass(tile, offset, fresh)
     }
 }
 
@@ -68,6 +74,10 @@ impl<T, V: CellVisitor<T> + ?Sized> CellVisitor<T> for &mut V {
     fn begin_ray(&mut self, cells: u64) {
         (**self).begin_ray(cells)
     }
+    #[inline(always)]
+    fn pass_at(&mut self, tile: &mut T, offset: usize, fresh: bool, cells_after: u64) {
+        (**self).pass_at(tile, offset, fresh, cells_after)
+    }
 }
 
 /// Two layers fed by one walk, first `A` then `B` on each cell.
@@ -87,6 +97,11 @@ impl<T, A: CellVisitor<T>, B: CellVisitor<T>> CellVisitor<T> for (A, B) {
         self.0.begin_ray(cells);
         self.1.begin_ray(cells);
     }
+    #[inline(always)]
+    fn pass_at(&mut self, tile: &mut T, offset: usize, fresh: bool, cells_after: u64) {
+        self.0.pass_at(tile, offset, fresh, cells_after);
+        self.1.pass_at(tile, offset, fresh, cells_after);
+    }
 }
 
 /// What one insertion did.
@@ -103,10 +118,10 @@ pub struct InsertStats {
     pub hit_updates: u64,
     /// Cells updated as free (once per observation).
     pub miss_updates: u64,
-    /// Of `miss_updates`, those the occupancy layer applied at a reduced weight because
-    /// the ray had passed through a cell the map held as confidently occupied (see
-    /// [`PassThroughParams`](super::PassThroughParams)).
-    pub miss_updates_attenuated: u64,
+    /// Of `cell_visits`, those at which the occupancy layer's free evidence had the
+    /// reduced weight of the pass-through rule: the ray had passed through a cell the map
+    /// held as confidently occupied (see [`PassThroughParams`](super::PassThroughParams)).
+    pub cell_visits_attenuated: u64,
 }
 
 impl InsertStats {
@@ -117,7 +132,7 @@ impl InsertStats {
         self.cell_visits += o.cell_visits;
         self.hit_updates += o.hit_updates;
         self.miss_updates += o.miss_updates;
-        self.miss_updates_attenuated += o.miss_updates_attenuated;
+        self.cell_visits_attenuated += o.cell_visits_attenuated;
     }
 }
 
@@ -183,7 +198,8 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
         loop {
             let fresh = tile.mark().test_and_set(offset as usize);
             stats.miss_updates += fresh as u64;
-            visitor.pass(tile, offset as usize, fresh);
+            // Before the step, the walk's own count says how many cells follow this one.
+            visitor.pass_at(tile, offset as usize, fresh, walk.cells_after());
             match walk.step() {
                 Step::Done => break,
                 Step::X => {

@@ -102,15 +102,15 @@ fn a_ray_ending_within_the_margin_is_a_plain_miss() {
     // Ends 3 cells behind (= the margin): the full miss.
     let s = g.insert(&data(vec![ray(5.0 + rule.margin_cells as f64, true)]));
     assert_eq!(g.log_odds(PILLAR), Some(g.table().update(before, d)));
-    assert_eq!(s.miss_updates_attenuated, 0);
+    assert_eq!(s.cell_visits_attenuated, 0);
     // Ends 4 cells behind: a quarter of it, on the pillar and the cells after it.
     let before = g.log_odds(PILLAR).unwrap();
     let near = g.log_odds(CellIndex::new(2, 0)).unwrap();
     let s = g.insert(&data(vec![ray(6.0 + rule.margin_cells as f64, true)]));
     let quarter = (rule.weight * d as f64) as f32;
     assert_eq!(g.log_odds(PILLAR), Some(g.table().update(before, quarter)));
-    // Cells 5, 6, 7, 8 (the end cell 9 is the hit).
-    assert_eq!(s.miss_updates_attenuated, 4);
+    // Visits of cells 5 to 9 (the end cell 9, the hit, is visited but not updated).
+    assert_eq!(s.cell_visits_attenuated, 5);
     assert_eq!(g.log_odds(CellIndex::new(7, 0)), Some(g.table().update(d, quarter)));
     // The cells before it got the full miss.
     assert_eq!(g.log_odds(CellIndex::new(2, 0)), Some(g.table().update(near, d)));
@@ -122,7 +122,7 @@ fn a_cell_below_the_threshold_shields_nothing() {
     // One hit: p = 0.9 < 0.95.
     g.insert(&data(vec![ray(5.0, true)]));
     let s = g.insert(&data(vec![ray(20.0, true)]));
-    assert_eq!(s.miss_updates_attenuated, 0);
+    assert_eq!(s.cell_visits_attenuated, 0);
     let t = *g.table();
     assert_eq!(g.log_odds(PILLAR), Some(t.update(t.increment(0.9), t.increment(0.4))));
 }

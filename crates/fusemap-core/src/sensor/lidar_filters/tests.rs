@@ -145,7 +145,8 @@ fn the_self_box_is_in_the_base_frame() {
 
 #[test]
 fn bad_parameters_name_their_key() {
-    let cases: [(fn(&mut ScanFilters), &str); 6] = [
+    type Edit = fn(&mut ScanFilters);
+    let cases: [(Edit, &str); 6] = [
         (|s| s.shadow.min_angle_deg = 0.0, "shadow.min_angle_deg"),
         (|s| s.shadow.window = 0, "shadow.window"),
         (|s| s.shadow.neighbors = 1000, "shadow.neighbors"),
