@@ -183,6 +183,7 @@ pub fn finish(
         rays_walked: st.insert.rays,
         rays_rejected: st.insert.rays_rejected,
         cell_visits: st.insert.cell_visits,
+        cell_visits_attenuated: st.insert.cell_visits_attenuated,
         cells_updated: CellsUpdated::from(&st.insert),
         map: MapInfo::new(raster.as_ref(), grid.geometry().resolution(), grid.tile_count()),
         entropy: raster.as_ref().map(map_entropy),

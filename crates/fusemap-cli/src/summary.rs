@@ -26,6 +26,9 @@ pub struct Summary {
     pub rays_rejected: u64,
     /// Cells visited by the walks (a cell counts once per ray crossing it).
     pub cell_visits: u64,
+    /// Of `cell_visits`, those whose free evidence had the reduced weight of the
+    /// pass-through rule (`[map.pass_through]`): behind a confidently occupied cell.
+    pub cell_visits_attenuated: u64,
     /// Cell updates applied (at most one per cell per scan).
     pub cells_updated: CellsUpdated,
     /// The exported raster.

@@ -16,7 +16,7 @@ pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSen
 
 use crate::estimator::EstimatorConfig;
 use crate::geometry::Point2;
-use crate::grid::{GridGeometry, OccupancyParams};
+use crate::grid::{GridGeometry, OccupancyParams, PassThroughParams};
 use crate::sensor::ClassTable;
 use serde::{Deserialize, Serialize};
 
@@ -164,6 +164,9 @@ pub struct MapConfig {
     pub occupied_threshold: f64,
     /// A cell is free below this probability.
     pub free_threshold: f64,
+    /// Free evidence behind confidently occupied cells (`[map.pass_through]`).
+    #[serde(default)]
+    pub pass_through: PassThroughParams,
 }
 
 impl Default for MapConfig {
@@ -177,6 +180,9 @@ impl Default for MapConfig {
             clamp_max: p.clamp_max,
             occupied_threshold: p.occupied_threshold,
             free_threshold: p.free_threshold,
+            // The configured map handles the lidar's pass-throughs; the core type's
+            // default is the plain model.
+            pass_through: PassThroughParams::default(),
         }
     }
 }
@@ -271,12 +277,30 @@ impl Config {
         if free_t >= occ_t {
             return Err(err("map.free_threshold", format!("must be below occupied_threshold ({occ_t}), got {free_t}")));
         }
+        let pt = m.pass_through;
+        probability("map.pass_through.threshold", pt.threshold)?;
+        if pt.threshold <= prior {
+            return Err(err(
+                "map.pass_through.threshold",
+                format!("must be above the prior {prior}, got {}", pt.threshold),
+            ));
+        }
+        if !(0.0..=1.0).contains(&finite("map.pass_through.weight", pt.weight)?) {
+            return Err(err("map.pass_through.weight", format!("must be within [0, 1], got {}", pt.weight)));
+        }
+        if pt.margin_cells > 10_000 {
+            return Err(err(
+                "map.pass_through.margin_cells",
+                format!("must be at most 10000, got {}", pt.margin_cells),
+            ));
+        }
         let occupancy = OccupancyParams {
             prior,
             clamp_min: cmin,
             clamp_max: cmax,
             occupied_threshold: occ_t,
             free_threshold: free_t,
+            pass_through: pt,
         };
 
         let sensor::PlannedSensors { mut lidars, cameras, others: sensors } =
@@ -453,5 +477,41 @@ mod tests {
         let mut c = Config::default();
         c.log.gap_bridge_motion_m = -1.0;
         assert_eq!(field_of(c), "log.gap_bridge_motion_m");
+        let map = |f: fn(&mut PassThroughParams)| {
+            let mut c = Config::default();
+            f(&mut c.map.pass_through);
+            field_of(c)
+        };
+        assert_eq!(map(|p| p.weight = 1.5), "map.pass_through.weight");
+        assert_eq!(map(|p| p.threshold = 0.3), "map.pass_through.threshold");
+        assert_eq!(map(|p| p.threshold = f64::NAN), "map.pass_through.threshold");
+        assert_eq!(map(|p| p.margin_cells = 1_000_000), "map.pass_through.margin_cells");
+        let filters = |f: fn(&mut crate::sensor::ScanFilters)| {
+            let mut filters = crate::sensor::ScanFilters::default();
+            f(&mut filters);
+            let mut c = Config::default();
+            c.sensor.push(SensorConfig { filters: Some(filters), ..SensorConfig::new(SensorKind::Lidar) });
+            field_of(c)
+        };
+        assert_eq!(filters(|f| f.speckle.window = 0), "sensor[0].filters.speckle.window");
+        assert_eq!(filters(|f| f.self_box.max = [-1.0, 0.0]), "sensor[0].filters.box");
+        let c = Config {
+            sensor: vec![SensorConfig {
+                filters: Some(crate::sensor::ScanFilters::default()),
+                ..SensorConfig::new(SensorKind::Imu)
+            }],
+            ..Default::default()
+        };
+        assert_eq!(field_of(c), "sensor[0].filters");
+    }
+
+    #[test]
+    fn a_configured_map_handles_pass_throughs_and_the_core_default_does_not() {
+        let plan = Config::default().validate().unwrap();
+        assert_eq!(plan.occupancy.pass_through, PassThroughParams::default());
+        assert!(!plan.occupancy.pass_through.is_off());
+        assert!(OccupancyParams::default().pass_through.is_off());
+        // Filters are off by default everywhere (lossless on the corrected CARMEN logs).
+        assert!(!plan.lidars[0].model.params().filters.any());
     }
 }

@@ -12,7 +12,7 @@
 //! `enabled = false` switches a kind off, auto-detection included.
 
 use crate::geometry::{Mount3, PlanarMount};
-use crate::sensor::{LidarModel, LidarParams, MaxRangePolicy};
+use crate::sensor::{LidarModel, LidarParams, MaxRangePolicy, ScanFilters};
 use serde::{Deserialize, Serialize};
 
 use super::camera::{plan_camera, PlannedCamera};
@@ -129,6 +129,10 @@ pub struct SensorConfig {
     /// Lidar: largest tilt of the scan plane accepted, degrees.
     #[serde(default)]
     pub max_tilt_deg: Option<f64>,
+    /// Lidar: the scan filters (`[sensor.filters.shadow]`, `.speckle`, `.angular_bounds`,
+    /// `.box`); a filter table left out keeps that filter's defaults.
+    #[serde(default)]
+    pub filters: Option<ScanFilters>,
 
     /// Wheel odometry: translation σ after one metre, per axis, m/√m (default: the
     /// estimator's `odometry_translation_noise`).
@@ -235,6 +239,7 @@ impl SensorConfig {
             max_range: None,
             max_range_policy: None,
             max_tilt_deg: None,
+            filters: None,
             translation_noise_per_sqrt_m: None,
             rotation_noise_per_sqrt_rad: None,
             rotation_noise_per_sqrt_m: None,
@@ -276,6 +281,7 @@ impl SensorConfig {
         check(self.max_range.is_some(), "max_range", SensorKind::Lidar);
         check(self.max_range_policy.is_some(), "max_range_policy", SensorKind::Lidar);
         check(self.max_tilt_deg.is_some(), "max_tilt_deg", SensorKind::Lidar);
+        check(self.filters.is_some(), "filters", SensorKind::Lidar);
         let odo = SensorKind::WheelOdometry;
         check(self.translation_noise_per_sqrt_m.is_some(), "translation_noise_per_sqrt_m", odo);
         check(self.rotation_noise_per_sqrt_rad.is_some(), "rotation_noise_per_sqrt_rad", odo);
@@ -536,7 +542,9 @@ fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<Pl
         min_range: min_r,
         max_range: max_r,
         max_range_policy: s.max_range_policy.unwrap_or(d.max_range_policy),
+        filters: s.filters.unwrap_or_default(),
     };
+    params.filters.validate().map_err(|(k, m)| err(f(&format!("filters.{k}")), m))?;
     Ok(PlannedLidar {
         name,
         model: LidarModel::new(params, mount),

@@ -2,12 +2,15 @@
 //! (merged with its correlation group's, when it belongs to one), and the dynamic layer's
 //! routing and clearing.
 
-use super::{CellVisitor, DynamicUpdate, FusionLayers, Group, LogOddsTable, MapTile};
+use super::{
+    CellVisitor, DynamicUpdate, FusionLayers, Group, LogOddsTable, MapTile, OccupancyUpdate, PassThroughParams,
+};
 use crate::measurement::Evidence;
 
 /// The per-cell update of a range observation into a [`FusionGrid`](super::FusionGrid).
 ///
-/// * Occupancy: the hit or miss increment of the evidence, once per observation; as a
+/// * Occupancy: the hit or miss increment of the evidence, once per observation, with the
+///   pass-through rule of [`PassThroughParams`] on the misses ([`OccupancyUpdate`]); as a
 ///   member of a correlation [`Group`], merged with the group's other members.
 /// * Dynamic layer (when given): a hit on a cell that holds a dynamic object now goes to
 ///   the dynamic layer instead of the static one (a lidar return from a person the camera
@@ -15,12 +18,12 @@ use crate::measurement::Evidence;
 ///   clears it there (the object has left).
 ///
 /// With neither a group nor a dynamic layer the update is the plain occupancy update,
-/// branch-free, bit for bit [`OccupancyUpdate`](super::OccupancyUpdate)'s.
+/// bit for bit [`OccupancyUpdate`]'s.
 #[derive(Clone, Debug)]
 pub struct FusedUpdate {
+    occ: OccupancyUpdate,
     table: LogOddsTable,
     d_hit: f32,
-    d_miss: f32,
     group: Option<Group>,
     dynamic: Option<DynamicUpdate>,
     route_hits: bool,
@@ -30,18 +33,21 @@ pub struct FusedUpdate {
 }
 
 impl FusedUpdate {
-    /// The update for `evidence` against the map's `table`.
+    /// The update for `evidence` against the map's `table`, with the pass-through rule
+    /// `pass_through` (cells below the free threshold it gives end it).
     pub fn new(
         table: LogOddsTable,
         evidence: Evidence,
+        pass_through: (&PassThroughParams, f64),
         group: Option<Group>,
         dynamic: Option<DynamicUpdate>,
         route_hits: bool,
     ) -> Self {
+        let occ = OccupancyUpdate::new(table, evidence).with_pass_through(pass_through.0, pass_through.1);
         Self {
+            occ,
             table,
             d_hit: table.increment(evidence.p_hit),
-            d_miss: table.increment(evidence.p_miss),
             group,
             dynamic,
             route_hits,
@@ -69,6 +75,18 @@ impl FusedUpdate {
     }
 }
 
+impl FusedUpdate {
+    /// Ends the last ray; call after the walk.
+    pub fn finish(&mut self) {
+        self.occ.finish();
+    }
+
+    /// Cell visits at which the pass-through rule's reduced weight applied.
+    pub fn attenuated(&self) -> u64 {
+        self.occ.attenuated()
+    }
+}
+
 impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
     #[inline(always)]
     fn hit(&mut self, tile: &mut MapTile<FusionLayers>, offset: usize, fresh: bool) {
@@ -91,16 +109,29 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
 
     #[inline(always)]
     fn pass(&mut self, tile: &mut MapTile<FusionLayers>, offset: usize, fresh: bool) {
+        // The walk calls `pass_at`; without the distance to the ray's end, a plain miss.
+        self.pass_at(tile, offset, fresh, u64::MAX);
+    }
+
+    #[inline(always)]
+    fn pass_at(&mut self, tile: &mut MapTile<FusionLayers>, offset: usize, fresh: bool, cells_after: u64) {
         if self.plain {
-            tile.update_log_odds(offset, self.d_miss, &self.table, fresh);
+            CellVisitor::<MapTile<FusionLayers>>::pass_at(&mut self.occ, tile, offset, fresh, cells_after);
             return;
         }
+        // The rule's state follows every visit of the ray, fresh or not.
+        let d = self.occ.miss_increment(tile.log_odds(offset).unwrap_or(f32::NAN), cells_after);
         if !fresh {
             return;
         }
-        Self::occupancy(&self.table, self.group, tile, offset, self.d_miss);
+        Self::occupancy(&self.table, self.group, tile, offset, d);
         if let Some(dy) = &self.dynamic {
             dy.clear(&mut tile.layers_mut().dynamic, offset);
         }
+    }
+
+    #[inline(always)]
+    fn begin_ray(&mut self, cells: u64) {
+        CellVisitor::<MapTile<FusionLayers>>::begin_ray(&mut self.occ, cells);
     }
 }

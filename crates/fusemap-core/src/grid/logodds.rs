@@ -53,12 +53,28 @@ pub struct OccupancyParams {
     pub occupied_threshold: f64,
     /// A cell is free when its probability is below this.
     pub free_threshold: f64,
+    /// How free evidence behind a confidently occupied cell is weighed. Off in
+    /// `OccupancyParams::default()` (the plain model of Thrun et al.); the configuration's
+    /// `[map.pass_through]` turns it on by default (see [`PassThroughParams`](super::PassThroughParams)).
+    #[serde(default = "pass_through_off")]
+    pub pass_through: super::PassThroughParams,
 }
 
 impl Default for OccupancyParams {
     fn default() -> Self {
-        Self { prior: 0.5, clamp_min: 0.12, clamp_max: 0.97, occupied_threshold: 0.65, free_threshold: 0.25 }
+        Self {
+            prior: 0.5,
+            clamp_min: 0.12,
+            clamp_max: 0.97,
+            occupied_threshold: 0.65,
+            free_threshold: 0.25,
+            pass_through: super::PassThroughParams::OFF,
+        }
     }
+}
+
+fn pass_through_off() -> super::PassThroughParams {
+    super::PassThroughParams::OFF
 }
 
 /// The same parameters in log-odds form, precomputed once for the update loop.

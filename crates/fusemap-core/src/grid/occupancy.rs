@@ -18,11 +18,12 @@
 
 use super::{
     walk_observation, CellBox, CellIndex, CellRaster, CellVisitor, ExtraLayers, GridGeometry, InsertStats,
-    LogOddsTable, MapTile, MarkedTile, OccupancyParams, Raster, Ternary, TileKey, TileMap, TILE_SIZE,
+    LogOddsTable, MapTile, MarkedTile, OccupancyParams, PassThroughParams, Raster, Ternary, TileKey, TileMap,
+    TILE_SIZE,
 };
 #[cfg(test)]
 use super::{CellRay, TILE_CELLS};
-use crate::grid::logodds::probability;
+use crate::grid::logodds::{logit, probability};
 use crate::measurement::RangeData;
 
 /// One tile of a map with occupancy only.
@@ -47,18 +48,138 @@ pub struct LayeredGrid<L = ()> {
 }
 
 /// The occupancy layer's per-cell update: the hit or the miss increment, kept on fresh
-/// visits only.
+/// visits only, with the pass-through rule of [`PassThroughParams`] on the misses.
+///
+/// The rule costs the common path one comparison: a crossed cell goes to the rule's own
+/// code only when its log-odds reach `hi` — the confidence threshold while the ray is in
+/// the open (`+inf` when the rule is off, so never), `-inf` while it is behind a
+/// confident cell (every observed cell then, to find where it leaves the object); cells
+/// never observed (NaN) always take the common path with the current increment `d_cur`.
 #[derive(Clone, Copy, Debug)]
 pub struct OccupancyUpdate {
     table: LogOddsTable,
     d_hit: f32,
     d_miss: f32,
+    /// The miss increment behind a confidently occupied cell (`weight · d_miss`).
+    d_pass: f32,
+    /// The miss increment of the common path: `d_miss`, or `d_pass` behind a confident cell.
+    d_cur: f32,
+    /// Log-odds at or above which a crossed cell is confidently occupied; `+inf` when the
+    /// rule is off.
+    confident: f32,
+    /// Log-odds below which a crossed cell is known free: the ray has left the object it
+    /// passed through, and the full update resumes.
+    known_free: f32,
+    /// The common path's bound (see the type docs).
+    hi: f32,
+    margin: u64,
+    /// The current ray is behind a confident cell; `since` is that cell's distance to the
+    /// ray's end, in cells.
+    through: bool,
+    since: u64,
+    attenuated: u64,
 }
 
 impl OccupancyUpdate {
-    /// The update for evidence `(p_hit, p_miss)` against the layer's `table`.
+    /// The update for evidence `(p_hit, p_miss)` against the layer's `table`, without the
+    /// pass-through rule.
     pub fn new(table: LogOddsTable, evidence: crate::measurement::Evidence) -> Self {
-        Self { table, d_hit: table.increment(evidence.p_hit), d_miss: table.increment(evidence.p_miss) }
+        let d_miss = table.increment(evidence.p_miss);
+        Self {
+            table,
+            d_hit: table.increment(evidence.p_hit),
+            d_miss,
+            d_pass: d_miss,
+            d_cur: d_miss,
+            confident: f32::INFINITY,
+            known_free: f32::NEG_INFINITY,
+            hi: f32::INFINITY,
+            margin: 0,
+            through: false,
+            since: 0,
+            attenuated: 0,
+        }
+    }
+
+    /// This update with the pass-through rule `rule` (off when `rule.is_off()`); a cell
+    /// below `free_threshold` (probability) ends the attenuation.
+    pub fn with_pass_through(mut self, rule: &PassThroughParams, free_threshold: f64) -> Self {
+        if !rule.is_off() {
+            self.confident = logit(rule.threshold) as f32;
+            self.hi = self.confident;
+            self.known_free = logit(free_threshold) as f32;
+            self.d_pass = (rule.weight * self.d_miss as f64) as f32;
+            self.margin = rule.margin_cells as u64;
+        }
+        self
+    }
+
+    /// The miss increment for a crossed cell holding `v` (NaN: never observed) with
+    /// `cells_after` cells of the ray still to come, advancing the ray's pass-through
+    /// state. Called on every visit of a ray's cells in order, fresh or not.
+    #[inline(always)]
+    pub fn miss_increment(&mut self, v: f32, cells_after: u64) -> f32 {
+        // NaN (never observed) fails the comparison and takes the common path.
+        if v >= self.hi {
+            self.rule(v, cells_after)
+        } else {
+            self.d_cur
+        }
+    }
+
+    /// The hit increment.
+    #[inline(always)]
+    pub fn hit_increment(&self) -> f32 {
+        self.d_hit
+    }
+
+    /// The layer's log-odds table.
+    #[inline(always)]
+    pub fn table(&self) -> &LogOddsTable {
+        &self.table
+    }
+
+    /// Cell visits so far at which the reduced weight applied (counted like
+    /// [`InsertStats::cell_visits`]); call [`finish`](Self::finish) after the last ray.
+    pub fn attenuated(&self) -> u64 {
+        self.attenuated
+    }
+
+    /// Ends the current ray (counts its attenuated visits).
+    #[inline(always)]
+    pub fn finish(&mut self) {
+        if self.through {
+            self.attenuated += self.since + 1;
+        }
+        self.through = false;
+        self.hi = self.confident;
+        self.d_cur = self.d_miss;
+    }
+
+    /// The rule on an observed cell at or above `hi`: updates the ray's state and returns
+    /// the miss increment for the cell.
+    #[inline(always)]
+    fn rule(&mut self, v: f32, cells_after: u64) -> f32 {
+        if self.through {
+            if v < self.known_free {
+                // Out of the object: this cell and the rest at full weight.
+                self.attenuated += self.since - cells_after;
+                self.through = false;
+                self.hi = self.confident;
+                self.d_cur = self.d_miss;
+                return self.d_miss;
+            }
+            self.d_pass
+        } else if cells_after > self.margin {
+            // A confident cell with more than the margin to go: a probable pass-through.
+            self.through = true;
+            self.since = cells_after;
+            self.hi = f32::NEG_INFINITY;
+            self.d_cur = self.d_pass;
+            self.d_pass
+        } else {
+            self.d_miss
+        }
     }
 }
 
@@ -70,7 +191,35 @@ impl<L> CellVisitor<MapTile<L>> for OccupancyUpdate {
 
     #[inline(always)]
     fn pass(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
+        // Without the distance to the ray's end the rule cannot be judged: a plain miss.
         tile.update_log_odds(offset, self.d_miss, &self.table, fresh);
+    }
+
+    #[inline(always)]
+    fn pass_at(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool, cells_after: u64) {
+        let d = self.miss_increment(tile.log_odds(offset).unwrap_or(f32::NAN), cells_after);
+        tile.update_log_odds(offset, d, &self.table, fresh);
+    }
+
+    #[inline(always)]
+    fn begin_ray(&mut self, _cells: u64) {
+        self.finish();
+    }
+}
+
+/// The occupancy update with the rule off: `pass_at` is the default (a plain miss), so a
+/// map without the rule runs exactly the walk it ran before the rule existed, at its cost.
+struct PlainUpdate(OccupancyUpdate);
+
+impl<L> CellVisitor<MapTile<L>> for PlainUpdate {
+    #[inline(always)]
+    fn hit(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
+        self.0.hit(tile, offset, fresh);
+    }
+
+    #[inline(always)]
+    fn pass(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
+        CellVisitor::<MapTile<L>>::pass(&mut self.0, tile, offset, fresh);
     }
 }
 
@@ -157,8 +306,18 @@ impl<L: ExtraLayers> LayeredGrid<L> {
     /// extra layers `layers` writes (occupancy first on each cell, then `layers`).
     pub fn insert_with<V: CellVisitor<MapTile<L>>>(&mut self, data: &RangeData, layers: &mut V) -> InsertStats {
         self.observations += 1;
-        let mut visitor = (OccupancyUpdate::new(self.table, data.evidence), layers);
-        walk_observation(&mut self.tiles, &self.geometry, self.observations, &data.rays, &mut self.known, &mut visitor)
+        let update = OccupancyUpdate::new(self.table, data.evidence);
+        let (tiles, known, obs) = (&mut self.tiles, &mut self.known, self.observations);
+        if self.params.pass_through.is_off() {
+            let mut visitor = (PlainUpdate(update), layers);
+            return walk_observation(tiles, &self.geometry, obs, &data.rays, known, &mut visitor);
+        }
+        let rule = update.with_pass_through(&self.params.pass_through, self.params.free_threshold);
+        let mut visitor = (rule, layers);
+        let mut stats = walk_observation(tiles, &self.geometry, obs, &data.rays, known, &mut visitor);
+        visitor.0.finish();
+        stats.cell_visits_attenuated = visitor.0.attenuated();
+        stats
     }
 
     /// Starts a new observation and returns its number, for an insertion that writes cells
@@ -295,8 +454,11 @@ mod tests {
     use proptest::prelude::*;
     use std::collections::{HashMap, HashSet};
 
+    /// The map without the pass-through rule: these tests pin the plain semantics, bit
+    /// for bit (the rule has its own tests in `pass_through`).
     fn grid() -> OccupancyGrid {
-        OccupancyGrid::new(GridGeometry::centered(1.0).unwrap(), OccupancyParams::default())
+        let params = OccupancyParams { pass_through: PassThroughParams::OFF, ..OccupancyParams::default() };
+        OccupancyGrid::new(GridGeometry::centered(1.0).unwrap(), params)
     }
 
     fn data(rays: Vec<Ray>) -> RangeData {

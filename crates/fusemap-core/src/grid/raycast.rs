@@ -88,6 +88,12 @@ impl CellRay {
         }
     }
 
+    /// Cells the walk visits after the current one (its steps left).
+    #[inline(always)]
+    pub fn cells_after(&self) -> u64 {
+        self.remaining
+    }
+
     /// The cell the walk is at.
     #[inline(always)]
     pub fn cell(&self) -> CellIndex {

@@ -36,6 +36,21 @@ pub trait CellVisitor<T> {
     fn hit(&mut self, tile: &mut T, offset: usize, fresh: bool);
     /// A cell a ray crosses, its end cell included (pass 2).
     fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool);
+    /// Called in pass 2 before the first visit of each ray, with the number of cells the
+    /// ray will visit (its end cell included). The default does nothing.
+    #[inline(always)]
+    fn begin_ray(&mut self, cells: u64) {
+        let _ = cells;
+    }
+    /// [`pass`](Self::pass) with the number of cells the ray still visits after this one
+    /// (0 at its end cell), which the walk knows for free; what pass 2 calls. A visitor that
+    /// needs to know how far each cell lies from the ray's end (the occupancy layer's
+    /// pass-through rule) overrides this; the default forgets it and calls `pass`.
+    #[inline(always)]
+    fn pass_at(&mut self, tile: &mut T, offset: usize, fresh: bool, cells_after: u64) {
+        let _ = cells_after;
+        self.pass(tile, offset, fresh)
+    }
 }
 
 /// No layer: the walk alone (its counts and marks).
@@ -55,6 +70,14 @@ impl<T, V: CellVisitor<T> + ?Sized> CellVisitor<T> for &mut V {
     fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool) {
         (**self).pass(tile, offset, fresh)
     }
+    #[inline(always)]
+    fn begin_ray(&mut self, cells: u64) {
+        (**self).begin_ray(cells)
+    }
+    #[inline(always)]
+    fn pass_at(&mut self, tile: &mut T, offset: usize, fresh: bool, cells_after: u64) {
+        (**self).pass_at(tile, offset, fresh, cells_after)
+    }
 }
 
 /// Two layers fed by one walk, first `A` then `B` on each cell.
@@ -68,6 +91,16 @@ impl<T, A: CellVisitor<T>, B: CellVisitor<T>> CellVisitor<T> for (A, B) {
     fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool) {
         self.0.pass(tile, offset, fresh);
         self.1.pass(tile, offset, fresh);
+    }
+    #[inline(always)]
+    fn begin_ray(&mut self, cells: u64) {
+        self.0.begin_ray(cells);
+        self.1.begin_ray(cells);
+    }
+    #[inline(always)]
+    fn pass_at(&mut self, tile: &mut T, offset: usize, fresh: bool, cells_after: u64) {
+        self.0.pass_at(tile, offset, fresh, cells_after);
+        self.1.pass_at(tile, offset, fresh, cells_after);
     }
 }
 
@@ -90,6 +123,10 @@ pub struct InsertStats {
     pub dynamic_updates: u64,
     /// Of those, lidar hits routed from the static layer to the dynamic one.
     pub routed_to_dynamic: u64,
+    /// Of `cell_visits`, those at which the occupancy layer's free evidence had the
+    /// reduced weight of the pass-through rule: the ray had passed through a cell the map
+    /// held as confidently occupied (see [`PassThroughParams`](super::PassThroughParams)).
+    pub cell_visits_attenuated: u64,
 }
 
 impl InsertStats {
@@ -102,6 +139,7 @@ impl InsertStats {
         self.miss_updates += o.miss_updates;
         self.dynamic_updates += o.dynamic_updates;
         self.routed_to_dynamic += o.routed_to_dynamic;
+        self.cell_visits_attenuated += o.cell_visits_attenuated;
     }
 }
 
@@ -149,6 +187,7 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
         let n = walk.len_cells();
         stats.rays += 1;
         stats.cell_visits += n;
+        visitor.begin_ray(n);
         // The union with the known box, written out so that it inlines into the loop.
         let (lo, hi) = known_box.map_or((ca, ca), |k| (k.min, k.max));
         known_box = Some(CellBox {
@@ -166,7 +205,8 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
         loop {
             let fresh = tile.mark().test_and_set(offset as usize);
             stats.miss_updates += fresh as u64;
-            visitor.pass(tile, offset as usize, fresh);
+            // Before the step, the walk's own count says how many cells follow this one.
+            visitor.pass_at(tile, offset as usize, fresh, walk.cells_after());
             match walk.step() {
                 Step::Done => break,
                 Step::X => {

@@ -11,7 +11,13 @@
 //! of any kind (the document's §4.3 habit 2: a ring of ghosts means they were not
 //! filtered), and each kind is counted. **No-returns** — at or beyond `max_range` — follow
 //! [`MaxRangePolicy`].
+//!
+//! **The lidar's own faults** — mixed pixels at depth edges, speckles, the robot's own
+//! body in the field of view — are removed by the [`ScanFilters`] of
+//! [`LidarParams::filters`] before a beam becomes a ray; a dropped beam is no evidence
+//! at all, and each filter's drops are counted in [`ReturnCounts`].
 
+use super::lidar_filters::{Dropped, ScanFilters};
 use crate::geometry::{PlanarMount, Point2, Pose2};
 use crate::measurement::{Evidence, RangeData, Ray, SensorId};
 use crate::time::Stamp;
@@ -42,11 +48,21 @@ pub struct LidarParams {
     pub max_range: f64,
     /// What no-returns do.
     pub max_range_policy: MaxRangePolicy,
+    /// The scan filters for the lidar's own faults (all off by default).
+    #[serde(default)]
+    pub filters: ScanFilters,
 }
 
 impl Default for LidarParams {
     fn default() -> Self {
-        Self { p_occ: 0.9, p_free: 0.4, min_range: 0.1, max_range: 10.0, max_range_policy: MaxRangePolicy::Skip }
+        Self {
+            p_occ: 0.9,
+            p_free: 0.4,
+            min_range: 0.1,
+            max_range: 10.0,
+            max_range_policy: MaxRangePolicy::Skip,
+            filters: ScanFilters::default(),
+        }
     }
 }
 
@@ -89,12 +105,29 @@ pub struct ReturnCounts {
     pub negative: u64,
     /// Positive but below `min_range`.
     pub below_min: u64,
+    /// Valid returns dropped by the shadow (veiling) filter: mixed pixels at depth edges.
+    #[serde(default)]
+    pub shadow: u64,
+    /// Valid returns dropped by the speckle filter.
+    #[serde(default)]
+    pub speckle: u64,
+    /// Returns and no-returns outside the angular bounds.
+    #[serde(default)]
+    pub out_of_angle: u64,
+    /// Valid returns inside the self box (the robot's own body).
+    #[serde(default)]
+    pub in_box: u64,
 }
 
 impl ReturnCounts {
     /// Beams of every kind.
     pub fn total(&self) -> u64 {
-        self.valid + self.no_return + self.invalid()
+        self.valid + self.no_return + self.invalid() + self.filtered()
+    }
+
+    /// Beams the scan filters dropped: shadow, speckle, out of angle, in the self box.
+    pub fn filtered(&self) -> u64 {
+        self.shadow + self.speckle + self.out_of_angle + self.in_box
     }
 
     /// Beams that are never evidence: NaN, ±inf, zero, negative, below `min_range`.
@@ -111,6 +144,10 @@ impl ReturnCounts {
         self.zero += o.zero;
         self.negative += o.negative;
         self.below_min += o.below_min;
+        self.shadow += o.shadow;
+        self.speckle += o.speckle;
+        self.out_of_angle += o.out_of_angle;
+        self.in_box += o.in_box;
     }
 }
 
@@ -224,14 +261,35 @@ impl LidarModel {
         out.rays.clear();
         let clear = self.params.max_range_policy == MaxRangePolicy::Clear;
         let origin_in_base = self.mount.origin_in_base();
+        let filters = &self.params.filters;
+        let filtering = filters.any();
+        let beam_angle = |i: usize| scan.angle_min + i as f64 * scan.angle_increment;
         for (i, &r) in scan.ranges.iter().enumerate() {
             let kind = self.classify(r);
             let (range, hit) = match kind {
                 Kind::Valid => {
+                    if filtering {
+                        let valid = |x: f32| self.classify(x) == Kind::Valid;
+                        let verdict =
+                            filters.verdict(&scan.ranges, i, scan.angle_increment, beam_angle(i), &self.mount, valid);
+                        if let Some(d) = verdict {
+                            match d {
+                                Dropped::Angle => counts.out_of_angle += 1,
+                                Dropped::Box => counts.in_box += 1,
+                                Dropped::Shadow => counts.shadow += 1,
+                                Dropped::Speckle => counts.speckle += 1,
+                            }
+                            continue;
+                        }
+                    }
                     counts.valid += 1;
                     (r as f64, true)
                 }
                 Kind::NoReturn => {
+                    if filtering && filters.outside_angles(beam_angle(i)) {
+                        counts.out_of_angle += 1;
+                        continue;
+                    }
                     counts.no_return += 1;
                     if !clear {
                         continue;
@@ -260,8 +318,7 @@ impl LidarModel {
                 }
             };
             let world_from_base = pose_of_beam(i);
-            let angle =
-                world_from_base.theta + self.mount.beam_angle_in_base(scan.angle_min + i as f64 * scan.angle_increment);
+            let angle = world_from_base.theta + self.mount.beam_angle_in_base(beam_angle(i));
             let origin = world_from_base * origin_in_base;
             let (s, c) = angle.sin_cos();
             out.rays.push(Ray { origin, end: Point2::new(origin.x + range * c, origin.y + range * s), hit });
@@ -292,7 +349,19 @@ mod tests {
         assert_eq!(rd.rays.len(), 1);
         assert_eq!(rd.stamp, Stamp(7));
         assert_eq!(rd.sensor, SensorId(3));
-        assert_eq!(c, ReturnCounts { valid: 1, no_return: 2, nan: 1, infinite: 2, zero: 1, negative: 1, below_min: 1 });
+        assert_eq!(
+            c,
+            ReturnCounts {
+                valid: 1,
+                no_return: 2,
+                nan: 1,
+                infinite: 2,
+                zero: 1,
+                negative: 1,
+                below_min: 1,
+                ..Default::default()
+            }
+        );
         assert_eq!(c.total(), corpus.len() as u64);
         // Under `clear` the two no-returns clear to max_range without a hit.
         let (rd, c) = run(MaxRangePolicy::Clear, corpus);

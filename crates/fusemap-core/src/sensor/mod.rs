@@ -5,9 +5,11 @@
 
 pub mod camera;
 pub mod lidar;
+pub mod lidar_filters;
 
 pub use camera::{
     Band, CameraError, CameraModel, CameraObservation, CameraParams, CameraPoint, ClassSpec, ClassTable, DepthImage,
     ImageError, LabelImage, Pinhole, PixelCounts,
 };
 pub use lidar::{LaserScan, LidarModel, LidarParams, MaxRangePolicy, ReturnCounts};
+pub use lidar_filters::{AngularBounds, ScanFilters, SelfBox, ShadowFilter, SpeckleFilter};
