@@ -34,16 +34,16 @@ pub struct FusedUpdate {
 
 impl FusedUpdate {
     /// The update for `evidence` against the map's `table`, with the pass-through rule
-    /// `pass_through` (cells below the free threshold it gives end it).
+    /// `pass_through`.
     pub fn new(
         table: LogOddsTable,
         evidence: Evidence,
-        pass_through: (&PassThroughParams, f64),
+        pass_through: &PassThroughParams,
         group: Option<Group>,
         dynamic: Option<DynamicUpdate>,
         route_hits: bool,
     ) -> Self {
-        let occ = OccupancyUpdate::new(table, evidence).with_pass_through(pass_through.0, pass_through.1);
+        let occ = OccupancyUpdate::new(table, evidence).with_pass_through(pass_through);
         Self {
             occ,
             table,
@@ -120,8 +120,9 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
             return;
         }
         // The rule's state follows every visit of the ray, fresh or not.
-        let d = self.occ.miss_increment(tile.log_odds(offset).unwrap_or(f32::NAN), cells_after);
-        if !fresh {
+        let v = tile.log_odds(offset).unwrap_or(f32::NAN);
+        let d = self.occ.miss_increment(v, cells_after);
+        if !fresh || (v.is_nan() && d == 0.0) {
             return;
         }
         Self::occupancy(&self.table, self.group, tile, offset, d);

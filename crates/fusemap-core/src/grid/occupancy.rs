@@ -52,9 +52,9 @@ pub struct LayeredGrid<L = ()> {
 ///
 /// The rule costs the common path one comparison: a crossed cell goes to the rule's own
 /// code only when its log-odds reach `hi` — the confidence threshold while the ray is in
-/// the open (`+inf` when the rule is off, so never), `-inf` while it is behind a
-/// confident cell (every observed cell then, to find where it leaves the object); cells
-/// never observed (NaN) always take the common path with the current increment `d_cur`.
+/// the open, `+inf` when the rule is off or once the ray is behind a confident cell (then
+/// every later cell takes the common path with `d_cur = 0`: no evidence); cells never
+/// observed (NaN) always take the common path.
 #[derive(Clone, Copy, Debug)]
 pub struct OccupancyUpdate {
     table: LogOddsTable,
@@ -62,14 +62,11 @@ pub struct OccupancyUpdate {
     d_miss: f32,
     /// The miss increment behind a confidently occupied cell (`weight · d_miss`).
     d_pass: f32,
-    /// The miss increment of the common path: `d_miss`, or `d_pass` behind a confident cell.
+    /// The miss increment of the common path: `d_miss`, or 0 behind a confident cell.
     d_cur: f32,
     /// Log-odds at or above which a crossed cell is confidently occupied; `+inf` when the
     /// rule is off.
     confident: f32,
-    /// Log-odds below which a crossed cell is known free: the ray has left the object it
-    /// passed through, and the full update resumes.
-    known_free: f32,
     /// The common path's bound (see the type docs).
     hi: f32,
     margin: u64,
@@ -92,7 +89,6 @@ impl OccupancyUpdate {
             d_pass: d_miss,
             d_cur: d_miss,
             confident: f32::INFINITY,
-            known_free: f32::NEG_INFINITY,
             hi: f32::INFINITY,
             margin: 0,
             through: false,
@@ -101,13 +97,11 @@ impl OccupancyUpdate {
         }
     }
 
-    /// This update with the pass-through rule `rule` (off when `rule.is_off()`); a cell
-    /// below `free_threshold` (probability) ends the attenuation.
-    pub fn with_pass_through(mut self, rule: &PassThroughParams, free_threshold: f64) -> Self {
+    /// This update with the pass-through rule `rule` (off when `rule.is_off()`).
+    pub fn with_pass_through(mut self, rule: &PassThroughParams) -> Self {
         if !rule.is_off() {
             self.confident = logit(rule.threshold) as f32;
             self.hi = self.confident;
-            self.known_free = logit(free_threshold) as f32;
             self.d_pass = (rule.weight * self.d_miss as f64) as f32;
             self.margin = rule.margin_cells as u64;
         }
@@ -121,7 +115,7 @@ impl OccupancyUpdate {
     pub fn miss_increment(&mut self, v: f32, cells_after: u64) -> f32 {
         // NaN (never observed) fails the comparison and takes the common path.
         if v >= self.hi {
-            self.rule(v, cells_after)
+            self.rule(cells_after)
         } else {
             self.d_cur
         }
@@ -159,23 +153,14 @@ impl OccupancyUpdate {
     /// The rule on an observed cell at or above `hi`: updates the ray's state and returns
     /// the miss increment for the cell.
     #[inline(always)]
-    fn rule(&mut self, v: f32, cells_after: u64) -> f32 {
-        if self.through {
-            if v < self.known_free {
-                // Out of the object: this cell and the rest at full weight.
-                self.attenuated += self.since - cells_after;
-                self.through = false;
-                self.hi = self.confident;
-                self.d_cur = self.d_miss;
-                return self.d_miss;
-            }
-            self.d_pass
-        } else if cells_after > self.margin {
-            // A confident cell with more than the margin to go: a probable pass-through.
+    fn rule(&mut self, cells_after: u64) -> f32 {
+        if cells_after > self.margin {
+            // A confident cell with more than the margin to go: a probable pass-through or
+            // ghost. This cell gets the reduced miss, every later cell of the ray nothing.
             self.through = true;
             self.since = cells_after;
-            self.hi = f32::NEG_INFINITY;
-            self.d_cur = self.d_pass;
+            self.hi = f32::INFINITY;
+            self.d_cur = 0.0;
             self.d_pass
         } else {
             self.d_miss
@@ -197,8 +182,10 @@ impl<L> CellVisitor<MapTile<L>> for OccupancyUpdate {
 
     #[inline(always)]
     fn pass_at(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool, cells_after: u64) {
-        let d = self.miss_increment(tile.log_odds(offset).unwrap_or(f32::NAN), cells_after);
-        tile.update_log_odds(offset, d, &self.table, fresh);
+        let v = tile.log_odds(offset).unwrap_or(f32::NAN);
+        let d = self.miss_increment(v, cells_after);
+        // A never-observed cell given no evidence stays never observed.
+        tile.update_log_odds(offset, d, &self.table, fresh & !(v.is_nan() & (d == 0.0)));
     }
 
     #[inline(always)]
@@ -312,7 +299,7 @@ impl<L: ExtraLayers> LayeredGrid<L> {
             let mut visitor = (PlainUpdate(update), layers);
             return walk_observation(tiles, &self.geometry, obs, &data.rays, known, &mut visitor);
         }
-        let rule = update.with_pass_through(&self.params.pass_through, self.params.free_threshold);
+        let rule = update.with_pass_through(&self.params.pass_through);
         let mut visitor = (rule, layers);
         let mut stats = walk_observation(tiles, &self.geometry, obs, &data.rays, known, &mut visitor);
         visitor.0.finish();

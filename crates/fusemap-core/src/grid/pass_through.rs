@@ -21,6 +21,14 @@
 //! margin (a beam that grazes a wall and ends, with range noise, a cell or two behind an
 //! occupied cell of that same wall), are updated exactly as before. Hits are not changed.
 //!
+//! Cells behind the confident cell that the map has **never observed** get no evidence
+//! from such a ray at all: whatever lies behind a known obstacle was reached only through
+//! it, so the ray says nothing credible about space no other ray has seen. This is what
+//! keeps the inside of a steel pillar or a machine body, which no beam can see, from being
+//! carved open by the ghosts that cross it, and what stops ghost rays from drawing free
+//! space outside the hall's walls. Cells observed before (a room behind an opened door)
+//! end the attenuation as soon as the ray reaches one held free, as below.
+//!
 //! **Why it keeps the map updatable.** The rule only slows free evidence down; it never
 //! stops it. A cell held at the upper clamp (OctoMap's clamping, Hornung et al. 2013
 //! §III-C, is the general mechanism that bounds how much evidence a cell can hold) that
