@@ -8,7 +8,10 @@
 //!    crossing the same cell near the sensor are one piece of evidence, not fifty
 //!    (the design document's "do not count correlated evidence twice", inside a scan);
 //! 2. a cell that ends any hit ray of the observation gets the hit update, never the miss
-//!    update of another ray that passes through it.
+//!    update of another ray that passes through it;
+//! 3. (when the map's [`PassThroughParams`] are on) free evidence behind a cell the map
+//!    holds as confidently occupied is attenuated — a specular ghost or a beam through
+//!    glass must not carve open the object it passed (see [`PassThroughParams`]).
 //!
 //! The walk that enforces both is [`walk_observation`](super::walk_observation); this
 //! module supplies what the occupancy layer does per cell (a clamped log-odds update,
