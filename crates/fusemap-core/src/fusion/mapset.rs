@@ -192,6 +192,7 @@ impl MapSet {
                 let mut s = m.grid.insert_visited(&data.rays, &mut v);
                 v.finish();
                 s.cell_visits_attenuated += v.attenuated();
+                s.ghost_hits += v.ghost_hits();
                 s.routed_to_dynamic += v.routed;
                 s.dynamic_updates += v.routed;
                 m.stats.add(&s);

@@ -35,22 +35,29 @@ pub enum MergeRule {
     Mean,
 }
 
-/// Per-cell scratch state of the current correlation group.
+/// Per-cell scratch state of the current correlation group: one 16-byte entry per cell,
+/// so a grouped update touches one cache line.
 #[derive(Clone, Debug)]
 pub struct GroupBlock {
-    /// The group that last touched the cell (0: none; groups start at 1).
-    tag: [u64; TILE_CELLS],
-    /// The cell's stored log-odds before the group (NaN: never observed).
-    base: [f32; TILE_CELLS],
-    /// The combined evidence so far (the max, or the sum for the mean).
-    acc: [f32; TILE_CELLS],
+    cells: [GroupCell; TILE_CELLS],
+}
+
+#[derive(Clone, Copy, Debug)]
+struct GroupCell {
+    /// The low 32 bits of the group that last touched the cell (0: none; groups start at
+    /// 1). Two groups 2³² apart (13 years of 10 Hz groups) would share a tag.
+    tag: u32,
     /// Members that reached the cell.
-    count: [u16; TILE_CELLS],
+    count: u32,
+    /// The cell's stored log-odds before the group (NaN: never observed).
+    base: f32,
+    /// The combined evidence so far (the max, or the sum for the mean).
+    acc: f32,
 }
 
 impl GroupBlock {
     fn empty() -> Self {
-        Self { tag: [0; TILE_CELLS], base: [f32::NAN; TILE_CELLS], acc: [0.0; TILE_CELLS], count: [0; TILE_CELLS] }
+        Self { cells: [GroupCell { tag: 0, count: 0, base: f32::NAN, acc: 0.0 }; TILE_CELLS] }
     }
 }
 
@@ -76,28 +83,27 @@ impl Group {
         table: &LogOddsTable,
     ) {
         let b = block.get_or_insert_with(|| Box::new(GroupBlock::empty()));
-        let merged = if b.tag[offset] != self.id {
-            b.tag[offset] = self.id;
-            b.base[offset] = *log_odds;
-            b.acc[offset] = delta;
-            b.count[offset] = 1;
+        let c = &mut b.cells[offset];
+        let tag = self.id as u32;
+        let merged = if c.tag != tag {
+            *c = GroupCell { tag, count: 1, base: *log_odds, acc: delta };
             delta
         } else {
-            b.count[offset] = b.count[offset].saturating_add(1);
+            c.count = c.count.saturating_add(1);
             match self.rule {
                 MergeRule::Max => {
-                    if delta.abs() > b.acc[offset].abs() {
-                        b.acc[offset] = delta;
+                    if delta.abs() > c.acc.abs() {
+                        c.acc = delta;
                     }
-                    b.acc[offset]
+                    c.acc
                 }
                 MergeRule::Mean => {
-                    b.acc[offset] += delta;
-                    b.acc[offset] / b.count[offset] as f32
+                    c.acc += delta;
+                    c.acc / c.count as f32
                 }
             }
         };
-        let base = b.base[offset];
+        let base = c.base;
         *log_odds = table.update(if base.is_nan() { table.prior } else { base }, merged);
     }
 }

@@ -30,6 +30,8 @@ pub struct FusedUpdate {
     plain: bool,
     /// Hits routed to the dynamic layer so far.
     pub routed: u64,
+    /// Ghost hits skipped on the non-plain path.
+    ghosts: u64,
 }
 
 impl FusedUpdate {
@@ -53,6 +55,7 @@ impl FusedUpdate {
             route_hits,
             plain: group.is_none() && dynamic.is_none(),
             routed: 0,
+            ghosts: 0,
         }
     }
 
@@ -84,6 +87,11 @@ impl FusedUpdate {
     /// Cell visits at which the pass-through rule's reduced weight applied.
     pub fn attenuated(&self) -> u64 {
         self.occ.attenuated()
+    }
+
+    /// Hits not applied because their ray had passed through a confidently occupied cell.
+    pub fn ghost_hits(&self) -> u64 {
+        self.occ.ghost_hits() + self.ghosts
     }
 }
 
@@ -129,6 +137,20 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
         if let Some(dy) = &self.dynamic {
             dy.clear(&mut tile.layers_mut().dynamic, offset);
         }
+    }
+
+    #[inline(always)]
+    fn end_hit(&mut self, tile: &mut MapTile<FusionLayers>, offset: usize, fresh: bool) {
+        if self.plain {
+            CellVisitor::<MapTile<FusionLayers>>::end_hit(&mut self.occ, tile, offset, fresh);
+            return;
+        }
+        if self.occ.is_through() {
+            // A ghost echo (see `OccupancyUpdate`): no evidence.
+            self.ghosts += fresh as u64;
+            return;
+        }
+        self.hit(tile, offset, fresh);
     }
 
     #[inline(always)]

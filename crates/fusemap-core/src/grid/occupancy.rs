@@ -78,6 +78,7 @@ pub struct OccupancyUpdate {
     through: bool,
     since: u64,
     attenuated: u64,
+    ghost_hits: u64,
 }
 
 impl OccupancyUpdate {
@@ -97,6 +98,7 @@ impl OccupancyUpdate {
             through: false,
             since: 0,
             attenuated: 0,
+            ghost_hits: 0,
         }
     }
 
@@ -109,6 +111,18 @@ impl OccupancyUpdate {
             self.margin = rule.margin_cells as u64;
         }
         self
+    }
+
+    /// Hits not applied so far because their ray had passed through a confidently
+    /// occupied cell (see [`PassThroughParams`]).
+    pub fn ghost_hits(&self) -> u64 {
+        self.ghost_hits
+    }
+
+    /// Whether the current ray is behind a confidently occupied cell.
+    #[inline(always)]
+    pub fn is_through(&self) -> bool {
+        self.through
     }
 
     /// The miss increment for a crossed cell holding `v` (NaN: never observed) with
@@ -194,6 +208,14 @@ impl<L> CellVisitor<MapTile<L>> for OccupancyUpdate {
     #[inline(always)]
     fn begin_ray(&mut self, _cells: u64) {
         self.finish();
+    }
+
+    #[inline(always)]
+    fn end_hit(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
+        // An echo from behind a confidently occupied cell is a ghost (a specular bounce)
+        // or a pass-through: like the free space it claims, it counts for nothing.
+        self.ghost_hits += (self.through & fresh) as u64;
+        tile.update_log_odds(offset, self.d_hit, &self.table, fresh & !self.through);
     }
 }
 
@@ -307,6 +329,7 @@ impl<L: ExtraLayers> LayeredGrid<L> {
         let mut stats = walk_observation(tiles, &self.geometry, obs, &data.rays, known, &mut visitor);
         visitor.0.finish();
         stats.cell_visits_attenuated = visitor.0.attenuated();
+        stats.ghost_hits = visitor.0.ghost_hits();
         stats
     }
 

@@ -4,9 +4,11 @@
 //! After Cartographer's `ProbabilityGridRangeDataInserter2D` (hits first, then misses,
 //! with an update marker) and OctoMap's `computeUpdate` ("occupied nodes have a preference
 //! over free ones"), for one observation:
-//! 1. **hits**: the end cell of every hit ray is visited once and marked;
+//! 1. **hits**: the end cell of every hit ray is marked;
 //! 2. **passes**: every ray is walked from its origin to its end cell (Amanatides & Woo,
-//!    [`CellRay`]), visiting each cell it crosses.
+//!    [`CellRay`]), visiting each cell it crosses, and a hit ray's end cell then gets its
+//!    hit ([`CellVisitor::end_hit`]), so that the layer has seen the whole ray before it
+//!    judges the echo.
 //!
 //! Each visit says whether it is the first of that cell in this observation (`fresh`,
 //! from the tile's shared [`UpdateMark`](super::UpdateMark)). A layer acts only on fresh
@@ -32,7 +34,7 @@ pub const MAX_RAY_CELLS: u64 = 1 << 22;
 /// `fresh` whether this is the cell's first visit in the current observation (the visit
 /// has already marked it).
 pub trait CellVisitor<T> {
-    /// The end cell of a hit ray (pass 1).
+    /// The end cell of a hit ray (called by the default [`end_hit`](Self::end_hit)).
     fn hit(&mut self, tile: &mut T, offset: usize, fresh: bool);
     /// A cell a ray crosses, its end cell included (pass 2).
     fn pass(&mut self, tile: &mut T, offset: usize, fresh: bool);
@@ -41,6 +43,14 @@ pub trait CellVisitor<T> {
     #[inline(always)]
     fn begin_ray(&mut self, cells: u64) {
         let _ = cells;
+    }
+    /// The end cell of a hit ray, after the ray's walk (pass 2), with whether it is the
+    /// cell's first hit of the observation. The default is [`hit`](Self::hit); a visitor
+    /// that judges the ray on the way (the pass-through rule: an echo from behind a
+    /// confidently occupied cell is a ghost) overrides it.
+    #[inline(always)]
+    fn end_hit(&mut self, tile: &mut T, offset: usize, fresh: bool) {
+        self.hit(tile, offset, fresh)
     }
     /// [`pass`](Self::pass) with the number of cells the ray still visits after this one
     /// (0 at its end cell), which the walk knows for free; what pass 2 calls. A visitor that
@@ -78,6 +88,10 @@ impl<T, V: CellVisitor<T> + ?Sized> CellVisitor<T> for &mut V {
     fn pass_at(&mut self, tile: &mut T, offset: usize, fresh: bool, cells_after: u64) {
         (**self).pass_at(tile, offset, fresh, cells_after)
     }
+    #[inline(always)]
+    fn end_hit(&mut self, tile: &mut T, offset: usize, fresh: bool) {
+        (**self).end_hit(tile, offset, fresh)
+    }
 }
 
 /// Two layers fed by one walk, first `A` then `B` on each cell.
@@ -102,6 +116,11 @@ impl<T, A: CellVisitor<T>, B: CellVisitor<T>> CellVisitor<T> for (A, B) {
         self.0.pass_at(tile, offset, fresh, cells_after);
         self.1.pass_at(tile, offset, fresh, cells_after);
     }
+    #[inline(always)]
+    fn end_hit(&mut self, tile: &mut T, offset: usize, fresh: bool) {
+        self.0.end_hit(tile, offset, fresh);
+        self.1.end_hit(tile, offset, fresh);
+    }
 }
 
 /// What one insertion did.
@@ -123,6 +142,9 @@ pub struct InsertStats {
     pub dynamic_updates: u64,
     /// Of those, lidar hits routed from the static layer to the dynamic one.
     pub routed_to_dynamic: u64,
+    /// Hits not applied: their ray had passed through a confidently occupied cell (a
+    /// ghost echo, see [`PassThroughParams`](super::PassThroughParams)).
+    pub ghost_hits: u64,
     /// Of `cell_visits`, those at which the occupancy layer's free evidence had the
     /// reduced weight of the pass-through rule: the ray had passed through a cell the map
     /// held as confidently occupied (see [`PassThroughParams`](super::PassThroughParams)).
@@ -139,6 +161,7 @@ impl InsertStats {
         self.miss_updates += o.miss_updates;
         self.dynamic_updates += o.dynamic_updates;
         self.routed_to_dynamic += o.routed_to_dynamic;
+        self.ghost_hits += o.ghost_hits;
         self.cell_visits_attenuated += o.cell_visits_attenuated;
     }
 }
@@ -161,24 +184,25 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
     let units = |p: crate::geometry::Point2| ((p.x - ox) * inv, (p.y - oy) * inv);
     let mut stats = InsertStats::default();
 
-    // Pass 1: hits. Each end cell is visited and marked, so the walks of pass 2 see it
-    // as already updated.
-    for ray in rays.iter().filter(|r| r.hit) {
+    // Pass 1: hits. Each end cell is marked, so the walks of pass 2 never give it a miss;
+    // the hit itself is applied at the end of its ray's walk (`end_hit`), when the ray is
+    // known, with whether it is the cell's first hit of the observation.
+    let mut first_hit = vec![false; rays.len()];
+    for (i, ray) in rays.iter().enumerate().filter(|(_, r)| r.hit) {
         let Some((_, _, _, c)) = checked(units(ray.origin), units(ray.end)) else {
             continue;
         };
         let tile = tiles.get_or_insert(c.tile());
         let mark = tile.mark();
         mark.begin(obs);
-        let offset = c.offset_in_tile();
-        let fresh = mark.test_and_set(offset);
+        let fresh = mark.test_and_set(c.offset_in_tile());
         stats.hit_updates += fresh as u64;
-        visitor.hit(tile, offset, fresh);
+        first_hit[i] = fresh;
     }
 
     // Pass 2: walk every ray from its origin to its end.
     let mut known_box = *known;
-    for ray in rays {
+    for (i, ray) in rays.iter().enumerate() {
         let Some((a, b, ca, cb)) = checked(units(ray.origin), units(ray.end)) else {
             stats.rays_rejected += 1;
             continue;
@@ -208,7 +232,12 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
             // Before the step, the walk's own count says how many cells follow this one.
             visitor.pass_at(tile, offset as usize, fresh, walk.cells_after());
             match walk.step() {
-                Step::Done => break,
+                Step::Done => {
+                    if ray.hit {
+                        visitor.end_hit(tile, offset as usize, first_hit[i]);
+                    }
+                    break;
+                }
                 Step::X => {
                     lx += sx;
                     offset += sx;

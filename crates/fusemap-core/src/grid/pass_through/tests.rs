@@ -137,14 +137,9 @@ fn reference(observations: &[Vec<Ray>], table: &LogOddsTable, rule: &PassThrough
     let confident = logit(rule.threshold) as f32;
     for rays in observations {
         let mut done: HashSet<CellIndex> = HashSet::new();
-        for r in rays.iter().filter(|r| r.hit) {
-            let c = g.cell_of(r.end).unwrap();
-            if done.insert(c) {
-                let v = cells.get(&c).copied().unwrap_or(table.prior);
-                cells.insert(c, table.update(v, d_hit));
-            }
-        }
-        for r in rays {
+        // Hit cells are marked first; each ray's hit is applied at the end of its walk.
+        let first: Vec<bool> = rays.iter().map(|r| r.hit && done.insert(g.cell_of(r.end).unwrap())).collect();
+        for (i, r) in rays.iter().enumerate() {
             let walk: Vec<CellIndex> = CellRay::new(g.to_cell_units(r.origin), g.to_cell_units(r.end)).collect();
             let mut through = false;
             for (k, c) in walk.iter().enumerate() {
@@ -169,6 +164,12 @@ fn reference(observations: &[Vec<Ray>], table: &LogOddsTable, rule: &PassThrough
                         cells.insert(*c, table.update(v, d));
                     }
                 }
+            }
+            // An echo from behind a confident cell counts for nothing.
+            if first[i] && !through {
+                let c = *walk.last().unwrap();
+                let v = cells.get(&c).copied().unwrap_or(table.prior);
+                cells.insert(c, table.update(v, d_hit));
             }
         }
     }
