@@ -12,7 +12,7 @@ use crate::recording::Inventory;
 use crate::report::Skipped;
 use crate::track::Track;
 use crate::PipelineError;
-use fusemap_core::config::{LogConfig, PlannedCamera};
+use fusemap_core::config::{ExtrinsicsSource, LogConfig, PlannedCamera};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::fusion::{Engine, EngineError};
 use fusemap_core::geometry::Pose3;
@@ -67,6 +67,16 @@ pub struct CameraReport {
     pub extrinsics: ExtrinsicsReport,
     /// What became of the pixels.
     pub pixels: PixelCounts,
+}
+
+/// A label + depth pair ready to insert.
+pub(crate) struct Frame {
+    /// The label image's (offset-corrected) stamp: the frame's pose is taken there.
+    pub(crate) label_stamp: Stamp,
+    /// The later of the two stamps: the frame enters the time-ordered engine there.
+    pub(crate) release: Stamp,
+    pub(crate) label: ImageMessage,
+    pub(crate) depth: ImageMessage,
 }
 
 /// One camera as the second pass uses it.
@@ -127,7 +137,18 @@ pub(crate) fn build_camera(
     }
     let frame = c.frame.clone().or_else(|| labels.frame().map(str::to_string)).unwrap_or_default();
     let log_mount = from_tf(tree, &cfg.base_frame, &frame, first_image);
-    let ext = resolve(&frame, cfg, c.mount_given.then_some(c.mount), log_mount, notes)?;
+    // Without a mount in the config or the log, the planned default (a level camera looking
+    // forward at base_link's origin, REP 103 optical axes), never the identity, whose
+    // optical axis would point up.
+    let no_mount = !c.mount_given && (log_mount.is_none() || cfg.extrinsics == ExtrinsicsSource::Config);
+    if no_mount {
+        notes.push(format!(
+            "camera `{}`: no mount in the config or the log's TF for `{frame}`; assumed a level camera looking forward at {}'s origin",
+            c.name, cfg.base_frame
+        ));
+    }
+    let config_mount = (c.mount_given || no_mount).then_some(c.mount);
+    let ext = resolve(&frame, cfg, config_mount, log_mount, notes)?;
     let m = ext.base_from_sensor;
     let base_from_optical = Pose3::new([m.x, m.y, m.z], m.quaternion());
     let model = CameraModel::new(pinhole, base_from_optical, c.params, resolution, classes.clone())
@@ -178,12 +199,7 @@ impl MappedCamera {
 
     /// Takes one released image (`key`: its offset-corrected stamp) and returns a frame
     /// when it completes a pair.
-    pub(crate) fn take(
-        &mut self,
-        stream: usize,
-        key: Stamp,
-        msg: ImageMessage,
-    ) -> Option<(Stamp, ImageMessage, ImageMessage)> {
+    pub(crate) fn take(&mut self, stream: usize, key: Stamp, msg: ImageMessage) -> Option<Frame> {
         let is_label = stream == self.label_stream;
         if is_label {
             self.report.labels_read += 1;
@@ -200,7 +216,10 @@ impl MappedCamera {
             if key.0.abs_diff(t.0) <= tol as u64 {
                 let (t_other, m_other) = other.take().expect("checked");
                 self.report.frames_paired += 1;
-                return Some(if is_label { (key, msg, m_other) } else { (t_other, m_other, msg) });
+                // The frame is taken at its label image's stamp; it is inserted at `key`,
+                // the later of the two (the merge has released everything before it).
+                let (label_stamp, label, depth) = if is_label { (key, msg, m_other) } else { (t_other, m_other, msg) };
+                return Some(Frame { label_stamp, release: key, label, depth });
             }
             // Released in stamp order: an older partner can no longer be paired.
             other.take();
@@ -226,15 +245,16 @@ impl MappedCamera {
         self.report.depths_unpaired += self.pending_depth.take().is_some() as u64;
     }
 
-    /// Decodes and inserts one frame: its stamp, label image and depth image.
+    /// Decodes and inserts one frame.
     pub(crate) fn insert(
         &mut self,
         engine: &mut Engine,
         track: &Track,
         mode: SyncMode,
         id: ObservationId,
-        (stamp, label, depth): (Stamp, &ImageMessage, &ImageMessage),
+        frame: &Frame,
     ) -> Result<(), PipelineError> {
+        let (stamp, label, depth) = (frame.label_stamp, &frame.label, &frame.depth);
         let Track::Timed(track) = track else {
             // Poses written on scan lines (CARMEN) cannot place a camera frame.
             self.report.frames_skipped.no_pose_on_line += 1;
@@ -256,9 +276,15 @@ impl MappedCamera {
                 return Ok(());
             }
         };
-        match engine.insert_camera_frame(self.id, Some(id), stamp, &labels, &depths, pose) {
+        match engine.insert_camera_frame(self.id, Some(id), frame.release, &labels, &depths, pose) {
             Ok(_) => {
                 self.report.frames_used += 1;
+                Ok(())
+            }
+            // Another sensor's observation was applied after this frame's stamp (a clock
+            // jump the merge let through): skipped and counted, never the end of the run.
+            Err(EngineError::OutOfOrder { .. }) => {
+                self.report.frames_skipped.late += 1;
                 Ok(())
             }
             Err(EngineError::Camera { error, .. }) => {

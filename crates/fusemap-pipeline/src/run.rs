@@ -263,7 +263,17 @@ pub fn map_with_track(
     let mut cameras: Vec<MappedCamera> = Vec::new();
     let planned = planned_cameras(plan, inv, &mut notes)?;
     for c in &planned {
-        let (model, report) = build_camera(c, &plan.classes, plan.geometry.resolution(), inv, &tree, cfg, &mut notes)?;
+        let built = build_camera(c, &plan.classes, plan.geometry.resolution(), inv, &tree, cfg, &mut notes);
+        let (model, report) = match built {
+            Ok(b) => b,
+            // A camera the config did not ask for never stops a run: the log is mapped
+            // without it, and the note says why.
+            Err(e) if !c.explicit => {
+                notes.push(format!("the camera found on `{}` is not mapped: {e}", c.topic));
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         let id = engine.add_camera(c.name.clone(), model);
         let label_stream = merge.add_stream(c.topic.clone());
         let depth_stream = merge.add_stream(c.depth_topic.clone());
@@ -504,10 +514,10 @@ fn release(
                 .iter_mut()
                 .find(|c| c.label_stream == stream || c.depth_stream == stream)
                 .expect("an image stream is a camera's");
-            if let Some((t, label, depth)) = c.take(stream, key, image) {
+            if let Some(frame) = c.take(stream, key, image) {
                 let id = ObservationId(inserter.next_id);
                 inserter.next_id += 1;
-                c.insert(inserter.engine, inserter.track, inserter.mode, id, (t, &label, &depth))?;
+                c.insert(inserter.engine, inserter.track, inserter.mode, id, &frame)?;
             }
             Ok(())
         }

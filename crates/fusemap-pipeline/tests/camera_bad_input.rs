@@ -161,3 +161,22 @@ fn a_camera_on_the_usual_topics_is_found_and_can_be_switched_off() {
     let r = map_inventory(&off.validate().unwrap(), &inv, &mut |_| {}).unwrap();
     assert!(r.report.cameras.is_empty());
 }
+
+/// Label and depth images a few milliseconds apart with a scan stamped between them: the
+/// frame enters the engine at the later stamp (its pose is the label's), never out of order.
+#[test]
+fn a_scan_between_a_label_and_its_depth_image_is_fine() {
+    let mut rec = short();
+    for m in rec.messages.iter_mut() {
+        match m {
+            SimMessage::Scan(s) => s.stamp = Stamp(s.stamp.0 + 1_000_000),
+            SimMessage::Image(i) if i.topic == "/camera/depth" => i.stamp = Stamp(i.stamp.0 + 3_000_000),
+            _ => {}
+        }
+    }
+    rec.messages.sort_by_key(|m| m.stamp());
+    let r = run("camera-between", &rec).unwrap();
+    let c = camera(&r);
+    assert_eq!(c.frames_used, c.frames_paired, "{c:?}");
+    assert!(c.frames_used > 50);
+}

@@ -1,7 +1,8 @@
 //! The semantic camera's `[[sensor]]` keys and the `[[class]]` tables.
 //!
-//! A camera reads three topics (label images, aligned depth images, `CameraInfo`) and is
-//! mapped only when the config lists it: cameras are never auto-detected. Its mount
+//! A camera reads three topics (label images, aligned depth images, `CameraInfo`). The
+//! config does not plan one it does not list; a log run maps a camera it finds on the
+//! usual topics with [`default_camera`] (unless the camera kind is disabled). Its mount
 //! `base_from_sensor` is `base_from_camera_optical`, the optical frame of REP 103 (x right,
 //! y down, z forward).
 
@@ -42,7 +43,7 @@ pub struct PlannedCamera {
     /// Largest stamp difference of a label image and the depth image paired with it,
     /// seconds.
     pub pair_tolerance_s: f64,
-    /// `true`: written in the config (always: cameras are not auto-detected).
+    /// `true`: written in the config; `false`: [`default_camera`], found on the usual topics.
     pub explicit: bool,
 }
 

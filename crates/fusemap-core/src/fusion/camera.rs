@@ -9,8 +9,9 @@
 //!   weight and `occupancy_weight`); obstacle-band pixels take precedence over floor ones,
 //!   as a hit does over a pass (OctoMap's rule). As a member of a correlation group the
 //!   cell's evidence is merged with the lidar's (§2.4);
-//! * **semantic**: one unit of Dirichlet evidence split over its pixels' static classes by
-//!   their semantic weights (see [`semantic`](crate::grid::semantic));
+//! * **semantic**: the mean of its pixels' semantic weights, as Dirichlet evidence split
+//!   over their static classes (at most one unit per frame while class weights are at
+//!   most 1; see [`semantic`]);
 //! * **dynamic**: pixels of a dynamic class there write the dynamic layer (never the static
 //!   occupancy); floor seen there clears it.
 //!

@@ -186,9 +186,10 @@ impl MapSet {
         let mut fed = 0;
         for m in std::iter::once(&mut self.primary).chain(&mut self.others) {
             if m.sensors.includes(data.sensor, kind) {
-                let rule = m.grid.params().pass_through;
+                let params = m.grid.params();
+                let rule = (&params.pass_through, params.free_threshold);
                 let mut v =
-                    FusedUpdate::new(*m.grid.table(), data.evidence, &rule, ctx.group, ctx.dynamic, ctx.route_hits);
+                    FusedUpdate::new(*m.grid.table(), data.evidence, rule, ctx.group, ctx.dynamic, ctx.route_hits);
                 let mut s = m.grid.insert_visited(&data.rays, &mut v);
                 v.finish();
                 s.cell_visits_attenuated += v.attenuated();

@@ -6,9 +6,15 @@
 //! lidar scan taken within a few milliseconds of each other, or two outputs of one
 //! pre-processing step, are not: adding both counts one look at the world twice and
 //! inflates confidence (design document §2.4). Observations of one *correlation group*
-//! (an id the engine assigns) are therefore merged per cell: the first of the group to
-//! reach a cell records the cell's value before the group, and every member's evidence
-//! for the cell is combined by the [`MergeRule`] and applied once to that value.
+//! (an id the engine assigns) are therefore merged per cell: every member's evidence for
+//! the cell is combined by the [`MergeRule`], and the cell carries the merged evidence
+//! once — each member changes it by the difference between the merged evidence and what
+//! the group has already applied there, so evidence another sensor wrote in between is
+//! kept.
+//!
+//! Limit: the scratch entry of a cell belongs to one group at a time; two configured
+//! groups whose members interleave on the same cell within their windows restart each
+//! other's merge there.
 //!
 //! * [`MergeRule::Max`] (the default) keeps the evidence of largest magnitude: the merged
 //!   observation is as informative as the most informative member, never more. It is
@@ -49,15 +55,15 @@ struct GroupCell {
     tag: u32,
     /// Members that reached the cell.
     count: u32,
-    /// The cell's stored log-odds before the group (NaN: never observed).
-    base: f32,
+    /// The change the group has made to the cell so far (after clamping).
+    applied: f32,
     /// The combined evidence so far (the max, or the sum for the mean).
     acc: f32,
 }
 
 impl GroupBlock {
     fn empty() -> Self {
-        Self { cells: [GroupCell { tag: 0, count: 0, base: f32::NAN, acc: 0.0 }; TILE_CELLS] }
+        Self { cells: [GroupCell { tag: 0, count: 0, applied: 0.0, acc: 0.0 }; TILE_CELLS] }
     }
 }
 
@@ -72,7 +78,7 @@ pub struct Group {
 
 impl Group {
     /// Applies `delta` to `log_odds` (one cell's stored value, NaN if never observed) as
-    /// this group's member: the first member records the base, later members merge.
+    /// this group's member: the cell ends up changed by the merged evidence once.
     #[inline]
     pub fn update(
         &self,
@@ -86,7 +92,7 @@ impl Group {
         let c = &mut b.cells[offset];
         let tag = self.id as u32;
         let merged = if c.tag != tag {
-            *c = GroupCell { tag, count: 1, base: *log_odds, acc: delta };
+            *c = GroupCell { tag, count: 1, applied: 0.0, acc: delta };
             delta
         } else {
             c.count = c.count.saturating_add(1);
@@ -103,8 +109,10 @@ impl Group {
                 }
             }
         };
-        let base = c.base;
-        *log_odds = table.update(if base.is_nan() { table.prior } else { base }, merged);
+        let before = if log_odds.is_nan() { table.prior } else { *log_odds };
+        let after = table.update(before, merged - c.applied);
+        c.applied += after - before;
+        *log_odds = after;
     }
 }
 
@@ -135,6 +143,19 @@ mod tests {
         g2.update(&mut block, &mut l, 0, 1.0, &t);
         g2.update(&mut block, &mut l, 0, 0.0, &t);
         assert!((l - t.update(before, 0.5)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn evidence_written_between_two_members_is_kept() {
+        let t = table();
+        let mut block = None;
+        let mut l = 0.0f32;
+        let g = Group { id: 3, rule: MergeRule::Max };
+        g.update(&mut block, &mut l, 0, 0.5, &t);
+        // Another, ungrouped sensor writes the cell.
+        l = t.update(l, -0.4);
+        g.update(&mut block, &mut l, 0, 0.8, &t);
+        assert!((l - (0.8 - 0.4)).abs() < 1e-6, "{l}");
     }
 
     proptest! {

@@ -30,22 +30,22 @@ pub struct FusedUpdate {
     plain: bool,
     /// Hits routed to the dynamic layer so far.
     pub routed: u64,
-    /// Ghost hits skipped on the non-plain path.
+    /// Suspected ghost hits counted on the non-plain path.
     ghosts: u64,
 }
 
 impl FusedUpdate {
     /// The update for `evidence` against the map's `table`, with the pass-through rule
-    /// `pass_through`.
+    /// `pass_through` (cells below the free threshold it gives end it).
     pub fn new(
         table: LogOddsTable,
         evidence: Evidence,
-        pass_through: &PassThroughParams,
+        pass_through: (&PassThroughParams, f64),
         group: Option<Group>,
         dynamic: Option<DynamicUpdate>,
         route_hits: bool,
     ) -> Self {
-        let occ = OccupancyUpdate::new(table, evidence).with_pass_through(pass_through);
+        let occ = OccupancyUpdate::new(table, evidence).with_pass_through(pass_through.0, pass_through.1);
         Self {
             occ,
             table,
@@ -89,7 +89,8 @@ impl FusedUpdate {
         self.occ.attenuated()
     }
 
-    /// Hits not applied because their ray had passed through a confidently occupied cell.
+    /// Hits whose ray had passed through a confidently occupied cell (see
+    /// [`InsertStats::ghost_hits`](super::InsertStats::ghost_hits)).
     pub fn ghost_hits(&self) -> u64 {
         self.occ.ghost_hits() + self.ghosts
     }
@@ -130,7 +131,9 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
         // The rule's state follows every visit of the ray, fresh or not.
         let v = tile.log_odds(offset).unwrap_or(f32::NAN);
         let d = self.occ.miss_increment(v, cells_after);
-        if !fresh || (v.is_nan() && d == 0.0) {
+        // No evidence (behind a confident cell) is not a zero vote: the cell, its group
+        // merge and the dynamic layer are left alone.
+        if !fresh || d == 0.0 {
             return;
         }
         Self::occupancy(&self.table, self.group, tile, offset, d);
@@ -145,11 +148,7 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
             CellVisitor::<MapTile<FusionLayers>>::end_hit(&mut self.occ, tile, offset, fresh);
             return;
         }
-        if self.occ.is_through() {
-            // A ghost echo (see `OccupancyUpdate`): no evidence.
-            self.ghosts += fresh as u64;
-            return;
-        }
+        self.ghosts += (self.occ.is_through() && fresh) as u64;
         self.hit(tile, offset, fresh);
     }
 

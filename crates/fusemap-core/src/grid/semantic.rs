@@ -4,10 +4,11 @@
 //! Dirichlet prior `α` over the classes that are not ignored, the posterior predictive
 //! probability of class `c` is `(α + n_c) / Σ_j (α + n_j)` (the Dirichlet–categorical
 //! conjugate update; Murphy, *Machine Learning: a Probabilistic Perspective*, §3.4). A
-//! camera frame adds at most one unit of evidence to a cell, split over the classes its
-//! pixels there report in proportion to their weights (depth, class rate, agreement of
-//! label and geometry): many pixels of one frame landing in one cell are one look, not
-//! many (the design document's "do not count correlated evidence twice", §2.4).
+//! camera frame adds to a cell the mean weight of its pixels there (depth, class rate,
+//! agreement of label and geometry; at most one unit while class weights are at most 1),
+//! split over the classes they report: many pixels of one frame landing in one cell are
+//! one look, not many (the design document's "do not count correlated evidence twice",
+//! §2.4).
 //!
 //! Counts are never decayed: the static semantic layer takes only static classes; moving
 //! objects go to the dynamic layer.

@@ -46,8 +46,8 @@ pub trait CellVisitor<T> {
     }
     /// The end cell of a hit ray, after the ray's walk (pass 2), with whether it is the
     /// cell's first hit of the observation. The default is [`hit`](Self::hit); a visitor
-    /// that judges the ray on the way (the pass-through rule: an echo from behind a
-    /// confidently occupied cell is a ghost) overrides it.
+    /// that judges the ray on the way (the pass-through rule counts echoes from behind a
+    /// confidently occupied cell) overrides it.
     #[inline(always)]
     fn end_hit(&mut self, tile: &mut T, offset: usize, fresh: bool) {
         self.hit(tile, offset, fresh)
@@ -142,8 +142,10 @@ pub struct InsertStats {
     pub dynamic_updates: u64,
     /// Of those, lidar hits routed from the static layer to the dynamic one.
     pub routed_to_dynamic: u64,
-    /// Hits not applied: their ray had passed through a confidently occupied cell (a
-    /// ghost echo, see [`PassThroughParams`](super::PassThroughParams)).
+    /// Hits whose ray was still behind a confidently occupied cell at its end (see
+    /// [`PassThroughParams`](super::PassThroughParams)): suspected ghost echoes. They are
+    /// applied — on real logs a wall seen past a clipped corner looks the same — and
+    /// counted.
     pub ghost_hits: u64,
     /// Of `cell_visits`, those at which the occupancy layer's free evidence had the
     /// reduced weight of the pass-through rule: the ray had passed through a cell the map

@@ -103,7 +103,7 @@ fn a_ray_ending_within_the_margin_is_a_plain_miss() {
     let s = g.insert(&data(vec![ray(5.0 + rule.margin_cells as f64, true)]));
     assert_eq!(g.log_odds(PILLAR), Some(g.table().update(before, d)));
     assert_eq!(s.cell_visits_attenuated, 0);
-    // Ends 4 cells behind: a quarter of it on the pillar, nothing on the cells after it.
+    // Ends 4 cells behind: a quarter of it on the pillar and the observed cells after it.
     let before = g.log_odds(PILLAR).unwrap();
     let near = g.log_odds(CellIndex::new(2, 0)).unwrap();
     let s = g.insert(&data(vec![ray(6.0 + rule.margin_cells as f64, true)]));
@@ -111,7 +111,7 @@ fn a_ray_ending_within_the_margin_is_a_plain_miss() {
     assert_eq!(g.log_odds(PILLAR), Some(g.table().update(before, quarter)));
     // Visits of cells 5 to 9 (the end cell 9, the hit, is visited but not updated).
     assert_eq!(s.cell_visits_attenuated, 5);
-    assert_eq!(g.log_odds(CellIndex::new(7, 0)), Some(d));
+    assert_eq!(g.log_odds(CellIndex::new(7, 0)), Some(g.table().update(d, quarter)));
     // The cells before it got the full miss.
     assert_eq!(g.log_odds(CellIndex::new(2, 0)), Some(g.table().update(near, d)));
 }
@@ -135,6 +135,7 @@ fn reference(observations: &[Vec<Ray>], table: &LogOddsTable, rule: &PassThrough
     let (d_hit, d_miss) = (table.increment(0.9), table.increment(0.4));
     let d_pass = (rule.weight * d_miss as f64) as f32;
     let confident = logit(rule.threshold) as f32;
+    let free = logit(OccupancyParams::default().free_threshold) as f32;
     for rays in observations {
         let mut done: HashSet<CellIndex> = HashSet::new();
         // Hit cells are marked first; each ray's hit is applied at the end of its walk.
@@ -145,19 +146,25 @@ fn reference(observations: &[Vec<Ray>], table: &LogOddsTable, rule: &PassThrough
             for (k, c) in walk.iter().enumerate() {
                 let after = walk.len() - 1 - k;
                 let v = cells.get(c).copied();
-                let entering = !through
-                    && !rule.is_off()
-                    && v.is_some_and(|v| v >= confident)
-                    && after > rule.margin_cells as usize;
-                // Behind a confident cell: no evidence at all.
-                let d = if through {
-                    None
-                } else if entering {
+                let d = if rule.is_off() {
+                    Some(d_miss)
+                } else if through {
+                    match v {
+                        // Never observed, behind a confident cell: no evidence.
+                        None => None,
+                        // Out into known free space: a plain ray again.
+                        Some(v) if v < free => {
+                            through = false;
+                            Some(d_miss)
+                        }
+                        Some(_) => Some(d_pass),
+                    }
+                } else if v.is_some_and(|v| v >= confident) && after > rule.margin_cells as usize {
+                    through = true;
                     Some(d_pass)
                 } else {
                     Some(d_miss)
                 };
-                through |= entering;
                 if done.insert(*c) {
                     if let Some(d) = d {
                         let v = v.unwrap_or(table.prior);
@@ -165,8 +172,8 @@ fn reference(observations: &[Vec<Ray>], table: &LogOddsTable, rule: &PassThrough
                     }
                 }
             }
-            // An echo from behind a confident cell counts for nothing.
-            if first[i] && !through {
+            // Every echo counts, applied at the end of its ray.
+            if first[i] {
                 let c = *walk.last().unwrap();
                 let v = cells.get(&c).copied().unwrap_or(table.prior);
                 cells.insert(c, table.update(v, d_hit));
