@@ -186,16 +186,23 @@ impl MapSet {
         let mut fed = 0;
         for m in std::iter::once(&mut self.primary).chain(&mut self.others) {
             if m.sensors.includes(data.sensor, kind) {
-                let params = m.grid.params();
-                let rule = (&params.pass_through, params.free_threshold);
-                let mut v =
-                    FusedUpdate::new(*m.grid.table(), data.evidence, rule, ctx.group, ctx.dynamic, ctx.route_hits);
-                let mut s = m.grid.insert_visited(&data.rays, &mut v);
-                v.finish();
-                s.cell_visits_attenuated += v.attenuated();
-                s.ghost_hits += v.ghost_hits();
-                s.routed_to_dynamic += v.routed;
-                s.dynamic_updates += v.routed;
+                let s = if ctx.group.is_none() && ctx.dynamic.is_none() {
+                    // The plain occupancy update, monomorphised on its own (the common case:
+                    // no correlated sensor, no camera).
+                    m.grid.insert(data)
+                } else {
+                    let params = m.grid.params();
+                    let rule = (&params.pass_through, params.free_threshold);
+                    let mut v =
+                        FusedUpdate::new(*m.grid.table(), data.evidence, rule, ctx.group, ctx.dynamic, ctx.route_hits);
+                    let mut s = m.grid.insert_visited(&data.rays, &mut v);
+                    v.finish();
+                    s.cell_visits_attenuated += v.attenuated();
+                    s.ghost_hits += v.ghost_hits();
+                    s.routed_to_dynamic += v.routed;
+                    s.dynamic_updates += v.routed;
+                    s
+                };
                 m.stats.add(&s);
                 total.add(&s);
                 fed += 1;
