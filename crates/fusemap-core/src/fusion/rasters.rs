@@ -25,9 +25,18 @@ pub struct SemanticCells {
 pub fn semantic_cells(grid: &FusionGrid, area: CellBox, classes: &ClassTable) -> SemanticCells {
     let eligible: Vec<bool> = classes.iter().map(|c| !c.ignore && !c.dynamic).collect();
     let k = eligible.len();
+    // With a symmetric prior the most likely class is the eligible one with the most
+    // evidence (ties: the first), so the first sweep needs no probabilities.
     let best = grid.cell_raster(area, -1i16, |tile, offset| {
-        let mut out = vec![0.0; k];
-        cell_semantics(tile, offset, &eligible, &mut out).map(|(b, _)| b as i16)
+        let counts = tile.layers().semantic_counts(offset, k)?;
+        let mut top: Option<(usize, f32)> = None;
+        for (c, (&n, &e)) in counts.iter().zip(&eligible).enumerate() {
+            if e && top.is_none_or(|(_, m)| n > m) {
+                top = Some((c, n));
+            }
+        }
+        let total: f32 = counts.iter().zip(&eligible).filter(|(_, &e)| e).map(|(n, _)| n).sum();
+        top.filter(|_| total > 0.0).map(|(c, _)| c as i16)
     });
     let n = best.width * best.height;
     let mut prob = vec![0.0f32; n];
