@@ -17,20 +17,18 @@ use crate::measurement::Evidence;
 ///   labelled, §2.4), when routing is on; a ray crossing a cell the dynamic layer holds
 ///   clears it there (the object has left).
 ///
-/// With neither a group nor a dynamic layer the update is the plain occupancy update,
-/// bit for bit [`OccupancyUpdate`]'s.
+/// An observation with neither a group nor a dynamic layer does not need it: it takes the
+/// plain occupancy insertion ([`LayeredGrid::insert`](super::LayeredGrid::insert)).
 #[derive(Clone, Debug)]
 pub struct FusedUpdate {
+    /// The occupancy update with the pass-through rule: its increments and its ray state.
     occ: OccupancyUpdate,
-    table: LogOddsTable,
-    d_hit: f32,
     group: Option<Group>,
     dynamic: Option<DynamicUpdate>,
     route_hits: bool,
-    plain: bool,
     /// Hits routed to the dynamic layer so far.
     pub routed: u64,
-    /// Suspected ghost hits counted on the non-plain path.
+    /// Hits whose ray was still behind a confidently occupied cell at its end.
     ghosts: u64,
 }
 
@@ -46,17 +44,7 @@ impl FusedUpdate {
         route_hits: bool,
     ) -> Self {
         let occ = OccupancyUpdate::new(table, evidence).with_pass_through(pass_through.0, pass_through.1);
-        Self {
-            occ,
-            table,
-            d_hit: table.increment(evidence.p_hit),
-            group,
-            dynamic,
-            route_hits,
-            plain: group.is_none() && dynamic.is_none(),
-            routed: 0,
-            ghosts: 0,
-        }
+        Self { occ, group, dynamic, route_hits, routed: 0, ghosts: 0 }
     }
 
     /// Applies an occupancy increment to a cell on its first visit of the observation.
@@ -92,17 +80,13 @@ impl FusedUpdate {
     /// Hits whose ray had passed through a confidently occupied cell (see
     /// [`InsertStats::ghost_hits`](super::InsertStats::ghost_hits)).
     pub fn ghost_hits(&self) -> u64 {
-        self.occ.ghost_hits() + self.ghosts
+        self.ghosts
     }
 }
 
 impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
     #[inline(always)]
     fn hit(&mut self, tile: &mut MapTile<FusionLayers>, offset: usize, fresh: bool) {
-        if self.plain {
-            tile.update_log_odds(offset, self.d_hit, &self.table, fresh);
-            return;
-        }
         if !fresh {
             return;
         }
@@ -113,7 +97,7 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
                 return;
             }
         }
-        Self::occupancy(&self.table, self.group, tile, offset, self.d_hit);
+        Self::occupancy(self.occ.table(), self.group, tile, offset, self.occ.hit_increment());
     }
 
     #[inline(always)]
@@ -124,10 +108,6 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
 
     #[inline(always)]
     fn pass_at(&mut self, tile: &mut MapTile<FusionLayers>, offset: usize, fresh: bool, cells_after: u64) {
-        if self.plain {
-            CellVisitor::<MapTile<FusionLayers>>::pass_at(&mut self.occ, tile, offset, fresh, cells_after);
-            return;
-        }
         // The rule's state follows every visit of the ray, fresh or not.
         let v = tile.log_odds(offset).unwrap_or(f32::NAN);
         let d = self.occ.miss_increment(v, cells_after);
@@ -136,7 +116,7 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
         if !fresh || d == 0.0 {
             return;
         }
-        Self::occupancy(&self.table, self.group, tile, offset, d);
+        Self::occupancy(self.occ.table(), self.group, tile, offset, d);
         if let Some(dy) = &self.dynamic {
             dy.clear(&mut tile.layers_mut().dynamic, offset);
         }
@@ -144,10 +124,6 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
 
     #[inline(always)]
     fn end_hit(&mut self, tile: &mut MapTile<FusionLayers>, offset: usize, fresh: bool) {
-        if self.plain {
-            CellVisitor::<MapTile<FusionLayers>>::end_hit(&mut self.occ, tile, offset, fresh);
-            return;
-        }
         self.ghosts += (self.occ.is_through() && fresh) as u64;
         self.hit(tile, offset, fresh);
     }
