@@ -1,0 +1,265 @@
+//! The probability grid of one submap: dense, growing to fit, updated in odds space.
+//!
+//! Scan matching reads a submap millions of times per second, so unlike the mapper's tiled
+//! log-odds grid this one is a dense array of 16-bit values. A value `v` in `1..=32767`
+//! stands for a probability linear in `[P_MIN, P_MAX]`; `0` is a cell never observed, read
+//! as `P_MIN` by the matchers (an unexplored cell explains no return). An update multiplies
+//! the cell's odds by the hit or miss odds (Thrun et al., *Probabilistic Robotics*, §9.2,
+//! written multiplicatively as in Hess et al. 2016), through two 32 768-entry tables built
+//! once, so an update is a table lookup. Each cell changes at most once per scan: a table
+//! entry carries a marker bit, and cells marked during a scan are left alone until the scan
+//! ends (the same once-per-scan rule as the mapper's grid).
+
+use crate::geometry::Point2;
+use crate::grid::{CellIndex, CellRay};
+
+/// The lowest probability a cell can hold (and what an unknown cell reads as).
+pub const P_MIN: f32 = 0.1;
+/// The highest probability a cell can hold.
+pub const P_MAX: f32 = 0.9;
+const MAX_VALUE: u16 = 32767;
+const MARK: u16 = 1 << 15;
+
+/// The probability a stored value stands for.
+#[inline]
+pub fn value_to_probability(v: u16) -> f32 {
+    let v = (v & !MARK).max(1);
+    P_MIN + (v - 1) as f32 * ((P_MAX - P_MIN) / (MAX_VALUE - 1) as f32)
+}
+
+/// The stored value nearest to probability `p` (clamped to `[P_MIN, P_MAX]`).
+#[inline]
+pub fn probability_to_value(p: f32) -> u16 {
+    let p = p.clamp(P_MIN, P_MAX);
+    1 + ((p - P_MIN) / (P_MAX - P_MIN) * (MAX_VALUE - 1) as f32).round() as u16
+}
+
+fn odds(p: f32) -> f32 {
+    p / (1.0 - p)
+}
+
+/// An odds-multiplying update as a table over stored values: entry `v` is the marked value
+/// after one update of a cell holding `v` (unknown cells start at probability ½).
+#[derive(Clone, Debug)]
+pub struct UpdateTable {
+    table: Vec<u16>,
+}
+
+impl UpdateTable {
+    /// The table for an observation of probability `p` (hit: `p > ½`, miss: `p < ½`).
+    pub fn new(p: f32) -> Self {
+        let o = odds(p.clamp(0.01, 0.99));
+        let table = (0..=MAX_VALUE)
+            .map(|v| {
+                let prior = if v == 0 { 0.5 } else { value_to_probability(v) };
+                let post = odds(prior) * o;
+                probability_to_value(post / (1.0 + post)) | MARK
+            })
+            .collect();
+        Self { table }
+    }
+}
+
+/// Cell limits of a grid: `width × height` cells from `min` (inclusive).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CellLimits {
+    /// The lowest cell (x, y).
+    pub min: CellIndex,
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+}
+
+impl CellLimits {
+    /// The linear index of cell `(x, y)`, when inside.
+    #[inline]
+    pub fn index(&self, x: i64, y: i64) -> Option<usize> {
+        let (dx, dy) = (x.wrapping_sub(self.min.x), y.wrapping_sub(self.min.y));
+        if dx < 0 || dy < 0 || dx as usize >= self.width || dy as usize >= self.height {
+            None
+        } else {
+            Some(dy as usize * self.width + dx as usize)
+        }
+    }
+}
+
+/// A submap's dense probability grid, in the local SLAM frame: cell `(i, j)` spans
+/// `[i·r, (i+1)·r) × [j·r, (j+1)·r)` metres.
+#[derive(Clone, Debug)]
+pub struct ProbabilityGrid {
+    resolution: f64,
+    limits: CellLimits,
+    cells: Vec<u16>,
+    marked: Vec<u32>,
+}
+
+impl ProbabilityGrid {
+    /// An empty grid of cell size `resolution` (metres).
+    pub fn new(resolution: f64) -> Self {
+        assert!(resolution > 0.0 && resolution.is_finite(), "grid resolution must be positive");
+        Self {
+            resolution,
+            limits: CellLimits { min: CellIndex::new(0, 0), width: 0, height: 0 },
+            cells: Vec::new(),
+            marked: Vec::new(),
+        }
+    }
+
+    /// Cell size, metres.
+    pub fn resolution(&self) -> f64 {
+        self.resolution
+    }
+
+    /// The cells held.
+    pub fn limits(&self) -> CellLimits {
+        self.limits
+    }
+
+    /// The stored values, row-major over [`limits`](Self::limits) (`0` = unknown).
+    pub fn values(&self) -> &[u16] {
+        &self.cells
+    }
+
+    /// The probability of cell `(x, y)`; [`P_MIN`] when unknown or outside.
+    #[inline]
+    pub fn probability(&self, x: i64, y: i64) -> f32 {
+        match self.limits.index(x, y) {
+            Some(i) => value_to_probability(self.cells[i]),
+            None => P_MIN,
+        }
+    }
+
+    /// True when cell `(x, y)` was ever updated.
+    pub fn is_known(&self, x: i64, y: i64) -> bool {
+        self.limits.index(x, y).is_some_and(|i| self.cells[i] != 0)
+    }
+
+    /// Observed cells.
+    pub fn known_cells(&self) -> usize {
+        self.cells.iter().filter(|&&v| v != 0).count()
+    }
+
+    /// Continuous cell coordinates of a point (cell `(i, j)` spans `[i, i+1) × [j, j+1)`).
+    #[inline]
+    pub fn to_cell_units(&self, p: Point2) -> (f64, f64) {
+        (p.x / self.resolution, p.y / self.resolution)
+    }
+
+    /// Grows the grid to hold the box `[lo, hi]` (cells), with a margin, keeping its data.
+    fn grow_to(&mut self, lo: (i64, i64), hi: (i64, i64)) {
+        let l = self.limits;
+        let (max_x, max_y) = (l.min.x + l.width as i64 - 1, l.min.y + l.height as i64 - 1);
+        if l.width > 0 && lo.0 >= l.min.x && lo.1 >= l.min.y && hi.0 <= max_x && hi.1 <= max_y {
+            return;
+        }
+        const MARGIN: i64 = 64;
+        let (nx0, ny0, nx1, ny1) = if l.width == 0 {
+            (lo.0 - MARGIN, lo.1 - MARGIN, hi.0 + MARGIN, hi.1 + MARGIN)
+        } else {
+            (
+                if lo.0 < l.min.x { lo.0 - MARGIN } else { l.min.x },
+                if lo.1 < l.min.y { lo.1 - MARGIN } else { l.min.y },
+                if hi.0 > max_x { hi.0 + MARGIN } else { max_x },
+                if hi.1 > max_y { hi.1 + MARGIN } else { max_y },
+            )
+        };
+        let (w, h) = ((nx1 - nx0 + 1) as usize, (ny1 - ny0 + 1) as usize);
+        let mut cells = vec![0u16; w * h];
+        for row in 0..l.height {
+            let src = &self.cells[row * l.width..(row + 1) * l.width];
+            let y = l.min.y + row as i64;
+            let start = (y - ny0) as usize * w + (l.min.x - nx0) as usize;
+            cells[start..start + l.width].copy_from_slice(src);
+        }
+        self.cells = cells;
+        self.limits = CellLimits { min: CellIndex::new(nx0, ny0), width: w, height: h };
+    }
+
+    #[inline]
+    fn apply(&mut self, x: i64, y: i64, table: &UpdateTable) {
+        if let Some(i) = self.limits.index(x, y) {
+            let v = self.cells[i];
+            if v & MARK == 0 {
+                self.cells[i] = table.table[v as usize];
+                self.marked.push(i as u32);
+            }
+        }
+    }
+
+    /// Inserts one scan: `hits` (returns) become more likely occupied, the cells crossed by
+    /// the rays from `origin` to every hit and to every `miss` (a free ray without a return)
+    /// more likely free. Hits are applied first, so a cell holding a return is never also
+    /// cleared by a neighbouring ray in the same scan; every cell changes at most once.
+    pub fn insert(&mut self, origin: Point2, hits: &[Point2], misses: &[Point2], hit: &UpdateTable, miss: &UpdateTable) {
+        let o = self.to_cell_units(origin);
+        let (mut lo, mut hi) = ((o.0.floor() as i64, o.1.floor() as i64), (o.0.floor() as i64, o.1.floor() as i64));
+        for p in hits.iter().chain(misses) {
+            let c = self.to_cell_units(*p);
+            let (cx, cy) = (c.0.floor() as i64, c.1.floor() as i64);
+            lo = (lo.0.min(cx), lo.1.min(cy));
+            hi = (hi.0.max(cx), hi.1.max(cy));
+        }
+        self.grow_to(lo, hi);
+        for p in hits {
+            let c = self.to_cell_units(*p);
+            self.apply(c.0.floor() as i64, c.1.floor() as i64, hit);
+        }
+        for (p, is_hit) in hits.iter().map(|p| (p, true)).chain(misses.iter().map(|p| (p, false))) {
+            let ray = CellRay::new(o, self.to_cell_units(*p));
+            let n = ray.len_cells();
+            for (k, c) in ray.enumerate() {
+                if is_hit && k as u64 + 1 == n {
+                    break;
+                }
+                self.apply(c.x, c.y, miss);
+            }
+        }
+        for i in self.marked.drain(..) {
+            self.cells[i as usize] &= !MARK;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_round_trip_probabilities() {
+        for p in [0.1f32, 0.25, 0.5, 0.75, 0.9] {
+            assert!((value_to_probability(probability_to_value(p)) - p).abs() < 1e-4);
+        }
+        assert_eq!(value_to_probability(0), P_MIN);
+    }
+
+    #[test]
+    fn hits_rise_misses_fall_and_each_cell_changes_once_per_scan() {
+        let (hit, miss) = (UpdateTable::new(0.55), UpdateTable::new(0.49));
+        let mut g = ProbabilityGrid::new(0.05);
+        let origin = Point2::new(0.0, 0.0);
+        // Two returns in the same cell: one update.
+        g.insert(origin, &[Point2::new(1.01, 0.01), Point2::new(1.02, 0.02)], &[], &hit, &miss);
+        assert!((g.probability(20, 0) - 0.55).abs() < 1e-3);
+        assert!((g.probability(10, 0) - 0.49).abs() < 1e-3);
+        assert!(!g.is_known(-5, 3));
+        for _ in 0..120 {
+            g.insert(origin, &[Point2::new(1.01, 0.01)], &[], &hit, &miss);
+        }
+        assert!((g.probability(20, 0) - P_MAX).abs() < 1e-3);
+        assert!((g.probability(10, 0) - P_MIN).abs() < 1e-3);
+    }
+
+    #[test]
+    fn the_grid_grows_in_every_direction_and_keeps_its_data() {
+        let (hit, miss) = (UpdateTable::new(0.55), UpdateTable::new(0.49));
+        let mut g = ProbabilityGrid::new(0.1);
+        g.insert(Point2::new(0.0, 0.0), &[Point2::new(1.0, 1.0)], &[], &hit, &miss);
+        let before = g.probability(10, 10);
+        g.insert(Point2::new(0.0, 0.0), &[Point2::new(-30.0, -20.0)], &[Point2::new(25.0, 40.0)], &hit, &miss);
+        assert_eq!(g.probability(10, 10), before);
+        assert!(g.probability(-300, -200) > 0.5);
+        assert!(g.is_known(201, 322));
+        assert!(g.probability(201, 322) < 0.5);
+    }
+}
