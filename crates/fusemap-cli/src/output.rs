@@ -5,7 +5,7 @@ use crate::summary::{CellsUpdated, MapInfo, Summary};
 use anyhow::{Context, Result};
 use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells};
 use fusemap_core::fusion::Engine;
-use fusemap_core::geometry::Pose2;
+use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::grid::{CellBox, CellIndex, CellRaster, DynamicParams, FusionGrid, Raster};
 use fusemap_core::measurement::SensorId;
 use fusemap_core::metrics::map_entropy;
@@ -38,6 +38,9 @@ pub struct OutputFiles {
     pub semantic_png: PathBuf,
     /// `dynamic.png`, for a run with a camera.
     pub dynamic: PathBuf,
+    /// `slam.png`: the optimised trajectory and its loop closures over the map, for a run
+    /// SLAM corrected.
+    pub slam: PathBuf,
 }
 
 impl OutputFiles {
@@ -53,10 +56,11 @@ impl OutputFiles {
             semantic: dir.join("semantic.yaml"),
             semantic_png: dir.join("semantic.png"),
             dynamic: dir.join("dynamic.png"),
+            slam: dir.join("slam.png"),
         }
     }
 
-    fn all(&self) -> [&PathBuf; 9] {
+    fn all(&self) -> [&PathBuf; 10] {
         [
             &self.npz,
             &self.yaml,
@@ -67,6 +71,7 @@ impl OutputFiles {
             &self.semantic,
             &self.semantic_png,
             &self.dynamic,
+            &self.slam,
         ]
     }
 }
@@ -145,10 +150,41 @@ pub fn write(
         }
         fusemap_io::map_server::write_map_server(&files.yaml, r)?;
         fusemap_io::picture::write_map_png(&files.png, r)?;
+        if let Some((trajectory, closures)) = summary.log.as_ref().and_then(pose_graph_of) {
+            fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, &trajectory, &closures)?;
+        }
     }
     let json = serde_json::to_vec_pretty(summary)?;
     write_atomic(&files.summary, |w| w.write_all(&json))?;
     Ok(())
+}
+
+/// The scan nodes and the loop closures (submap origin, node) of the pose graph in a run
+/// report's `slam` section.
+fn pose_graph_of(log: &serde_json::Value) -> Option<(Vec<Point2>, Vec<(Point2, Point2)>)> {
+    let slam = log.get("slam")?;
+    let nodes: Vec<(bool, Point2)> = slam
+        .get("nodes")?
+        .as_array()?
+        .iter()
+        .map(|n| {
+            let p = n.get("pose").and_then(|p| p.as_array());
+            let c = |i: usize| p.and_then(|p| p.get(i)).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
+            (n.get("kind").and_then(|k| k.as_str()) == Some("scan"), Point2::new(c(0), c(1)))
+        })
+        .collect();
+    let trajectory = nodes.iter().filter(|n| n.0).map(|n| n.1).collect();
+    let closures = slam
+        .get("edges")?
+        .as_array()?
+        .iter()
+        .filter(|e| e.get("kind").and_then(|k| k.as_str()) == Some("loop_closure"))
+        .filter_map(|e| {
+            let i = |k: &str| e.get(k).and_then(|v| v.as_u64()).and_then(|v| nodes.get(v as usize)).map(|n| n.1);
+            Some((i("from")?, i("to")?))
+        })
+        .collect();
+    Some((trajectory, closures))
 }
 
 /// Builds the summary of a finished engine and writes every output.

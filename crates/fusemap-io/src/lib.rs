@@ -18,6 +18,7 @@ pub mod read_ahead;
 pub mod scanfile;
 pub mod semantic;
 pub mod simulation;
+pub mod slam_picture;
 pub mod trajectory;
 pub mod world_file;
 

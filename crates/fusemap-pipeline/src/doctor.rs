@@ -163,7 +163,7 @@ pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
     let mut notes = Vec::new();
     let mut findings: Vec<String> = Vec::new();
     let mut sync = None;
-    match crate::run::prepare(plan, &log) {
+    match crate::run::prepare_track(plan, &log) {
         Ok((bound, _, _)) if bound.lidars.is_empty() => {
             findings.push("cannot be mapped: every [[sensor]] of kind lidar is disabled".into())
         }

@@ -358,6 +358,7 @@ pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Ch
         receive,
         estimator: serde_json::to_value(report).ok(),
         notes,
+        slam: None,
     })
 }
 

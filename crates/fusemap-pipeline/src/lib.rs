@@ -34,6 +34,7 @@ pub mod report;
 pub mod run;
 pub mod scenario;
 pub mod sensors;
+pub mod slam;
 pub mod track;
 
 pub use run::{map_inventory, map_log, map_with_track, MapRun, Progress};

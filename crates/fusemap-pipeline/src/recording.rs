@@ -29,6 +29,9 @@ pub struct ScanTopic {
     pub frames: BTreeMap<String, u64>,
     /// Scans that carry a pose on their line (CARMEN).
     pub with_pose: u64,
+    /// Of those, lines whose pose is their raw odometry pose (a raw CARMEN log: nothing
+    /// has corrected it, so SLAM should).
+    pub pose_is_odometry: u64,
     /// The first (robot pose, laser pose) pair of a line that carries both (CARMEN
     /// `ROBOTLASER1`), from which the mount follows.
     pub first_laser_pose: Option<(Pose2, Pose2)>,
@@ -235,8 +238,11 @@ impl Inventory {
                     t.stamps.push(s.scan.stamp);
                     t.receive.push(s.receive_stamp);
                     *t.frames.entry(s.frame_id).or_default() += 1;
-                    if s.pose.is_some() {
+                    if let Some(p) = s.pose {
                         t.with_pose += 1;
+                        if s.odom_pose == Some(p) {
+                            t.pose_is_odometry += 1;
+                        }
                     }
                     if t.first_laser_pose.is_none() {
                         if let (Some(r), Some(l)) = (s.pose, s.laser_pose) {

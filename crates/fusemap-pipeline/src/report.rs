@@ -115,6 +115,9 @@ pub struct LogReport {
     pub cameras: Vec<crate::camera::CameraReport>,
     /// Observations merged into a correlation group another observation had opened.
     pub correlated_merged: u64,
+    /// What SLAM did (scan matching, loop closure, the optimised pose graph), when it ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slam: Option<crate::slam::SlamSummary>,
     /// The sensors that were read, by name: `kind topic`.
     pub sensors: BTreeMap<String, String>,
     /// The pose track's counters.

@@ -13,10 +13,11 @@ use crate::extrinsics::{frame_tree, lidar_mount_from_log, resolve, ExtrinsicsRep
 use crate::merge::{OrderedMerge, Pushed};
 use crate::recording::{for_each_range_message, Inventory, RangeMessage};
 use crate::report::{LidarReport, LogReport, Skipped};
-use crate::sensors::{bind, Bound};
+use crate::sensors::{bind, Bound, BoundLidar};
 use crate::track::{choose, count_reordered, ChosenTrack, Track};
 use crate::PipelineError;
 use fusemap_core::config::{default_camera, LogConfig, Plan, PlannedCamera, SensorKind, SyncConfig};
+use fusemap_core::frames::FrameTree;
 use fusemap_core::fusion::{Correlation, Engine, MapSet};
 use fusemap_core::geometry::{PlanarMount, Pose2};
 use fusemap_core::grid::FusionGrid;
@@ -148,8 +149,33 @@ struct Mapped {
     report: LidarReport,
 }
 
-/// Binds the sensors and builds the pose track: everything before the scans are read.
-pub fn prepare(plan: &Plan, inv: &Inventory) -> Result<(Bound, ChosenTrack, f64), PipelineError> {
+/// A bound lidar's frame, its resolved mount and its sensor model.
+pub(crate) fn lidar_setup(
+    b: &BoundLidar,
+    inv: &Inventory,
+    tree: &FrameTree,
+    cfg: &LogConfig,
+    notes: &mut Vec<String>,
+) -> Result<(String, ExtrinsicsReport, LidarModel), PipelineError> {
+    let topic = &inv.scans[&b.topic];
+    let frame = b.lidar.frame.clone().or_else(|| topic.frame().map(str::to_string)).unwrap_or_default();
+    let log_mount = lidar_mount_from_log(tree, &cfg.base_frame, &frame, topic);
+    let config_mount = b.lidar.mount_given.then_some(b.lidar.mount);
+    let ext: ExtrinsicsReport = resolve(&frame, cfg, config_mount, log_mount, notes)?;
+    let planar: PlanarMount = ext
+        .base_from_sensor
+        .to_planar(b.lidar.max_tilt)
+        .map_err(|e| PipelineError::Refused(format!("mount of lidar `{}` ({}): {e}", b.lidar.name, ext.source)))?;
+    let mut params = *b.lidar.model.params();
+    if !b.lidar.explicit {
+        // Defaults suited to a typical indoor 2D lidar rather than the document's 10 m corridor.
+        params.max_range = 40.0;
+    }
+    Ok((frame, ext, LidarModel::new(params, planar)))
+}
+
+/// Binds the sensors and builds the pose track from the pose sensors alone.
+pub fn prepare_track(plan: &Plan, inv: &Inventory) -> Result<(Bound, ChosenTrack, f64), PipelineError> {
     if inv.scans.is_empty() && inv.stats.malformed > 0 {
         return Err(PipelineError::Refused(format!(
             "the log holds no usable laser scans; {} records could not be decoded, the first: {}",
@@ -163,13 +189,47 @@ pub fn prepare(plan: &Plan, inv: &Inventory) -> Result<(Bound, ChosenTrack, f64)
     Ok((bound, chosen, t0.elapsed().as_secs_f64()))
 }
 
+/// [`prepare_track`], then SLAM corrects the track when [`crate::slam::applies`] says so.
+pub fn prepare(plan: &Plan, inv: &Inventory) -> Result<(Bound, ChosenTrack, f64), PipelineError> {
+    prepare_with(plan, inv, &mut |_| {})
+}
+
+/// [`prepare`] with progress reports.
+pub fn prepare_with(
+    plan: &Plan,
+    inv: &Inventory,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(Bound, ChosenTrack, f64), PipelineError> {
+    let (bound, chosen, track_s) = prepare_track(plan, inv)?;
+    let (on, reason) = crate::slam::applies(plan, inv, &bound, &chosen);
+    if !on {
+        return Ok((bound, chosen, track_s));
+    }
+    let t0 = Instant::now();
+    let mut run = crate::slam::run(plan, inv, &bound, &chosen, reason, progress)?;
+    let mut track = crate::slam::track(plan, inv, &bound, &mut run)?;
+    track.notes.extend(chosen.notes);
+    track.notes.push(format!(
+        "SLAM corrected the poses ({}): {} scans matched ({} degenerate), {} nodes, {} submaps, {} of {} loop-closure searches accepted",
+        run.summary.reason,
+        run.summary.counts.matched + run.summary.counts.degenerate,
+        run.summary.counts.degenerate,
+        run.summary.counts.nodes,
+        run.summary.counts.submaps,
+        run.summary.counts.loop_accepted,
+        run.summary.counts.loop_searches,
+    ));
+    track.slam = Some(Box::new(run.summary));
+    Ok((bound, track, track_s + t0.elapsed().as_secs_f64()))
+}
+
 /// Maps a recording whose first pass is done.
 pub fn map_inventory(
     plan: &Plan,
     inv: &Inventory,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MapRun, PipelineError> {
-    let (bound, chosen, track_s) = prepare(plan, inv)?;
+    let (bound, chosen, track_s) = prepare_with(plan, inv, progress)?;
     map_with_track(plan, inv, &bound, chosen, track_s, None, progress)
 }
 
@@ -190,6 +250,8 @@ pub fn map_with_track(
 ) -> Result<MapRun, PipelineError> {
     let cfg = &plan.log;
     let mut notes = bound.notes.clone();
+    let mut chosen = chosen;
+    let slam_summary = chosen.slam.take();
     if bound.lidars.is_empty() {
         return Err(PipelineError::Refused("no lidar to map: every [[sensor]] of kind lidar is disabled".into()));
     }
@@ -209,20 +271,8 @@ pub fn map_with_track(
     let mut lidars = Vec::new();
     for b in &bound.lidars {
         let topic = &inv.scans[&b.topic];
-        let frame = b.lidar.frame.clone().or_else(|| topic.frame().map(str::to_string)).unwrap_or_default();
-        let log_mount = lidar_mount_from_log(&tree, &cfg.base_frame, &frame, topic);
-        let config_mount = b.lidar.mount_given.then_some(b.lidar.mount);
-        let ext: ExtrinsicsReport = resolve(&frame, cfg, config_mount, log_mount, &mut notes)?;
-        let planar: PlanarMount = ext
-            .base_from_sensor
-            .to_planar(b.lidar.max_tilt)
-            .map_err(|e| PipelineError::Refused(format!("mount of lidar `{}` ({}): {e}", b.lidar.name, ext.source)))?;
-        let mut params = *b.lidar.model.params();
-        if !b.lidar.explicit {
-            // Defaults suited to a typical indoor 2D lidar rather than the document's 10 m corridor.
-            params.max_range = 40.0;
-        }
-        let id = engine.add_lidar(b.lidar.name.clone(), LidarModel::new(params, planar));
+        let (frame, ext, model) = lidar_setup(b, inv, &tree, cfg, &mut notes)?;
+        let id = engine.add_lidar(b.lidar.name.clone(), model);
         let mut other_frames = topic.frames.clone();
         other_frames.remove(&frame);
         other_frames.remove("");
@@ -489,6 +539,7 @@ pub fn map_with_track(
         lidars: lidars.into_iter().map(|l| l.report).collect(),
         cameras: cameras.into_iter().map(|c| c.report).collect(),
         correlated_merged: engine.stats().correlated_merged,
+        slam: slam_summary.map(|s| *s),
     };
     notes.extend(chosen.notes.iter().cloned());
     Ok(MapRun { engine, format: inv.format, report, trajectory, notes })

@@ -59,6 +59,8 @@ pub struct ChosenTrack {
     pub estimator: Option<serde_json::Value>,
     /// Facts about the track a user should know.
     pub notes: Vec<String>,
+    /// What SLAM did, when it corrected the track.
+    pub slam: Option<Box<crate::slam::SlamSummary>>,
 }
 
 /// `root_from_base` looked up in the frame tree at each stamp: the TF pose source when the
@@ -125,6 +127,7 @@ impl ChosenTrack {
             receive: Vec::new(),
             estimator: None,
             notes: Vec::new(),
+            slam: None,
         }
     }
 }
@@ -233,6 +236,7 @@ pub fn choose(
                 receive: Vec::new(),
                 estimator: None,
                 notes: Vec::new(),
+                slam: None,
             })
         }
         PoseSource::Odometry => {
@@ -260,6 +264,7 @@ pub fn choose(
                 receive: msgs.iter().map(|m| m.receive_stamp).collect(),
                 estimator: None,
                 notes: Vec::new(),
+                slam: None,
             })
         }
         PoseSource::Tf => {
@@ -286,6 +291,7 @@ pub fn choose(
                     stamps,
                     estimator: None,
                     notes: Vec::new(),
+                    slam: None,
                 });
             }
             let stamps: Vec<Stamp> = tf_samples.iter().map(|s| s.0).collect();
@@ -302,6 +308,7 @@ pub fn choose(
                 stamps,
                 estimator: None,
                 notes: Vec::new(),
+                slam: None,
             })
         }
         PoseSource::Estimator => estimate(),

@@ -8,10 +8,12 @@
 
 mod camera;
 mod fusion;
+mod slam;
 mod sensor;
 
 pub use camera::{default_camera, ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
 pub use fusion::FusionConfig;
+pub use slam::{SlamConfig, SlamMode};
 pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 
 use crate::estimator::EstimatorConfig;
@@ -39,6 +41,9 @@ pub struct Config {
     /// How the sensors' evidence is combined: correlated sensors, the dynamic layer.
     #[serde(default)]
     pub fusion: FusionConfig,
+    /// Scan matching, submaps and loop closure.
+    #[serde(default)]
+    pub slam: SlamConfig,
     /// The semantic classes of the cameras' label images, one `[[class]]` table each;
     /// none: [`ClassTable::production_default`].
     #[serde(default)]
@@ -247,6 +252,12 @@ pub struct Plan {
     pub fusion: FusionConfig,
     /// The dynamic layer's parameters (from `[fusion]`).
     pub dynamic: crate::grid::DynamicParams,
+    /// When SLAM runs.
+    pub slam_mode: SlamMode,
+    /// SLAM's parameters (from `[slam]`).
+    pub slam: crate::slam::SlamParams,
+    /// σ (metres, radians) of the optimised scan poses as pose-estimator inputs.
+    pub slam_pose_sigma: (f64, f64),
 }
 
 impl Config {
@@ -351,6 +362,7 @@ impl Config {
             _ => err("estimator", m),
         })?;
         let dynamic = self.fusion.validate(occ_t)?;
+        let slam = self.slam.validate()?;
         for (i, group) in self.fusion.correlated.iter().enumerate() {
             for name in group {
                 let known = lidars.iter().any(|l| &l.name == name)
@@ -373,6 +385,9 @@ impl Config {
             estimator: self.estimator.clone(),
             fusion: self.fusion.clone(),
             dynamic,
+            slam_mode: self.slam.mode,
+            slam,
+            slam_pose_sigma: (self.slam.pose_sigma_m, self.slam.pose_sigma_deg.to_radians()),
         })
     }
 }

@@ -1,2 +1,27 @@
 //! 2D SLAM: scan-to-submap matching, submaps, loop closure and a pose graph.
+//!
+//! | step | module |
+//! |---|---|
+//! | a submap's probability grid | `grid.rs` |
+//! | its smooth (bicubic) interpolation | `interpolation.rs` |
+//! | correlative search + Gauss–Newton refinement + information | `local_match.rs` |
+//! | two active submaps, finished ones kept | `submap.rs` |
+//! | branch-and-bound loop-closure search | `global_match.rs` |
+//! | sparse pose-graph optimisation | `pose_graph.rs` |
+//! | the loop over scans | `mapper.rs` |
+pub mod global_match;
 pub mod grid;
+pub mod interpolation;
+pub mod local_match;
+mod mapper;
+mod params;
+pub mod pose_graph;
+mod report;
+pub mod submap;
+#[cfg(test)]
+mod test_world;
+
+pub use local_match::LocalMatchParams;
+pub use mapper::{ScanInput, ScanOutcome, Slam, SlamResult};
+pub use params::SlamParams;
+pub use report::SlamReport;

@@ -1,0 +1,260 @@
+//! `[slam]`: scan matching, submaps and loop closure (Hess et al. 2016), and when they run.
+//!
+//! Every key maps onto [`SlamParams`]; the defaults are in [`SlamParams::default`] and the
+//! reasons for them beside each field there.
+
+use super::{err, finite, probability, ConfigError};
+use crate::slam::{LocalMatchParams, SlamParams};
+use serde::{Deserialize, Serialize};
+
+/// When SLAM corrects the pose track.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SlamMode {
+    /// On when the poses come from odometry, the estimator, TF under an `odom` frame or
+    /// the raw odometry of a CARMEN log; off when they are already corrected (corrected
+    /// CARMEN logs, TF from a `map` frame).
+    #[default]
+    Auto,
+    /// Always (on a log with a lidar).
+    On,
+    /// Never: the pose track is used as it is.
+    Off,
+}
+
+/// The `[slam]` table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SlamConfig {
+    /// `auto`, `on` or `off`.
+    pub mode: SlamMode,
+    /// Submap cell size, metres.
+    pub resolution_m: f64,
+    /// Scans each submap takes before the next one starts.
+    pub scans_per_submap: usize,
+    /// Occupancy probability of one hit in a submap.
+    pub hit_probability: f64,
+    /// Occupancy probability of one miss in a submap.
+    pub miss_probability: f64,
+    /// Returns farther than this are not used by SLAM, metres.
+    pub max_range_m: f64,
+    /// Scans with fewer usable returns are not matched.
+    pub min_points: usize,
+    /// A scan becomes a pose-graph node after this much travel, metres …
+    pub node_distance_m: f64,
+    /// … or this much turn, degrees …
+    pub node_angle_deg: f64,
+    /// … or this much time, seconds.
+    pub node_time_s: f64,
+    /// Correlative search half-width in x and y, metres.
+    pub search_linear_window_m: f64,
+    /// Correlative search half-width in heading, degrees.
+    pub search_angular_window_deg: f64,
+    /// Correlative motion penalty per metre.
+    pub translation_delta_cost: f64,
+    /// Correlative motion penalty per radian.
+    pub rotation_delta_cost: f64,
+    /// Refinement pull towards the correlative result, per metre.
+    pub translation_weight: f64,
+    /// Refinement pull towards the correlative result, per radian.
+    pub rotation_weight: f64,
+    /// σ of one point's residual (probability units) scaling the match information.
+    pub match_residual_sigma: f64,
+    /// Smallest/largest translational information below which a match is degenerate.
+    pub degeneracy_ratio: f64,
+    /// Odometry edge σ per metre travelled.
+    pub odometry_translation_per_m: f64,
+    /// Odometry edge σ floor, metres.
+    pub odometry_floor_m: f64,
+    /// Odometry edge σ per radian turned.
+    pub odometry_rotation_per_rad: f64,
+    /// Odometry edge σ floor, degrees.
+    pub odometry_floor_deg: f64,
+    /// Search for loop closures.
+    pub loop_closure: bool,
+    /// Share of (node, nearby finished submap) pairs searched: the loop-closure rate.
+    pub loop_closure_sampling_ratio: f64,
+    /// Only submaps within this distance of a node are searched, metres.
+    pub loop_closure_max_distance_m: f64,
+    /// Loop-closure search half-width in x and y, metres.
+    pub loop_closure_linear_window_m: f64,
+    /// Loop-closure search half-width in heading, degrees.
+    pub loop_closure_angular_window_deg: f64,
+    /// Minimum mean probability of a loop closure's points (the score threshold).
+    pub loop_closure_min_score: f64,
+    /// Huber scale of loop-closure edges, in σ.
+    pub loop_closure_huber: f64,
+    /// σ of a loop closure's translation, metres.
+    pub loop_closure_sigma_m: f64,
+    /// σ of a loop closure's rotation, degrees.
+    pub loop_closure_sigma_deg: f64,
+    /// Optimise the pose graph every this many nodes (and at the end).
+    pub optimize_every_n_nodes: usize,
+    /// Levels of the branch-and-bound precomputation (2^(depth−1) cells at the top).
+    pub branch_and_bound_depth: usize,
+    /// σ of the optimised scan poses given to the pose estimator, metres.
+    pub pose_sigma_m: f64,
+    /// σ of the optimised scan poses given to the pose estimator, degrees.
+    pub pose_sigma_deg: f64,
+}
+
+impl Default for SlamConfig {
+    fn default() -> Self {
+        let p = SlamParams::default();
+        Self {
+            mode: SlamMode::Auto,
+            resolution_m: p.resolution,
+            scans_per_submap: p.scans_per_submap,
+            hit_probability: p.hit_probability as f64,
+            miss_probability: p.miss_probability as f64,
+            max_range_m: p.max_range_m,
+            min_points: p.min_points,
+            node_distance_m: p.node_distance_m,
+            node_angle_deg: p.node_angle_rad.to_degrees(),
+            node_time_s: p.node_time_s,
+            search_linear_window_m: p.local.linear_window_m,
+            search_angular_window_deg: p.local.angular_window_rad.to_degrees(),
+            translation_delta_cost: p.local.translation_delta_cost,
+            rotation_delta_cost: p.local.rotation_delta_cost,
+            translation_weight: p.local.translation_weight,
+            rotation_weight: p.local.rotation_weight,
+            match_residual_sigma: p.local.residual_sigma,
+            degeneracy_ratio: p.local.degeneracy_ratio,
+            odometry_translation_per_m: p.odometry_translation_per_m,
+            odometry_floor_m: p.odometry_floor_m,
+            odometry_rotation_per_rad: p.odometry_rotation_per_rad,
+            odometry_floor_deg: p.odometry_floor_rad.to_degrees(),
+            loop_closure: p.loop_closure,
+            loop_closure_sampling_ratio: p.loop_closure_sampling_ratio,
+            loop_closure_max_distance_m: p.loop_closure_max_distance_m,
+            loop_closure_linear_window_m: p.loop_closure_linear_window_m,
+            loop_closure_angular_window_deg: p.loop_closure_angular_window_rad.to_degrees(),
+            loop_closure_min_score: p.loop_closure_min_score as f64,
+            loop_closure_huber: p.loop_closure_huber,
+            loop_closure_sigma_m: p.loop_closure_sigma_m,
+            loop_closure_sigma_deg: p.loop_closure_sigma_rad.to_degrees(),
+            optimize_every_n_nodes: p.optimize_every_n_nodes,
+            branch_and_bound_depth: p.branch_and_bound_depth,
+            pose_sigma_m: 0.01,
+            pose_sigma_deg: 0.25,
+        }
+    }
+}
+
+fn positive(field: &str, v: f64) -> Result<f64, ConfigError> {
+    let v = finite(&format!("slam.{field}"), v)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(err(format!("slam.{field}"), format!("must be > 0, got {v}")))
+    }
+}
+
+fn non_negative(field: &str, v: f64) -> Result<f64, ConfigError> {
+    let v = finite(&format!("slam.{field}"), v)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(err(format!("slam.{field}"), format!("must be ≥ 0, got {v}")))
+    }
+}
+
+impl SlamConfig {
+    /// Checks every key and builds the parameters.
+    pub fn validate(&self) -> Result<SlamParams, ConfigError> {
+        let hit = probability("slam.hit_probability", self.hit_probability)?;
+        let miss = probability("slam.miss_probability", self.miss_probability)?;
+        if hit <= 0.5 || miss >= 0.5 {
+            return Err(err("slam", format!("need hit_probability > 0.5 > miss_probability, got {hit} / {miss}")));
+        }
+        let score = probability("slam.loop_closure_min_score", self.loop_closure_min_score)?;
+        let ratio = finite("slam.loop_closure_sampling_ratio", self.loop_closure_sampling_ratio)?;
+        if !(0.0..=1.0).contains(&ratio) {
+            return Err(err("slam.loop_closure_sampling_ratio", format!("must be within 0..=1, got {ratio}")));
+        }
+        let res = positive("resolution_m", self.resolution_m)?;
+        if !(0.005..=1.0).contains(&res) {
+            return Err(err("slam.resolution_m", format!("must be within 0.005..=1 m, got {res}")));
+        }
+        for (k, v) in [("scans_per_submap", self.scans_per_submap), ("optimize_every_n_nodes", self.optimize_every_n_nodes)] {
+            if v == 0 {
+                return Err(err(format!("slam.{k}"), "must be at least 1"));
+            }
+        }
+        if !(1..=12).contains(&self.branch_and_bound_depth) {
+            return Err(err("slam.branch_and_bound_depth", format!("must be within 1..=12, got {}", self.branch_and_bound_depth)));
+        }
+        let angular = non_negative("search_angular_window_deg", self.search_angular_window_deg)?;
+        let lc_angular = non_negative("loop_closure_angular_window_deg", self.loop_closure_angular_window_deg)?;
+        if angular > 180.0 || lc_angular > 180.0 {
+            return Err(err("slam", "angular search windows must be at most 180°"));
+        }
+        positive("pose_sigma_m", self.pose_sigma_m)?;
+        positive("pose_sigma_deg", self.pose_sigma_deg)?;
+        Ok(SlamParams {
+            resolution: res,
+            scans_per_submap: self.scans_per_submap,
+            hit_probability: hit as f32,
+            miss_probability: miss as f32,
+            max_range_m: positive("max_range_m", self.max_range_m)?,
+            min_points: self.min_points,
+            node_distance_m: non_negative("node_distance_m", self.node_distance_m)?,
+            node_angle_rad: non_negative("node_angle_deg", self.node_angle_deg)?.to_radians(),
+            node_time_s: positive("node_time_s", self.node_time_s)?,
+            local: LocalMatchParams {
+                linear_window_m: non_negative("search_linear_window_m", self.search_linear_window_m)?.min(5.0),
+                angular_window_rad: angular.to_radians(),
+                translation_delta_cost: non_negative("translation_delta_cost", self.translation_delta_cost)?,
+                rotation_delta_cost: non_negative("rotation_delta_cost", self.rotation_delta_cost)?,
+                map_weight: 1.0,
+                translation_weight: non_negative("translation_weight", self.translation_weight)?,
+                rotation_weight: non_negative("rotation_weight", self.rotation_weight)?,
+                residual_sigma: positive("match_residual_sigma", self.match_residual_sigma)?,
+                degeneracy_ratio: non_negative("degeneracy_ratio", self.degeneracy_ratio)?,
+            },
+            odometry_translation_per_m: non_negative("odometry_translation_per_m", self.odometry_translation_per_m)?,
+            odometry_floor_m: positive("odometry_floor_m", self.odometry_floor_m)?,
+            odometry_rotation_per_rad: non_negative("odometry_rotation_per_rad", self.odometry_rotation_per_rad)?,
+            odometry_floor_rad: positive("odometry_floor_deg", self.odometry_floor_deg)?.to_radians(),
+            loop_closure: self.loop_closure,
+            loop_closure_sampling_ratio: ratio,
+            loop_closure_max_distance_m: non_negative("loop_closure_max_distance_m", self.loop_closure_max_distance_m)?,
+            loop_closure_linear_window_m: non_negative("loop_closure_linear_window_m", self.loop_closure_linear_window_m)?
+                .min(100.0),
+            loop_closure_angular_window_rad: lc_angular.to_radians(),
+            loop_closure_min_score: score as f32,
+            loop_closure_huber: positive("loop_closure_huber", self.loop_closure_huber)?,
+            loop_closure_sigma_m: positive("loop_closure_sigma_m", self.loop_closure_sigma_m)?,
+            loop_closure_sigma_rad: positive("loop_closure_sigma_deg", self.loop_closure_sigma_deg)?.to_radians(),
+            optimize_every_n_nodes: self.optimize_every_n_nodes,
+            branch_and_bound_depth: self.branch_and_bound_depth,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_round_trip_to_the_parameters() {
+        let p = SlamConfig::default().validate().unwrap();
+        let d = SlamParams::default();
+        assert_eq!(p.scans_per_submap, d.scans_per_submap);
+        assert!((p.node_angle_rad - d.node_angle_rad).abs() < 1e-12);
+        assert!((p.loop_closure_angular_window_rad - d.loop_closure_angular_window_rad).abs() < 1e-12);
+        assert_eq!(p.local.linear_window_m, d.local.linear_window_m);
+    }
+
+    #[test]
+    fn bad_keys_are_named() {
+        let c = SlamConfig { resolution_m: 1e-9, ..Default::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("slam.resolution_m"));
+        let c = SlamConfig { hit_probability: 0.4, ..Default::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("hit_probability"));
+        let c = SlamConfig { loop_closure_sampling_ratio: 2.0, ..Default::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("slam.loop_closure_sampling_ratio"));
+        let c = SlamConfig { scans_per_submap: 0, ..Default::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("slam.scans_per_submap"));
+    }
+}

@@ -1,0 +1,385 @@
+//! The SLAM loop: local matching into submaps, nodes and constraints into a pose graph,
+//! loop-closure search on finished submaps, and the optimised trajectory.
+//!
+//! Local SLAM (Hess et al. 2016, §IV): each scan's pose is predicted from the previous
+//! scan's matched pose and the pose track's motion between the two stamps (odometry, IMU
+//! and fixes already fused by the estimator), then matched against the older active
+//! submap. The predicted motion is the prior of the match: where the lidar sees structure
+//! the match dominates, and where the match is degenerate (a corridor) the prediction is
+//! kept along the weak direction.
+//!
+//! Global SLAM (§V): every scan that moved far enough becomes a node; it is tied to the
+//! submaps it went into by its local pose (information from the match's curvature) and to
+//! the previous node by the track's motion (an odometry edge, whose σ grows with the
+//! distance). Nodes are searched against finished submaps near them by branch-and-bound
+//! (loop closures, Huber loss), and the graph is optimised every few nodes and at the end.
+//! Every scan's final pose is its nearest earlier node's optimised pose composed with the
+//! local offset between the two.
+
+use super::global_match::{match_branch_and_bound, GlobalSearch, PrecomputedGrids};
+use super::local_match::{mean_probability, refine, LocalMatchParams};
+use super::params::SlamParams;
+use super::pose_graph::{Edge, EdgeKind, Loss, OptimizeOptions, PoseGraph};
+use super::report::SlamReport;
+use super::submap::Submaps;
+use crate::geometry::{normalize_angle, Point2, Pose2};
+use crate::time::Stamp;
+use std::time::Instant;
+
+/// One scan as SLAM takes it. Points are in the base frame.
+#[derive(Clone, Copy, Debug)]
+pub struct ScanInput<'a> {
+    /// The scan's stamp.
+    pub stamp: Stamp,
+    /// `map_from_base` at the stamp from the pose track (odometry or the estimator): only
+    /// its motion between scans is used.
+    pub track: Pose2,
+    /// The sensor's origin in the base frame.
+    pub origin: Point2,
+    /// Returns.
+    pub hits: &'a [Point2],
+    /// Ends of free rays without a return (beyond the sensor's range), if any.
+    pub misses: &'a [Point2],
+}
+
+/// What became of a scan.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ScanOutcome {
+    /// Matched against a submap.
+    Matched,
+    /// Matched, but the match was degenerate: the prediction was kept along its weak direction.
+    Degenerate,
+    /// Too few usable returns (or no submap yet): the predicted pose was kept.
+    Predicted,
+    /// Refused: a non-finite track pose.
+    Refused,
+}
+
+struct ScanRecord {
+    stamp: Stamp,
+    local: Pose2,
+    anchor: Option<usize>,
+}
+
+struct Node {
+    stamp: Stamp,
+    local: Pose2,
+    track: Pose2,
+    graph: usize,
+    points: Vec<Point2>,
+    submaps: Vec<usize>,
+}
+
+/// The SLAM state over one log. Feed scans in time order with [`add_scan`](Self::add_scan),
+/// then [`finish`](Self::finish).
+pub struct Slam {
+    p: SlamParams,
+    submaps: Submaps,
+    submap_graph: Vec<usize>,
+    precomputed: Vec<Option<PrecomputedGrids>>,
+    samplers: Vec<f64>,
+    graph: PoseGraph,
+    nodes: Vec<Node>,
+    scans: Vec<ScanRecord>,
+    last: Option<(Pose2, Pose2)>,
+    global_from_local: Pose2,
+    since_optimisation: usize,
+    closures_since_optimisation: usize,
+    report: SlamReport,
+}
+
+/// The result of a SLAM run.
+pub struct SlamResult {
+    /// Every scan's optimised `map_from_base`, in input order.
+    pub trajectory: Vec<(Stamp, Pose2)>,
+    /// The nodes' stamps, graph indices of nodes in node order.
+    pub node_stamps: Vec<Stamp>,
+    /// The pose graph (nodes: scans then submaps interleaved as created).
+    pub graph: PoseGraph,
+    /// Graph indices of the submaps.
+    pub submap_nodes: Vec<usize>,
+    /// Graph indices of the scan nodes.
+    pub scan_nodes: Vec<usize>,
+    /// Counts and timings.
+    pub report: SlamReport,
+}
+
+fn information_diag(sx: f64, sth: f64) -> [[f64; 3]; 3] {
+    [[1.0 / (sx * sx), 0.0, 0.0], [0.0, 1.0 / (sx * sx), 0.0], [0.0, 0.0, 1.0 / (sth * sth)]]
+}
+
+impl Slam {
+    /// An empty run.
+    pub fn new(p: SlamParams) -> Self {
+        Self {
+            submaps: Submaps::new(p.resolution, p.scans_per_submap, p.hit_probability, p.miss_probability),
+            p,
+            submap_graph: Vec::new(),
+            precomputed: Vec::new(),
+            samplers: Vec::new(),
+            graph: PoseGraph::new(),
+            nodes: Vec::new(),
+            scans: Vec::new(),
+            last: None,
+            global_from_local: Pose2::IDENTITY,
+            since_optimisation: 0,
+            closures_since_optimisation: 0,
+            report: SlamReport::default(),
+        }
+    }
+
+    /// The counters so far.
+    pub fn report(&self) -> &SlamReport {
+        &self.report
+    }
+
+    /// Adds the next scan (stamps non-decreasing).
+    pub fn add_scan(&mut self, scan: ScanInput) -> ScanOutcome {
+        self.report.scans += 1;
+        if !scan.track.is_finite() || !scan.origin.is_finite() {
+            self.report.refused += 1;
+            return ScanOutcome::Refused;
+        }
+        let max2 = self.p.max_range_m * self.p.max_range_m;
+        let in_range = |q: &&Point2| {
+            let (dx, dy) = (q.x - scan.origin.x, q.y - scan.origin.y);
+            q.is_finite() && dx * dx + dy * dy <= max2
+        };
+        let hits: Vec<Point2> = scan.hits.iter().filter(in_range).copied().collect();
+        let predicted = match self.last {
+            Some((local, track)) => local.compose(track.inverse().compose(scan.track)),
+            None => scan.track,
+        };
+        let t0 = Instant::now();
+        let (local, outcome, information) = self.match_local(&hits, predicted);
+        self.report.matching_s += t0.elapsed().as_secs_f64();
+        match outcome {
+            ScanOutcome::Matched => self.report.matched += 1,
+            ScanOutcome::Degenerate => self.report.degenerate += 1,
+            _ => self.report.predicted += 1,
+        }
+        self.last = Some((local, scan.track));
+        let anchor = self.nodes.last().map(|_| self.nodes.len() - 1);
+        self.scans.push(ScanRecord { stamp: scan.stamp, local, anchor });
+        let new_node = match self.nodes.last() {
+            None => true,
+            Some(n) => {
+                let d = n.local.inverse().compose(local);
+                d.x.hypot(d.y) >= self.p.node_distance_m
+                    || d.theta.abs() >= self.p.node_angle_rad
+                    || (scan.stamp.0 - n.stamp.0) as f64 * 1e-9 >= self.p.node_time_s
+            }
+        };
+        if new_node {
+            let misses: Vec<Point2> = scan.misses.iter().filter(|q| q.is_finite()).copied().collect();
+            self.add_node(scan.stamp, local, scan.track, scan.origin, hits, &misses, information);
+            self.scans.last_mut().expect("pushed above").anchor = Some(self.nodes.len() - 1);
+        }
+        outcome
+    }
+
+    fn match_local(&self, hits: &[Point2], predicted: Pose2) -> (Pose2, ScanOutcome, Option<[[f64; 3]; 3]>) {
+        let Some((_, submap)) = self.submaps.matching() else {
+            return (predicted, ScanOutcome::Predicted, None);
+        };
+        if hits.len() < self.p.min_points {
+            return (predicted, ScanOutcome::Predicted, None);
+        }
+        let m = super::local_match::match_scan(&submap.grid, hits, predicted, &self.p.local);
+        if m.degenerate {
+            // Keep the prediction along the weak direction: refine from the prediction
+            // with a pull towards it ten times stronger than usual.
+            let strong = LocalMatchParams {
+                translation_weight: self.p.local.translation_weight * 10.0,
+                rotation_weight: self.p.local.rotation_weight,
+                ..self.p.local
+            };
+            let pose = refine(&submap.grid, hits, predicted, predicted, &strong);
+            return (pose, ScanOutcome::Degenerate, Some(m.information));
+        }
+        (m.pose, ScanOutcome::Matched, Some(m.information))
+    }
+
+    fn match_information(&self, info: Option<[[f64; 3]; 3]>) -> [[f64; 3]; 3] {
+        // Unmatched (first scans of the log): the local pose is as good as the odometry.
+        let floor = information_diag(0.5, 10f64.to_radians());
+        let cap = information_diag(0.005, 0.05f64.to_radians());
+        let mut out = info.unwrap_or(floor);
+        for i in 0..3 {
+            out[i][i] = out[i][i].clamp(floor[i][i], cap[i][i]);
+        }
+        out
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn add_node(
+        &mut self,
+        stamp: Stamp,
+        local: Pose2,
+        track: Pose2,
+        origin: Point2,
+        hits: Vec<Point2>,
+        misses: &[Point2],
+        information: Option<[[f64; 3]; 3]>,
+    ) {
+        let to_local = |q: &Point2| local.transform_point(*q);
+        let local_hits: Vec<Point2> = hits.iter().map(to_local).collect();
+        let local_misses: Vec<Point2> = misses.iter().map(to_local).collect();
+        let before = self.submaps.all().len();
+        let (into, finished) = self.submaps.insert(local, local.transform_point(origin), &local_hits, &local_misses);
+        for s in before..self.submaps.all().len() {
+            let g = self.graph.add_node(self.global_from_local.compose(self.submaps.all()[s].local_pose));
+            self.submap_graph.push(g);
+            self.precomputed.push(None);
+            self.samplers.push(0.0);
+        }
+        let g = self.graph.add_node(self.global_from_local.compose(local));
+        if self.nodes.is_empty() {
+            self.graph.set_fixed(g, true);
+        }
+        let info = self.match_information(information);
+        for &s in &into {
+            let sm = &self.submaps.all()[s];
+            let first = sm.scans == 1;
+            let e = Edge {
+                from: self.submap_graph[s],
+                to: g,
+                measurement: sm.local_pose.inverse().compose(local),
+                information: if first { information_diag(0.001, 0.01f64.to_radians()) } else { info },
+                loss: Loss::Trivial,
+                kind: EdgeKind::Match,
+            };
+            self.graph.add_edge(e).expect("valid match edge");
+        }
+        if let Some(prev) = self.nodes.last() {
+            let d = prev.track.inverse().compose(track);
+            let st = self.p.odometry_floor_m + self.p.odometry_translation_per_m * d.x.hypot(d.y);
+            let sr = self.p.odometry_floor_rad + self.p.odometry_rotation_per_rad * d.theta.abs();
+            let e = Edge {
+                from: prev.graph,
+                to: g,
+                measurement: d,
+                information: information_diag(st, sr),
+                loss: Loss::Trivial,
+                kind: EdgeKind::Odometry,
+            };
+            if d.is_finite() {
+                self.graph.add_edge(e).expect("valid odometry edge");
+            }
+        }
+        self.nodes.push(Node { stamp, local, track, graph: g, points: hits, submaps: into });
+        self.report.nodes += 1;
+        self.report.submaps = self.submaps.all().len();
+        if self.p.loop_closure {
+            let t0 = Instant::now();
+            if let Some(f) = finished {
+                self.precomputed[f] = Some(PrecomputedGrids::new(&self.submaps.all()[f].grid, self.p.branch_and_bound_depth));
+                for n in 0..self.nodes.len() {
+                    self.search(n, f);
+                }
+            }
+            let n = self.nodes.len() - 1;
+            for s in 0..self.submaps.all().len() {
+                if self.precomputed[s].is_some() && (finished != Some(s)) {
+                    self.search(n, s);
+                }
+            }
+            self.report.loop_search_s += t0.elapsed().as_secs_f64();
+        }
+        self.since_optimisation += 1;
+        if self.since_optimisation >= self.p.optimize_every_n_nodes && self.closures_since_optimisation > 0 {
+            self.optimise();
+        }
+    }
+
+    /// Searches node `n` against finished submap `s` for a loop closure.
+    fn search(&mut self, n: usize, s: usize) {
+        let node = &self.nodes[n];
+        if node.submaps.contains(&s) {
+            return;
+        }
+        let (gn, gs) = (self.graph.nodes()[node.graph], self.graph.nodes()[self.submap_graph[s]]);
+        if (gn.x - gs.x).hypot(gn.y - gs.y) > self.p.loop_closure_max_distance_m {
+            return;
+        }
+        self.samplers[s] += self.p.loop_closure_sampling_ratio;
+        if self.samplers[s] < 1.0 {
+            return;
+        }
+        self.samplers[s] -= 1.0;
+        let Some(pre) = &self.precomputed[s] else { return };
+        let sm = &self.submaps.all()[s];
+        let initial = sm.local_pose.compose(gs.inverse().compose(gn));
+        let search = GlobalSearch {
+            linear_window_m: self.p.loop_closure_linear_window_m,
+            angular_window_rad: self.p.loop_closure_angular_window_rad,
+            min_score: self.p.loop_closure_min_score,
+            depth: self.p.branch_and_bound_depth,
+        };
+        self.report.loop_searches += 1;
+        let Some(found) = match_branch_and_bound(pre, &node.points, initial, &search) else {
+            self.report.loop_rejected += 1;
+            return;
+        };
+        let pose = refine(&sm.grid, &node.points, found.pose, found.pose, &self.p.local);
+        let score = mean_probability(&sm.grid, &node.points, pose);
+        if score < self.p.loop_closure_min_score {
+            self.report.loop_rejected += 1;
+            return;
+        }
+        let e = Edge {
+            from: self.submap_graph[s],
+            to: node.graph,
+            measurement: sm.local_pose.inverse().compose(pose),
+            information: information_diag(self.p.loop_closure_sigma_m, self.p.loop_closure_sigma_rad),
+            loss: Loss::Huber(self.p.loop_closure_huber),
+            kind: EdgeKind::LoopClosure,
+        };
+        self.graph.add_edge(e).expect("valid loop-closure edge");
+        self.report.loop_accepted += 1;
+        self.closures_since_optimisation += 1;
+    }
+
+    fn optimise(&mut self) {
+        let t0 = Instant::now();
+        let opts = OptimizeOptions::default();
+        match self.graph.optimize(&opts) {
+            Ok(r) => {
+                self.report.optimisations += 1;
+                self.report.last_optimisation = Some(r);
+            }
+            Err(e) => self.report.optimisation_failures.push(e.to_string()),
+        }
+        if let Some(n) = self.nodes.last() {
+            self.global_from_local = self.graph.nodes()[n.graph].compose(n.local.inverse());
+        }
+        self.since_optimisation = 0;
+        self.closures_since_optimisation = 0;
+        self.report.optimisation_s += t0.elapsed().as_secs_f64();
+    }
+
+    /// Optimises once more and returns every scan's pose.
+    pub fn finish(mut self) -> SlamResult {
+        if !self.nodes.is_empty() {
+            self.optimise();
+        }
+        let trajectory = self
+            .scans
+            .iter()
+            .filter_map(|s| {
+                let n = &self.nodes[s.anchor?];
+                let g = self.graph.nodes()[n.graph];
+                let p = g.compose(n.local.inverse().compose(s.local));
+                Some((s.stamp, Pose2::new(p.x, p.y, normalize_angle(p.theta))))
+            })
+            .collect();
+        SlamResult {
+            trajectory,
+            node_stamps: self.nodes.iter().map(|n| n.stamp).collect(),
+            scan_nodes: self.nodes.iter().map(|n| n.graph).collect(),
+            submap_nodes: self.submap_graph,
+            graph: self.graph,
+            report: self.report,
+        }
+    }
+}

@@ -1,0 +1,94 @@
+//! Parameters of the SLAM back end, with the reasons for their defaults.
+
+use super::local_match::LocalMatchParams;
+
+/// Everything [`Slam`](super::Slam) can be tuned by. The `[slam]` config section maps onto
+/// it key by key.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlamParams {
+    /// Submap cell size, metres. 5 cm, as Hess et al. 2016 use for 2D.
+    pub resolution: f64,
+    /// Scans each submap takes before the next starts (the older active submap then holds
+    /// twice as many when it is finished).
+    pub scans_per_submap: usize,
+    /// Probability of a return's cell being occupied (one update).
+    pub hit_probability: f32,
+    /// Probability of a crossed cell being occupied (one update).
+    pub miss_probability: f32,
+    /// Returns farther than this are not used for matching or submaps, metres: far returns
+    /// grow the submaps and their angular error is largest.
+    pub max_range_m: f64,
+    /// A scan with fewer usable returns is not matched (its pose is predicted).
+    pub min_points: usize,
+    /// A scan becomes a node (and goes into the submaps) once the robot has moved this far
+    /// since the last node, metres …
+    pub node_distance_m: f64,
+    /// … or turned this much, radians …
+    pub node_angle_rad: f64,
+    /// … or this much time has passed, seconds.
+    pub node_time_s: f64,
+    /// The local matcher.
+    pub local: LocalMatchParams,
+    /// Odometry edge σ: translational, per metre travelled (plus `odometry_floor_m`).
+    pub odometry_translation_per_m: f64,
+    /// Odometry edge σ floor, metres.
+    pub odometry_floor_m: f64,
+    /// Odometry edge σ: rotational, per radian turned (plus `odometry_floor_rad`).
+    pub odometry_rotation_per_rad: f64,
+    /// Odometry edge σ floor, radians.
+    pub odometry_floor_rad: f64,
+    /// Search for loop closures at all.
+    pub loop_closure: bool,
+    /// Share of (node, finished submap) pairs searched for a loop closure.
+    pub loop_closure_sampling_ratio: f64,
+    /// Only submaps whose centre is within this distance of the node are searched, metres.
+    pub loop_closure_max_distance_m: f64,
+    /// Half-width of the loop-closure search in x and y, metres.
+    pub loop_closure_linear_window_m: f64,
+    /// Half-width of the loop-closure search in heading, radians.
+    pub loop_closure_angular_window_rad: f64,
+    /// Minimum mean probability of a loop closure's points.
+    pub loop_closure_min_score: f32,
+    /// Huber scale of loop-closure edges (whitened units).
+    pub loop_closure_huber: f64,
+    /// σ of a loop closure (translation, metres).
+    pub loop_closure_sigma_m: f64,
+    /// σ of a loop closure (rotation, radians).
+    pub loop_closure_sigma_rad: f64,
+    /// Optimise the pose graph every this many new nodes (and once at the end).
+    pub optimize_every_n_nodes: usize,
+    /// Levels of the branch-and-bound precomputation.
+    pub branch_and_bound_depth: usize,
+}
+
+impl Default for SlamParams {
+    fn default() -> Self {
+        Self {
+            resolution: 0.05,
+            scans_per_submap: 60,
+            hit_probability: 0.55,
+            miss_probability: 0.49,
+            max_range_m: 30.0,
+            min_points: 20,
+            node_distance_m: 0.1,
+            node_angle_rad: 2f64.to_radians(),
+            node_time_s: 5.0,
+            local: LocalMatchParams::default(),
+            odometry_translation_per_m: 0.1,
+            odometry_floor_m: 0.02,
+            odometry_rotation_per_rad: 0.1,
+            odometry_floor_rad: 1f64.to_radians(),
+            loop_closure: true,
+            loop_closure_sampling_ratio: 0.3,
+            loop_closure_max_distance_m: 15.0,
+            loop_closure_linear_window_m: 7.0,
+            loop_closure_angular_window_rad: 30f64.to_radians(),
+            loop_closure_min_score: 0.55,
+            loop_closure_huber: 1.0,
+            loop_closure_sigma_m: 0.05,
+            loop_closure_sigma_rad: 1f64.to_radians(),
+            optimize_every_n_nodes: 90,
+            branch_and_bound_depth: 7,
+        }
+    }
+}

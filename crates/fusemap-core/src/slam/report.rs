@@ -1,0 +1,41 @@
+//! What a SLAM run did, for the run report.
+
+use super::pose_graph::OptimizeReport;
+use serde::Serialize;
+
+/// Counts and timings of a SLAM run.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct SlamReport {
+    /// Scans given.
+    pub scans: u64,
+    /// Scans matched against a submap.
+    pub matched: u64,
+    /// Scans whose match was degenerate (the prediction kept along the weak direction).
+    pub degenerate: u64,
+    /// Scans not matched (too few returns, or no submap yet): predicted pose kept.
+    pub predicted: u64,
+    /// Scans refused (non-finite track pose or sensor origin).
+    pub refused: u64,
+    /// Pose-graph nodes (scans that moved far enough).
+    pub nodes: u64,
+    /// Submaps built.
+    pub submaps: usize,
+    /// Loop-closure searches run.
+    pub loop_searches: u64,
+    /// Loop closures accepted.
+    pub loop_accepted: u64,
+    /// Loop-closure searches that found nothing above the score threshold.
+    pub loop_rejected: u64,
+    /// Pose-graph optimisations run.
+    pub optimisations: u64,
+    /// Optimisations that failed (the previous poses were kept), with the reason.
+    pub optimisation_failures: Vec<String>,
+    /// The last optimisation.
+    pub last_optimisation: Option<OptimizeReport>,
+    /// Wall time in local matching, seconds.
+    pub matching_s: f64,
+    /// Wall time in loop-closure search (precomputation included), seconds.
+    pub loop_search_s: f64,
+    /// Wall time in pose-graph optimisation, seconds.
+    pub optimisation_s: f64,
+}

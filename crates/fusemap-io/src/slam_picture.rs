@@ -1,0 +1,115 @@
+//! `slam.png`: the optimised trajectory and its loop closures drawn over the map.
+//!
+//! An RGB PNG (colour type 2) of the map shaded as `map.png` is (see [`crate::picture`]),
+//! with the trajectory through the pose-graph nodes in blue and every accepted loop
+//! closure as a red segment from the submap's origin to the node it was matched with, so
+//! a user sees at a glance where the lidar closed loops and whether the walls agree.
+
+use crate::atomic::{check_raster, write_atomic};
+use crate::picture::{scale_factor, shade};
+use crate::{Error, Location, Result};
+use fusemap_core::geometry::Point2;
+use fusemap_core::grid::{LogOddsTable, Raster};
+use std::io;
+use std::path::Path;
+
+const TRAJECTORY: [u8; 3] = [30, 90, 230];
+const LOOP_CLOSURE: [u8; 3] = [230, 30, 30];
+
+struct Canvas {
+    width: usize,
+    height: usize,
+    rgb: Vec<u8>,
+}
+
+impl Canvas {
+    fn put(&mut self, x: i64, y: i64, c: [u8; 3]) {
+        if x >= 0 && y >= 0 && (x as usize) < self.width && (y as usize) < self.height {
+            let i = 3 * (y as usize * self.width + x as usize);
+            self.rgb[i..i + 3].copy_from_slice(&c);
+        }
+    }
+
+    /// A straight segment between two pixels (Bresenham), bounded in length.
+    fn line(&mut self, a: (i64, i64), b: (i64, i64), c: [u8; 3]) {
+        let (dx, dy) = ((b.0 - a.0).abs(), -(b.1 - a.1).abs());
+        if dx > 100_000 || dy < -100_000 {
+            return;
+        }
+        let (sx, sy) = (if a.0 < b.0 { 1 } else { -1 }, if a.1 < b.1 { 1 } else { -1 });
+        let (mut x, mut y, mut err) = (a.0, a.1, dx + dy);
+        loop {
+            self.put(x, y, c);
+            if (x, y) == b {
+                break;
+            }
+            let e2 = 2 * err;
+            if e2 >= dy {
+                err += dy;
+                x += sx;
+            }
+            if e2 <= dx {
+                err += dx;
+                y += sy;
+            }
+        }
+    }
+}
+
+/// Writes the picture (atomically) and returns the enlargement factor.
+pub fn write_pose_graph_png(
+    path: &Path,
+    raster: &Raster,
+    trajectory: &[Point2],
+    loop_closures: &[(Point2, Point2)],
+) -> Result<usize> {
+    check_raster(path, raster, true)?;
+    let factor = scale_factor(raster.width, raster.height);
+    let (width, height) = (raster.width * factor, raster.height * factor);
+    if width > 32_768 || height > 32_768 {
+        return Err(Error::format(path, Location::File, format!("a {width} × {height} picture is too large")));
+    }
+    let table = LogOddsTable::new(&raster.params);
+    let mut canvas = Canvas { width, height, rgb: vec![0; width * height * 3] };
+    for py in 0..height {
+        let row = raster.height - 1 - py / factor;
+        for px in 0..width {
+            let i = row * raster.width + px / factor;
+            let s = shade(raster.log_odds[i], raster.known[i], table.min, table.max);
+            canvas.put(px as i64, py as i64, [s, s, s]);
+        }
+    }
+    let to_px = |p: Point2| {
+        let u = (p.x - raster.origin.x) / raster.resolution * factor as f64;
+        let v = (p.y - raster.origin.y) / raster.resolution * factor as f64;
+        (u.floor() as i64, height as i64 - 1 - v.floor() as i64)
+    };
+    let finite = |p: &Point2| p.is_finite() && p.x.abs() < 1e9 && p.y.abs() < 1e9;
+    for w in trajectory.windows(2) {
+        if finite(&w[0]) && finite(&w[1]) {
+            canvas.line(to_px(w[0]), to_px(w[1]), TRAJECTORY);
+        }
+    }
+    for (a, b) in loop_closures.iter().filter(|(a, b)| finite(a) && finite(b)) {
+        canvas.line(to_px(*a), to_px(*b), LOOP_CLOSURE);
+    }
+    write_atomic(path, |w| {
+        let mut encoder = png::Encoder::new(w, width as u32, height as u32);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder
+            .add_text_chunk(
+                "Description".into(),
+                format!(
+                    "fusemap pose graph over the map: {} x {} cells of {} m, lower-left corner at ({}, {}) m, {} pixels per cell; blue the optimised trajectory, red the {} loop closures (submap origin to node)",
+                    raster.width, raster.height, raster.resolution, raster.origin.x, raster.origin.y, factor, loop_closures.len()
+                ),
+            )
+            .map_err(io::Error::from)?;
+        let mut writer = encoder.write_header().map_err(io::Error::from)?;
+        writer.write_image_data(&canvas.rgb).map_err(io::Error::from)?;
+        writer.finish().map_err(io::Error::from)?;
+        Ok(())
+    })?;
+    Ok(factor)
+}

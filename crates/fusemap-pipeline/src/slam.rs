@@ -1,0 +1,274 @@
+//! The SLAM pass: the lidar corrects the pose track before the map is built.
+//!
+//! When the poses of a log are raw (odometry, the estimator over odometry/IMU/GNSS, TF
+//! under an `odom` frame, the odometry written on raw CARMEN lines), a pass over the
+//! first lidar's scans runs [`fusemap_core::slam`]: each scan predicted from the track's
+//! motion, matched against the local submap, turned into a pose-graph node, searched
+//! against older submaps for loop closures, and the graph optimised. The optimised scan
+//! poses then enter the one pose estimator as absolute pose measurements beside the
+//! odometry, IMU and GNSS (GNSS fixes also enter the graph as position priors, so the two
+//! agree), and the estimator's smoothed track places every measurement — the scans,
+//! de-skewed, and the camera frames — at its own stamp. Without odometry to run the
+//! estimator on, the optimised scan poses are the track.
+
+use crate::estimation::inputs;
+use crate::extrinsics::frame_tree;
+use crate::recording::{for_each_range_message, Inventory, RangeMessage};
+use crate::run::{lidar_setup, sync_mode, Progress};
+use crate::sensors::Bound;
+use crate::track::{ChosenTrack, TfTrack, Track, TrackCounts};
+use crate::PipelineError;
+use fusemap_core::config::{Plan, PoseSource, SensorKind, SlamMode};
+use fusemap_core::estimator::{estimate, EstimatorInput};
+use fusemap_core::geometry::{Point2, Pose2};
+use fusemap_core::slam::pose_graph::EdgeKind;
+use fusemap_core::slam::{ScanInput, Slam, SlamReport, SlamResult};
+use fusemap_core::time::{PoseBuffer, Stamp};
+use serde::Serialize;
+use std::time::Instant;
+
+/// A pose-graph node as the run report shows it.
+#[derive(Clone, Debug, Serialize)]
+pub struct GraphNode {
+    /// `scan` or `submap`.
+    pub kind: &'static str,
+    /// The scan's stamp, ns (scans only).
+    pub stamp_ns: Option<i64>,
+    /// Optimised pose `[x, y, θ]`.
+    pub pose: [f64; 3],
+}
+
+/// A pose-graph edge as the run report shows it.
+#[derive(Clone, Debug, Serialize)]
+pub struct GraphEdge {
+    /// Index into the nodes.
+    pub from: usize,
+    /// Index into the nodes.
+    pub to: usize,
+    /// `odometry`, `match` (a scan in a submap it went into) or `loop_closure`.
+    pub kind: &'static str,
+}
+
+/// What the SLAM pass did, for `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct SlamSummary {
+    /// Why SLAM ran.
+    pub reason: String,
+    /// The lidar topic SLAM used.
+    pub topic: String,
+    /// Scans without a track pose (not used by SLAM).
+    pub scans_without_pose: u64,
+    /// Scans older than the one before (not used by SLAM).
+    pub scans_out_of_order: u64,
+    /// The core's counts and timings.
+    pub counts: SlamReport,
+    /// Wall time of the whole pass, reading included, seconds.
+    pub seconds: f64,
+    /// How the track was made from the optimised poses.
+    pub track: String,
+    /// The optimised pose graph.
+    pub nodes: Vec<GraphNode>,
+    /// Its edges.
+    pub edges: Vec<GraphEdge>,
+    /// Every scan's optimised pose (in `trajectory.tum` through the track, not here).
+    #[serde(skip)]
+    pub scan_poses: Vec<(Stamp, Pose2)>,
+}
+
+/// The SLAM pass's result: the summary, with every scan's optimised pose.
+pub struct SlamRun {
+    /// The summary.
+    pub summary: SlamSummary,
+}
+
+/// Whether SLAM should run on this log with this track, and why (or why not).
+pub fn applies(plan: &Plan, inv: &Inventory, bound: &Bound, chosen: &ChosenTrack) -> (bool, String) {
+    if bound.lidars.is_empty() {
+        return (false, "no lidar".into());
+    }
+    match plan.slam_mode {
+        SlamMode::Off => return (false, "slam.mode = \"off\"".into()),
+        SlamMode::On => return (true, "slam.mode = \"on\"".into()),
+        SlamMode::Auto => {}
+    }
+    match chosen.source {
+        PoseSource::Odometry => (true, "the poses are raw odometry".into()),
+        PoseSource::Estimator => (true, "the poses come from the estimator (odometry, IMU, GNSS)".into()),
+        PoseSource::ScanLine => {
+            let t = &inv.scans[&bound.lidars[0].topic];
+            if t.with_pose > 0 && t.pose_is_odometry == t.with_pose {
+                (true, "the poses on the scan lines are their raw odometry".into())
+            } else {
+                (false, "the poses on the scan lines are corrected".into())
+            }
+        }
+        PoseSource::Tf => {
+            let (tree, _) = frame_tree(&plan.log, &inv.tf_static, &inv.tf_dynamic);
+            let base = plan.log.base_frame.trim_start_matches('/');
+            match TfTrack::root_of(&tree, base) {
+                Some(root) if root.trim_start_matches('/') == "odom" => (true, "the TF poses are under `odom`".into()),
+                Some(root) => (false, format!("the TF poses come from `{root}`, taken as corrected")),
+                None => (false, "no TF root".into()),
+            }
+        }
+        PoseSource::Auto => (false, "unresolved pose source".into()),
+    }
+}
+
+/// Runs SLAM over the first lidar's scans with `chosen` as the prediction.
+pub fn run(
+    plan: &Plan,
+    inv: &Inventory,
+    bound: &Bound,
+    chosen: &ChosenTrack,
+    reason: String,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<SlamRun, PipelineError> {
+    let t0 = Instant::now();
+    let cfg = &plan.log;
+    let b = &bound.lidars[0];
+    let (tree, _) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
+    let mut scratch = Vec::new();
+    let (_, _, model) = lidar_setup(b, inv, &tree, cfg, &mut scratch)?;
+    let mount = *model.mount();
+    let params = *model.params();
+    let offset = crate::offset_ns(b.lidar.time_offset_s);
+    let stamps = &inv.scans[&b.topic].stamps;
+    let mode = sync_mode(cfg, stamps);
+    let mut slam = Slam::new(plan.slam);
+    let (mut without_pose, mut out_of_order) = (0u64, 0u64);
+    let mut last: Option<Stamp> = None;
+    let mut hits: Vec<Point2> = Vec::new();
+    progress(Progress::Phase { name: "slam", total: stamps.len() as u64 });
+    let topics = [b.topic.clone()];
+    for_each_range_message(&inv.path, &topics, &[], |msg| {
+        let RangeMessage::Scan(scan) = msg else { return Ok(()) };
+        if scan.topic != b.topic {
+            return Ok(());
+        }
+        progress(Progress::Advance(1));
+        let t = Stamp(scan.scan.stamp.0.saturating_add(offset));
+        let pose = match &chosen.track {
+            Track::ScanLine => scan.pose.filter(|p| p.is_finite()),
+            Track::Timed(track) => track.pose_at(t, mode).ok(),
+        };
+        let Some(pose) = pose else {
+            without_pose += 1;
+            return Ok(());
+        };
+        if last.is_some_and(|l| t < l) {
+            out_of_order += 1;
+            return Ok(());
+        }
+        last = Some(t);
+        let lo = params.min_range.max(scan.range_min as f64);
+        let hi = params.max_range.min(scan.range_max as f64);
+        let (a0, inc) = (scan.scan.angle_min as f32 as f64, scan.scan.angle_increment as f32 as f64);
+        let origin = mount.origin_in_base();
+        hits.clear();
+        hits.extend(scan.scan.ranges.iter().enumerate().filter_map(|(i, &r)| {
+            let r = r as f64;
+            (r.is_finite() && r >= lo && r < hi).then(|| {
+                let a = mount.beam_angle_in_base(a0 + i as f64 * inc);
+                Point2::new(origin.x + r * a.cos(), origin.y + r * a.sin())
+            })
+        }));
+        slam.add_scan(ScanInput { stamp: t, track: pose, origin, hits: &hits, misses: &[] });
+        Ok(())
+    })?;
+    progress(Progress::Done);
+    let result = slam.finish();
+    let summary = summary(&result, reason, b.topic.clone(), without_pose, out_of_order, t0.elapsed().as_secs_f64());
+    Ok(SlamRun { summary })
+}
+
+fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, out_of_order: u64, seconds: f64) -> SlamSummary {
+    let mut kind = vec![("scan", None); r.graph.nodes().len()];
+    for (&g, &s) in r.scan_nodes.iter().zip(&r.node_stamps) {
+        kind[g] = ("scan", Some(s.0));
+    }
+    for &g in &r.submap_nodes {
+        kind[g] = ("submap", None);
+    }
+    let nodes = r
+        .graph
+        .nodes()
+        .iter()
+        .zip(kind)
+        .map(|(p, (kind, stamp_ns))| GraphNode { kind, stamp_ns, pose: [p.x, p.y, p.theta] })
+        .collect();
+    let edges = r
+        .graph
+        .edges()
+        .iter()
+        .map(|e| GraphEdge {
+            from: e.from,
+            to: e.to,
+            kind: match e.kind {
+                EdgeKind::Odometry => "odometry",
+                EdgeKind::Match => "match",
+                EdgeKind::LoopClosure => "loop_closure",
+            },
+        })
+        .collect();
+    SlamSummary {
+        reason,
+        topic,
+        scans_without_pose: without_pose,
+        scans_out_of_order: out_of_order,
+        counts: r.report.clone(),
+        seconds,
+        track: String::new(),
+        nodes,
+        edges,
+        scan_poses: r.trajectory.clone(),
+    }
+}
+
+/// The pose track from a SLAM run: the estimator over the log's pose sensors plus the
+/// optimised scan poses when the log has odometry, else the optimised poses themselves.
+pub fn track(plan: &Plan, inv: &Inventory, bound: &Bound, run: &mut SlamRun) -> Result<ChosenTrack, PipelineError> {
+    let (st, sr) = plan.slam_pose_sigma;
+    let covariance = [[st * st, 0.0, 0.0], [0.0, st * st, 0.0], [0.0, 0.0, sr * sr]];
+    if bound.first(SensorKind::WheelOdometry).is_some() {
+        let mut built = inputs(plan, inv, bound)?;
+        built.inputs.extend(run.summary.scan_poses.iter().map(|&(stamp, pose)| EstimatorInput::Pose { stamp, pose, covariance }));
+        built.inputs.sort_by_key(|i| i.stamp());
+        let e = estimate(&built.inputs, &built.config)
+            .map_err(|e| PipelineError::Refused(format!("pose estimator with the SLAM poses: {e}")))?;
+        run.summary.track = "estimator: odometry and the log's other pose sensors, with the optimised scan poses".into();
+        let counts = TrackCounts {
+            samples: e.report.odometry.received as u64,
+            used: e.report.odometry.used as u64,
+            duplicates: e.report.odometry.duplicate_stamps as u64,
+            not_finite: e.report.odometry.not_finite as u64,
+            ..Default::default()
+        };
+        let odom = bound.first(SensorKind::WheelOdometry).map(|o| &inv.odom[&o.topic]);
+        return Ok(ChosenTrack {
+            source: PoseSource::Estimator,
+            estimator: serde_json::to_value(&e.report).ok(),
+            track: Track::Timed(Box::new(e)),
+            name: "SLAM (scan matching + loop closure) through the estimator".into(),
+            counts,
+            stamps: odom.map(|o| o.iter().map(|m| m.stamp).collect()).unwrap_or_default(),
+            receive: odom.map(|o| o.iter().map(|m| m.receive_stamp).collect()).unwrap_or_default(),
+            notes: built.notes,
+            slam: None,
+        });
+    }
+    run.summary.track = "the optimised scan poses, interpolated".into();
+    let mut counts = TrackCounts::default();
+    let buffer: PoseBuffer = crate::track::buffer_of(&plan.log, run.summary.scan_poses.clone(), &mut counts);
+    Ok(ChosenTrack {
+        source: PoseSource::Odometry,
+        track: Track::Timed(Box::new(buffer)),
+        name: "SLAM (scan matching + loop closure)".into(),
+        counts,
+        stamps: run.summary.scan_poses.iter().map(|s| s.0).collect(),
+        receive: vec![None; run.summary.scan_poses.len()],
+        estimator: None,
+        notes: Vec::new(),
+        slam: None,
+    })
+}
