@@ -42,4 +42,5 @@ pub mod measurement;
 pub mod metrics;
 pub mod sensor;
 pub mod sim;
+pub mod slam;
 pub mod time;
