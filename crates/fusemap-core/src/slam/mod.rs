@@ -1,2 +1,3 @@
 //! 2D SLAM: scan-to-submap matching, submaps, loop closure and a pose graph.
+pub mod global_match;
 pub mod grid;
