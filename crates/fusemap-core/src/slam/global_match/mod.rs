@@ -176,7 +176,7 @@ struct Search<'a> {
 
 impl Search<'_> {
     fn bound(&self, level: &Level, scan: u32, dx: i32, dy: i32) -> Candidate {
-        let bound = level.sum(&self.problem.scans[scan as usize].cells, dx, dy);
+        let bound = level.sum(&self.problem.scans[scan as usize].cells, dx, dy, self.floor);
         Candidate { scan, dx, dy, bound }
     }
 
@@ -190,12 +190,13 @@ impl Search<'_> {
         let s = 1i32 << (h - 1);
         let level = self.grids.level(h - 1);
         let w = self.problem.window;
+        let sums = level.sum4(&self.problem.scans[c.scan as usize].cells, c.dx, c.dy, s, self.floor);
         let mut children = [c; 4];
         let mut n = 0;
-        for (ox, oy) in [(0, 0), (s, 0), (0, s), (s, s)] {
+        for ((ox, oy), bound) in [(0, 0), (s, 0), (0, s), (s, s)].into_iter().zip(sums) {
             let (dx, dy) = (c.dx + ox, c.dy + oy);
             if dx <= w && dy <= w {
-                children[n] = self.bound(level, c.scan, dx, dy);
+                children[n] = Candidate { scan: c.scan, dx, dy, bound };
                 n += 1;
             }
         }

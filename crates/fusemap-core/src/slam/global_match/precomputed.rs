@@ -51,19 +51,61 @@ impl Level {
     }
 
     /// The sum over `cells` (relative to the grid's first cell) shifted by `(dx, dy)`:
-    /// the hot loop of the search.
+    /// the hot loop of the search. Stops early once the sum so far plus 255 for every
+    /// point left cannot exceed `floor`, and returns that figure: still an upper bound of
+    /// the sum, and one the caller discards. A result above `floor` is the exact sum.
     #[inline]
-    pub(super) fn sum(&self, cells: &[[i32; 2]], dx: i32, dy: i32) -> u32 {
+    pub(super) fn sum(&self, cells: &[[i32; 2]], dx: i32, dy: i32, floor: i64) -> u32 {
+        const CHUNK: usize = 16;
         let (ox, oy) = (dx + self.pad, dy + self.pad);
         let (xmax, ymax, w) = (self.width - 1, self.height - 1, self.width as usize);
         let data = &self.cells[..];
         let mut sum = 0u32;
-        for &[x, y] in cells {
-            let ix = (x + ox).clamp(0, xmax) as usize;
-            let iy = (y + oy).clamp(0, ymax) as usize;
-            sum += u32::from(data[iy * w + ix]);
+        let mut left = 255 * cells.len() as i64;
+        for chunk in cells.chunks(CHUNK) {
+            for &[x, y] in chunk {
+                let ix = (x + ox).clamp(0, xmax) as usize;
+                let iy = (y + oy).clamp(0, ymax) as usize;
+                sum += u32::from(data[iy * w + ix]);
+            }
+            left -= 255 * chunk.len() as i64;
+            if i64::from(sum) + left <= floor {
+                return (i64::from(sum) + left) as u32;
+            }
         }
         sum
+    }
+
+    /// The four sums of the quadrants of a node: [`sum`](Self::sum) at `(dx, dy)`,
+    /// `(dx + s, dy)`, `(dx, dy + s)` and `(dx + s, dy + s)`, in one pass over the points
+    /// (each point's clamped rows and columns serve all four). Stops early once none of the
+    /// four can exceed `floor`, returning upper bounds as [`sum`](Self::sum) does.
+    #[inline]
+    pub(super) fn sum4(&self, cells: &[[i32; 2]], dx: i32, dy: i32, s: i32, floor: i64) -> [u32; 4] {
+        const CHUNK: usize = 16;
+        let (ox, oy) = (dx + self.pad, dy + self.pad);
+        let (xmax, ymax, w) = (self.width - 1, self.height - 1, self.width as usize);
+        let data = &self.cells[..];
+        let mut sums = [0u32; 4];
+        let mut left = 255 * cells.len() as i64;
+        for chunk in cells.chunks(CHUNK) {
+            for &[x, y] in chunk {
+                let x0 = (x + ox).clamp(0, xmax) as usize;
+                let x1 = (x + ox + s).clamp(0, xmax) as usize;
+                let r0 = (y + oy).clamp(0, ymax) as usize * w;
+                let r1 = (y + oy + s).clamp(0, ymax) as usize * w;
+                sums[0] += u32::from(data[r0 + x0]);
+                sums[1] += u32::from(data[r0 + x1]);
+                sums[2] += u32::from(data[r1 + x0]);
+                sums[3] += u32::from(data[r1 + x1]);
+            }
+            left -= 255 * chunk.len() as i64;
+            let top = sums.iter().copied().max().unwrap_or(0);
+            if i64::from(top) + left <= floor {
+                return sums.map(|v| (i64::from(v) + left) as u32);
+            }
+        }
+        sums
     }
 }
 

@@ -157,7 +157,7 @@ fn brute_force(grids: &PrecomputedGrids, problem: &Problem) -> Option<Candidate>
     for (scan, s) in problem.scans.iter().enumerate() {
         for dx in -w..=w {
             for dy in -w..=w {
-                let bound = grids.level(0).sum(&s.cells, dx, dy);
+                let bound = grids.level(0).sum(&s.cells, dx, dy, -1);
                 if best.is_none_or(|b| bound > b.bound) {
                     best = Some(Candidate { scan: scan as u32, dx, dy, bound });
                 }
@@ -211,7 +211,7 @@ proptest! {
             prop_assert_eq!(found.bound, exhaustive.bound);
             let w = problem.window;
             prop_assert!(found.dx.abs() <= w && found.dy.abs() <= w);
-            prop_assert_eq!(grids.level(0).sum(&problem.scans[found.scan as usize].cells, found.dx, found.dy), found.bound);
+            prop_assert_eq!(grids.level(0).sum(&problem.scans[found.scan as usize].cells, found.dx, found.dy, -1), found.bound);
             let m = match_branch_and_bound(&grids, &points, initial, &search).expect("the same match");
             prop_assert!(m.score >= min_score);
             prop_assert_eq!(m.score, problem.score(u64::from(exhaustive.bound)));
