@@ -191,7 +191,14 @@ impl ProbabilityGrid {
     /// the rays from `origin` to every hit and to every `miss` (a free ray without a return)
     /// more likely free. Hits are applied first, so a cell holding a return is never also
     /// cleared by a neighbouring ray in the same scan; every cell changes at most once.
-    pub fn insert(&mut self, origin: Point2, hits: &[Point2], misses: &[Point2], hit: &UpdateTable, miss: &UpdateTable) {
+    pub fn insert(
+        &mut self,
+        origin: Point2,
+        hits: &[Point2],
+        misses: &[Point2],
+        hit: &UpdateTable,
+        miss: &UpdateTable,
+    ) {
         let o = self.to_cell_units(origin);
         let (mut lo, mut hi) = ((o.0.floor() as i64, o.1.floor() as i64), (o.0.floor() as i64, o.1.floor() as i64));
         for p in hits.iter().chain(misses) {
