@@ -13,7 +13,7 @@
 //! | sensor models (lidar inverse model, semantic camera) | [`sensor`] |
 //! | the engine taking time-ordered measurements | [`fusion`] |
 //! | the `map → base_link` track from odometry, gyro, GNSS (EKF + RTS smoother) | [`estimator`] |
-//! | entropy, precision / recall | [`metrics`] |
+//! | entropy, precision / recall, SLAM-benchmark relations (Kümmerle et al. 2009) | [`metrics`] |
 //! | simulated worlds and scanners, the production-line simulator | [`sim`] |
 //! | the validated run configuration | [`config`] |
 //!

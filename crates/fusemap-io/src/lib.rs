@@ -15,6 +15,7 @@ pub mod map_server;
 pub mod npz;
 pub mod picture;
 pub mod read_ahead;
+pub mod relations;
 pub mod scanfile;
 pub mod semantic;
 pub mod simulation;

@@ -1,10 +1,14 @@
 //! Map quality: entropy (the design document's §5.1 fusion gain) and agreement with
-//! ground truth.
+//! ground truth; trajectory accuracy by the SLAM benchmark's relations.
 
 mod entropy;
+mod relations;
 mod scores;
 mod semantic;
 
 pub use entropy::{binary_entropy, map_entropy, EntropyReport};
+pub use relations::{
+    parse_relations, relation_errors, score_relations, Relation, RelationScore, RelationsError, PLANAR_TOLERANCE,
+};
 pub use scores::{Confusion, TolerantScore};
 pub use semantic::{ClassAccuracy, SemanticAccuracy};
