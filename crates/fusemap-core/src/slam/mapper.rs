@@ -200,14 +200,23 @@ impl Slam {
         (m.pose, ScanOutcome::Matched, Some(m.information))
     }
 
+    /// The information of a scan's local pose as a graph edge: the match's own (positive
+    /// semi-definite, from its curvature) plus a floor — an unmatched or degenerate
+    /// direction is as good as the odometry, not infinitely bad — and scaled down as a
+    /// whole if it claims more than a few millimetres, which stays positive definite.
     fn match_information(&self, info: Option<[[f64; 3]; 3]>) -> [[f64; 3]; 3] {
-        // Unmatched (first scans of the log): the local pose is as good as the odometry.
         let floor = information_diag(0.5, 10f64.to_radians());
         let cap = information_diag(0.005, 0.05f64.to_radians());
-        let mut out = info.unwrap_or(floor);
+        let mut out = info.unwrap_or([[0.0; 3]; 3]);
         for i in 0..3 {
-            out[i][i] = out[i][i].clamp(floor[i][i], cap[i][i]);
+            out[i][i] += floor[i][i];
+            for j in 0..i {
+                let v = 0.5 * (out[i][j] + out[j][i]);
+                (out[i][j], out[j][i]) = (v, v);
+            }
         }
+        let over = (0..3).map(|i| out[i][i] / cap[i][i]).fold(1.0, f64::max);
+        out.iter_mut().flatten().for_each(|v| *v /= over);
         out
     }
 
