@@ -57,6 +57,24 @@ enum Command {
         /// The log.
         log: PathBuf,
     },
+    /// Score a trajectory (TUM) by the SLAM benchmark's relations (Kümmerle et al. 2009):
+    /// mean ± standard deviation of the translational (m) and rotational (deg) errors of
+    /// the relative motions, as Hess et al. 2016 report them.
+    Relations {
+        /// A relations file: `t1 t2 x y z roll pitch yaw` a line.
+        #[arg(long)]
+        relations: PathBuf,
+        /// The trajectory to score, TUM format (`t x y z qx qy qz qw`).
+        #[arg(long)]
+        trajectory: PathBuf,
+        /// How far (milliseconds) a pose's stamp may lie from a relation's stamp; the
+        /// nearest pose is taken.
+        #[arg(long, default_value_t = 1.0)]
+        tolerance_ms: f64,
+        /// One JSON object instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Simulate the design document's production line (or a scenario file's world) and
     /// write it as a rosbag2 bag (MCAP) with its ground truth: DIR/bag, DIR/truth.yaml +
     /// truth.pgm (map_server), DIR/truth.tum.
@@ -109,6 +127,9 @@ fn main() {
             commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out)
         }
         Command::Doctor { config, log } => commands::doctor::run(config.as_deref(), &log),
+        Command::Relations { relations, trajectory, tolerance_ms, json } => {
+            commands::relations::run(&relations, &trajectory, tolerance_ms, json)
+        }
         Command::Simulate { scenario, out, resolution, overwrite } => {
             commands::simulate::run(scenario.as_deref(), &out, resolution, overwrite)
         }

@@ -4,4 +4,5 @@ pub mod bench;
 pub mod demo;
 pub mod doctor;
 pub mod map;
+pub mod relations;
 pub mod simulate;

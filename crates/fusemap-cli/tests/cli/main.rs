@@ -6,6 +6,7 @@ mod demo;
 mod doctor;
 mod formats;
 mod real_logs;
+mod relations;
 mod scenario_demo;
 mod simulate;
 mod sync;
