@@ -25,6 +25,20 @@
 //! The private `solver` module does the work: Gauss–Newton normal equations
 //! `JᵀWJ δ = −JᵀWr` with Marquardt damping, a sparse Cholesky (faer) on a block fill-reducing
 //! ordering, and the symbolic factorisation kept while the graph's structure does not change.
+//!
+//! ```
+//! use fusemap_core::geometry::Pose2;
+//! use fusemap_core::slam::pose_graph::*;
+//! let mut graph = PoseGraph::new();
+//! let a = graph.add_node(Pose2::IDENTITY);
+//! let b = graph.add_node(Pose2::new(0.8, 0.3, 0.1)); // a poor initial guess
+//! let information = [[100.0, 0.0, 0.0], [0.0, 100.0, 0.0], [0.0, 0.0, 400.0]];
+//! let measurement = Pose2::new(1.0, 0.0, 0.0); // b is 1 m ahead of a
+//! graph.add_edge(Edge { from: a, to: b, measurement, information, loss: Loss::Trivial, kind: EdgeKind::Odometry }).unwrap();
+//! let report = graph.optimize(&OptimizeOptions::default()).unwrap();
+//! assert!(report.converged && report.final_cost < 1e-12);
+//! assert!((graph.nodes()[b].x - 1.0).abs() < 1e-6); // node a holds the gauge
+//! ```
 
 mod solver;
 #[cfg(test)]
