@@ -224,6 +224,25 @@ fn fixed_nodes_do_not_move() {
 }
 
 #[test]
+fn a_node_without_constraints_is_left_alone() {
+    let truth = ring(12, 2.0);
+    let mut init = truth.clone();
+    init[4].y += 0.4;
+    let mut g = consistent_graph(&truth, &init);
+    let lonely = g.add_node(Pose2::new(7.0, -3.0, 1.0));
+    // Many iterations drive the damping to its floor, where the lonely node's block is tiny.
+    let opts = OptimizeOptions {
+        max_iterations: 100,
+        function_tolerance: 0.0,
+        parameter_tolerance: 0.0,
+        ..Default::default()
+    };
+    g.optimize(&opts).unwrap();
+    assert_eq!(g.nodes()[lonely], Pose2::new(7.0, -3.0, 1.0));
+    assert!(max_pose_error(&g.nodes()[..12], &truth) < 1e-6);
+}
+
+#[test]
 fn angles_wrap_across_plus_minus_pi() {
     let truth =
         vec![Pose2::new(0.0, 0.0, PI - 0.01), Pose2::new(-1.0, 0.0, -PI + 0.01), Pose2::new(-2.0, 0.02, PI - 0.02)];
