@@ -54,7 +54,10 @@ pub(super) struct Structure {
     /// (block row = smaller free index), or [`FIXED`] when an end is fixed.
     off: Vec<[usize; 3]>,
     symbolic: SymbolicCholesky<usize>,
+    /// Workspace of the numeric factorisation and solve.
     mem: MemBuffer,
+    /// Values of the Cholesky factor, kept so repeated calls do not page in fresh memory.
+    factor: Vec<f64>,
 }
 
 impl std::fmt::Debug for Structure {
@@ -144,7 +147,8 @@ impl Structure {
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
         ]));
-        Ok(Structure { n_edges: graph.edges.len(), free, col_ptr, row_idx, diag, off, symbolic, mem })
+        let factor = vec![0.0; symbolic.len_val()];
+        Ok(Structure { n_edges: graph.edges.len(), free, col_ptr, row_idx, diag, off, symbolic, mem, factor })
     }
 }
 
@@ -308,7 +312,12 @@ pub(super) fn optimize(graph: &mut PoseGraph, opts: &OptimizeOptions) -> Result<
     let reusable = matches!(&graph.cache, Some(st) if st.n_edges == graph.edges.len() && st.free == free);
     let mut st = match graph.cache.take() {
         Some(st) if reusable => st,
-        _ => Structure::build(graph, free, n_free)?,
+        _ => {
+            let t = std::time::Instant::now();
+            let s = Structure::build(graph, free, n_free)?;
+            eprintln!("DBG build {:?}", t.elapsed());
+            s
+        }
     };
     report.reused_symbolic = reusable;
     let start = graph.nodes.clone();
@@ -333,7 +342,6 @@ fn iterate(
     let mut grad = vec![0.0; n];
     let mut scale = vec![0.0; n];
     let mut delta = vec![0.0; n];
-    let mut factor = vec![0.0; st.symbolic.len_val()];
     let mut trial = graph.nodes.clone();
     let mut cost = linearize(graph, st, &mut h, &mut grad);
     let mut lambda = opts.initial_lambda;
@@ -366,11 +374,11 @@ fn iterate(
         for (d, g) in delta.iter_mut().zip(&grad) {
             *d = -g;
         }
-        let Structure { col_ptr, row_idx, symbolic, mem, .. } = &mut *st;
+        let Structure { col_ptr, row_idx, symbolic, mem, factor, .. } = &mut *st;
         let stack = MemStack::new(mem);
         let matrix = SparseColMatRef::new(SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx), &damped);
         match symbolic.factorize_numeric_llt(
-            &mut factor,
+            factor,
             matrix,
             Side::Upper,
             LltRegularization::default(),

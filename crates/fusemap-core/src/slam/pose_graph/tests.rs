@@ -224,6 +224,25 @@ fn fixed_nodes_do_not_move() {
 }
 
 #[test]
+fn a_node_without_constraints_is_left_alone() {
+    let truth = ring(12, 2.0);
+    let mut init = truth.clone();
+    init[4].y += 0.4;
+    let mut g = consistent_graph(&truth, &init);
+    let lonely = g.add_node(Pose2::new(7.0, -3.0, 1.0));
+    // Many iterations drive the damping to its floor, where the lonely node's block is tiny.
+    let opts = OptimizeOptions {
+        max_iterations: 100,
+        function_tolerance: 0.0,
+        parameter_tolerance: 0.0,
+        ..Default::default()
+    };
+    g.optimize(&opts).unwrap();
+    assert_eq!(g.nodes()[lonely], Pose2::new(7.0, -3.0, 1.0));
+    assert!(max_pose_error(&g.nodes()[..12], &truth) < 1e-6);
+}
+
+#[test]
 fn angles_wrap_across_plus_minus_pi() {
     let truth =
         vec![Pose2::new(0.0, 0.0, PI - 0.01), Pose2::new(-1.0, 0.0, -PI + 0.01), Pose2::new(-2.0, 0.02, PI - 0.02)];
@@ -399,4 +418,78 @@ proptest! {
             prop_assert!(rho0 == 0.0 && w0 == 1.0);
         }
     }
+}
+
+/// A measurement, not a check: the time of `optimize` on a graph the size of a long indoor
+/// log (15,000 nodes, 60,000 edges).  Run by hand:
+/// `cargo test --release -p fusemap-core --lib slam::pose_graph::tests::timing -- --ignored --nocapture`
+#[test]
+#[ignore = "measurement, not a check; run by hand with --release"]
+fn timing_15000_nodes_60000_edges() {
+    use std::collections::HashMap;
+    use std::time::Instant;
+    let n = 15_000;
+    let mut rng = Rng(2024);
+    // A smooth random walk in a 60 m square, 0.4 m a step, turning back at the walls.
+    let mut truth = vec![Pose2::new(30.0, 30.0, 0.0)];
+    for _ in 1..n {
+        let p = *truth.last().unwrap();
+        let ahead = p.compose(Pose2::new(2.0, 0.0, 0.0));
+        let turn =
+            if (0.0..60.0).contains(&ahead.x) && (0.0..60.0).contains(&ahead.y) { 0.15 * rng.normal() } else { 0.5 };
+        truth.push(p.compose(Pose2::new(0.4, 0.0, turn)));
+    }
+    let mut g = PoseGraph::new();
+    g.add_node(truth[0]);
+    let noisy = |rng: &mut Rng, z: Pose2, s: f64| {
+        Pose2::new(z.x + s * rng.normal(), z.y + s * rng.normal(), z.theta + 0.25 * s * rng.normal())
+    };
+    for i in 1..n {
+        let z = noisy(&mut rng, between(truth[i - 1], truth[i]), 0.02);
+        let prev = g.nodes()[i - 1];
+        g.add_node(prev.compose(z));
+        g.add_edge(Edge { kind: EdgeKind::Odometry, ..edge(i - 1, i, z, info(0.02, 0.005), Loss::Trivial) }).unwrap();
+    }
+    for i in 0..n {
+        for k in [2, 3] {
+            if i + k < n {
+                let z = noisy(&mut rng, between(truth[i], truth[i + k]), 0.02);
+                g.add_edge(edge(i, i + k, z, info(0.02, 0.005), Loss::Huber(2.0))).unwrap();
+            }
+        }
+    }
+    // Loop closures: earlier nodes within the same 2 m cell, until 60,000 edges.
+    let mut cells: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    for (i, p) in truth.iter().enumerate() {
+        let key = ((p.x / 2.0).floor() as i64, (p.y / 2.0).floor() as i64);
+        let cell = cells.entry(key).or_default();
+        let old: Vec<usize> = cell.iter().copied().filter(|&j| j + 50 < i).collect();
+        for _ in 0..2 {
+            if !old.is_empty() && g.edges().len() < 60_000 {
+                let j = old[(rng.uniform() * old.len() as f64) as usize % old.len()];
+                let z = noisy(&mut rng, between(truth[j], truth[i]), 0.05);
+                g.add_edge(Edge { kind: EdgeKind::LoopClosure, ..edge(j, i, z, info(0.05, 0.0125), Loss::Huber(2.0)) })
+                    .unwrap();
+            }
+        }
+        cell.push(i);
+    }
+    let opts = OptimizeOptions::default();
+    let t = Instant::now();
+    let cold = g.optimize(&opts).unwrap();
+    let cold_time = t.elapsed();
+    eprintln!("nodes {} edges {}", g.nodes().len(), g.edges().len());
+    eprintln!("from odometry (with symbolic analysis): {cold_time:?} {cold:?}");
+    eprintln!("mean error {:.3} m", mean_translation_error(g.nodes(), &truth));
+    let one = OptimizeOptions { max_iterations: 1, ..opts };
+    let t = Instant::now();
+    let single = g.optimize(&one).unwrap();
+    eprintln!("one iteration at the optimum (symbolic reused): {:?} {single:?}", t.elapsed());
+    for i in (0..n).step_by(7) {
+        let p = g.nodes()[i];
+        g.set_node(i, Pose2::new(p.x + 0.05 * rng.normal(), p.y + 0.05 * rng.normal(), p.theta + 0.01 * rng.normal()));
+    }
+    let t = Instant::now();
+    let warm = g.optimize(&opts).unwrap();
+    eprintln!("warm start, perturbed (symbolic reused): {:?} {warm:?}", t.elapsed());
 }
