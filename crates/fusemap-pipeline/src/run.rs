@@ -207,8 +207,7 @@ pub fn prepare_with(
     }
     let t0 = Instant::now();
     let mut run = crate::slam::run(plan, inv, &bound, &chosen, reason, progress)?;
-    let mut track = crate::slam::track(plan, inv, &bound, &mut run)?;
-    track.notes.extend(chosen.notes);
+    let mut track = crate::slam::track(plan, chosen, &mut run);
     track.notes.push(format!(
         "SLAM corrected the poses ({}): {} scans matched ({} degenerate), {} nodes, {} submaps, {} of {} loop-closure searches accepted",
         run.summary.reason,

@@ -11,18 +11,18 @@
 //! de-skewed, and the camera frames — at its own stamp. Without odometry to run the
 //! estimator on, the optimised scan poses are the track.
 
-use crate::estimation::inputs;
 use crate::extrinsics::frame_tree;
+use crate::merge::{OrderedMerge, Pushed};
 use crate::recording::{for_each_range_message, Inventory, RangeMessage};
+use fusemap_io::log::ScanMessage;
 use crate::run::{lidar_setup, sync_mode, Progress};
 use crate::sensors::Bound;
 use crate::track::{ChosenTrack, TfTrack, Track, TrackCounts};
 use crate::PipelineError;
-use fusemap_core::config::{Plan, PoseSource, SensorKind, SlamMode};
-use fusemap_core::estimator::{estimate, EstimatorInput};
+use fusemap_core::config::{Plan, PoseSource, SlamMode};
 use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::slam::pose_graph::EdgeKind;
-use fusemap_core::slam::{ScanInput, Slam, SlamReport, SlamResult};
+use fusemap_core::slam::{CorrectedTrack, ScanInput, Slam, SlamReport, SlamResult};
 use fusemap_core::time::{PoseBuffer, Stamp};
 use serde::Serialize;
 use std::time::Instant;
@@ -56,10 +56,10 @@ pub struct SlamSummary {
     pub reason: String,
     /// The lidar topic SLAM used.
     pub topic: String,
-    /// Scans without a track pose (not used by SLAM).
+    /// Scans without a track pose (matched from the previous scan's pose).
     pub scans_without_pose: u64,
-    /// Scans older than the one before (not used by SLAM).
-    pub scans_out_of_order: u64,
+    /// Scans that arrived more than `log.reorder_window_s` behind a later one (not used).
+    pub scans_late: u64,
     /// The core's counts and timings.
     pub counts: SlamReport,
     /// Wall time of the whole pass, reading included, seconds.
@@ -136,31 +136,29 @@ pub fn run(
     let stamps = &inv.scans[&b.topic].stamps;
     let mode = sync_mode(cfg, stamps);
     let mut slam = Slam::new(plan.slam);
-    let (mut without_pose, mut out_of_order) = (0u64, 0u64);
-    let mut last: Option<Stamp> = None;
+    // The track refuses to interpolate across its gaps (a map must not guess); a
+    // prediction may: the match corrects it.
+    let samples = match &chosen.track {
+        Track::Timed(track) => track.samples(),
+        Track::ScanLine => Vec::new(),
+    };
+    let (mut without_pose, mut late) = (0u64, 0u64);
     let mut hits: Vec<Point2> = Vec::new();
     progress(Progress::Phase { name: "slam", total: stamps.len() as u64 });
     let topics = [b.topic.clone()];
-    for_each_range_message(&inv.path, &topics, &[], |msg| {
-        let RangeMessage::Scan(scan) = msg else { return Ok(()) };
-        if scan.topic != b.topic {
-            return Ok(());
-        }
+    // Scans in stamp order, as the mapping pass releases them (logs hold them in arrival
+    // order; CARMEN IPC stamps go backwards now and then).
+    let mut merge: OrderedMerge<ScanMessage> = OrderedMerge::new(crate::offset_ns(cfg.reorder_window_s));
+    let stream = merge.add_stream(b.topic.clone());
+    let mut feed = |t: Stamp, scan: ScanMessage| {
         progress(Progress::Advance(1));
-        let t = Stamp(scan.scan.stamp.0.saturating_add(offset));
         let pose = match &chosen.track {
             Track::ScanLine => scan.pose.filter(|p| p.is_finite()),
-            Track::Timed(track) => track.pose_at(t, mode).ok(),
+            Track::Timed(track) => track.pose_at(t, mode).ok().or_else(|| across_gap(&samples, t)),
         };
-        let Some(pose) = pose else {
+        if pose.is_none() {
             without_pose += 1;
-            return Ok(());
-        };
-        if last.is_some_and(|l| t < l) {
-            out_of_order += 1;
-            return Ok(());
         }
-        last = Some(t);
         let lo = params.min_range.max(scan.range_min as f64);
         let hi = params.max_range.min(scan.range_max as f64);
         let (a0, inc) = (scan.scan.angle_min as f32 as f64, scan.scan.angle_increment as f32 as f64);
@@ -174,15 +172,52 @@ pub fn run(
             })
         }));
         slam.add_scan(ScanInput { stamp: t, track: pose, origin, hits: &hits, misses: &[] });
+    };
+    let mut seq = 0i64;
+    for_each_range_message(&inv.path, &topics, &[], |msg| {
+        let RangeMessage::Scan(scan) = msg else { return Ok(()) };
+        if scan.topic != b.topic {
+            return Ok(());
+        }
+        // Poses on the scan lines do not depend on the stamps: file order.
+        let key = match chosen.track {
+            Track::ScanLine => {
+                seq += 1;
+                seq
+            }
+            Track::Timed(_) => scan.scan.stamp.0.saturating_add(offset),
+        };
+        if merge.push(stream, key, scan) == Pushed::Late {
+            late += 1;
+        }
+        while let Some((_, _, scan)) = merge.pop_ready() {
+            let t = Stamp(scan.scan.stamp.0.saturating_add(offset));
+            feed(t, scan);
+        }
         Ok(())
     })?;
+    while let Some((_, _, scan)) = merge.pop_final() {
+        let t = Stamp(scan.scan.stamp.0.saturating_add(offset));
+        feed(t, scan);
+    }
     progress(Progress::Done);
     let result = slam.finish();
-    let summary = summary(&result, reason, b.topic.clone(), without_pose, out_of_order, t0.elapsed().as_secs_f64());
+    let summary = summary(&result, reason, b.topic.clone(), without_pose, late, t0.elapsed().as_secs_f64());
     Ok(SlamRun { summary })
 }
 
-fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, out_of_order: u64, seconds: f64) -> SlamSummary {
+/// The track's pose at `t` interpolated between its samples whatever the gap between
+/// them; `None` outside the samples.
+fn across_gap(samples: &[(Stamp, Pose2)], t: Stamp) -> Option<Pose2> {
+    let i = samples.partition_point(|s| s.0 < t);
+    let (b, a) = (samples.get(i)?, samples.get(i.checked_sub(1)?)?);
+    if b.0 == t {
+        return Some(b.1);
+    }
+    Some(a.1.interpolate(b.1, (t.0 - a.0 .0) as f64 / (b.0 .0 - a.0 .0) as f64))
+}
+
+fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, late: u64, seconds: f64) -> SlamSummary {
     let mut kind = vec![("scan", None); r.graph.nodes().len()];
     for (&g, &s) in r.scan_nodes.iter().zip(&r.node_stamps) {
         kind[g] = ("scan", Some(s.0));
@@ -215,7 +250,7 @@ fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, out
         reason,
         topic,
         scans_without_pose: without_pose,
-        scans_out_of_order: out_of_order,
+        scans_late: late,
         counts: r.report.clone(),
         seconds,
         track: String::new(),
@@ -225,50 +260,39 @@ fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, out
     }
 }
 
-/// The pose track from a SLAM run: the estimator over the log's pose sensors plus the
-/// optimised scan poses when the log has odometry, else the optimised poses themselves.
-pub fn track(plan: &Plan, inv: &Inventory, bound: &Bound, run: &mut SlamRun) -> Result<ChosenTrack, PipelineError> {
-    let (st, sr) = plan.slam_pose_sigma;
-    let covariance = [[st * st, 0.0, 0.0], [0.0, st * st, 0.0], [0.0, 0.0, sr * sr]];
-    if bound.first(SensorKind::WheelOdometry).is_some() {
-        let mut built = inputs(plan, inv, bound)?;
-        built.inputs.extend(run.summary.scan_poses.iter().map(|&(stamp, pose)| EstimatorInput::Pose { stamp, pose, covariance }));
-        built.inputs.sort_by_key(|i| i.stamp());
-        let e = estimate(&built.inputs, &built.config)
-            .map_err(|e| PipelineError::Refused(format!("pose estimator with the SLAM poses: {e}")))?;
-        run.summary.track = "estimator: odometry and the log's other pose sensors, with the optimised scan poses".into();
-        let counts = TrackCounts {
-            samples: e.report.odometry.received as u64,
-            used: e.report.odometry.used as u64,
-            duplicates: e.report.odometry.duplicate_stamps as u64,
-            not_finite: e.report.odometry.not_finite as u64,
-            ..Default::default()
-        };
-        let odom = bound.first(SensorKind::WheelOdometry).map(|o| &inv.odom[&o.topic]);
-        return Ok(ChosenTrack {
-            source: PoseSource::Estimator,
-            estimator: serde_json::to_value(&e.report).ok(),
-            track: Track::Timed(Box::new(e)),
-            name: "SLAM (scan matching + loop closure) through the estimator".into(),
-            counts,
-            stamps: odom.map(|o| o.iter().map(|m| m.stamp).collect()).unwrap_or_default(),
-            receive: odom.map(|o| o.iter().map(|m| m.receive_stamp).collect()).unwrap_or_default(),
-            notes: built.notes,
-            slam: None,
-        });
+/// The pose track from a SLAM run: the prediction track corrected at every scan by the
+/// optimised pose ([`CorrectedTrack`]); for poses on the scan lines (raw CARMEN), the
+/// optimised poses themselves, interpolated.
+///
+/// Measured alternative, not taken: the optimised poses as absolute pose inputs of the
+/// EKF + smoother beside the odometry. On the Intel log its χ² gate refused 88 % of them
+/// (the odometry's heading drifts faster than its noise model says) and the track's
+/// relation error was 9.4 m against 0.02 m for the optimised poses. The graph already
+/// fuses the estimator's motion, the matches, the loop closures and the fixes; the
+/// correction keeps its result exactly at every scan.
+pub fn track(plan: &Plan, chosen: ChosenTrack, run: &mut SlamRun) -> ChosenTrack {
+    match chosen.track {
+        Track::Timed(base) => {
+            run.summary.track = format!("{} corrected at every scan by the optimised pose graph", chosen.name);
+            ChosenTrack {
+                track: Track::Timed(Box::new(CorrectedTrack::new(base, &run.summary.scan_poses))),
+                name: format!("SLAM (scan matching + loop closure) over {}", chosen.name),
+                ..chosen
+            }
+        }
+        Track::ScanLine => {
+            run.summary.track = "the optimised scan poses, interpolated".into();
+            let mut counts = TrackCounts::default();
+            let buffer: PoseBuffer = crate::track::buffer_of(&plan.log, run.summary.scan_poses.clone(), &mut counts);
+            ChosenTrack {
+                source: PoseSource::Odometry,
+                track: Track::Timed(Box::new(buffer)),
+                name: "SLAM (scan matching + loop closure) over the odometry on the scan lines".into(),
+                counts,
+                stamps: run.summary.scan_poses.iter().map(|s| s.0).collect(),
+                receive: vec![None; run.summary.scan_poses.len()],
+                ..chosen
+            }
+        }
     }
-    run.summary.track = "the optimised scan poses, interpolated".into();
-    let mut counts = TrackCounts::default();
-    let buffer: PoseBuffer = crate::track::buffer_of(&plan.log, run.summary.scan_poses.clone(), &mut counts);
-    Ok(ChosenTrack {
-        source: PoseSource::Odometry,
-        track: Track::Timed(Box::new(buffer)),
-        name: "SLAM (scan matching + loop closure)".into(),
-        counts,
-        stamps: run.summary.scan_poses.iter().map(|s| s.0).collect(),
-        receive: vec![None; run.summary.scan_poses.len()],
-        estimator: None,
-        notes: Vec::new(),
-        slam: None,
-    })
 }

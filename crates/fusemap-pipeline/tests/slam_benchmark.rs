@@ -26,14 +26,21 @@ fn score(log: &str, relations: &str) -> Option<Scored> {
     let log = dataset(log)?;
     let rel = dataset(relations)?;
     let relations = parse_relations(&std::fs::read_to_string(&rel).unwrap()).unwrap();
-    let plan = Config::default().validate().unwrap();
+    // FUSEMAP_SLAM_TOML: a `[slam]` table to try other settings without rebuilding.
+    let mut config = Config::default();
+    if let Ok(t) = std::env::var("FUSEMAP_SLAM_TOML") {
+        config.slam = toml::from_str(&t).expect("FUSEMAP_SLAM_TOML is a [slam] table");
+    }
+    let plan = config.validate().unwrap();
     let inv = Inventory::read(&log).unwrap();
     let (bound, chosen, _) = prepare(&plan, &inv).unwrap();
     let slam = chosen.slam.as_ref().expect("SLAM runs on a raw log");
     eprintln!(
-        "{}: {} scans, {} matched, {} degenerate, {} nodes, {} submaps, loop closures {}/{} accepted, {} optimisations; matching {:.2} s, loop search {:.2} s, optimisation {:.2} s, total {:.2} s",
+        "{}: {} scans ({} without a track pose, {} late), {} matched, {} degenerate, {} nodes, {} submaps, loop closures {}/{} accepted, {} optimisations; matching {:.2} s, loop search {:.2} s, optimisation {:.2} s, total {:.2} s",
         log.display(),
         slam.counts.scans,
+        slam.scans_without_pose,
+        slam.scans_late,
         slam.counts.matched,
         slam.counts.degenerate,
         slam.counts.nodes,
@@ -46,6 +53,10 @@ fn score(log: &str, relations: &str) -> Option<Scored> {
         slam.counts.optimisation_s,
         slam.seconds
     );
+    if std::env::var("FUSEMAP_SLAM_DEBUG").is_ok() {
+        let e = chosen.estimator.as_ref().map(|v| v.to_string()).unwrap_or_default();
+        eprintln!("estimator: {}", &e[..e.len().min(3000)]);
+    }
     let stamps = &inv.scans[&bound.lidars[0].topic].stamps;
     let Track::Timed(track) = &chosen.track else { panic!("SLAM gives a timed track") };
     let at = |t: &Stamp| track.pose_at(*t, SyncMode::Interpolate).ok().map(|p| (*t, p));

@@ -72,8 +72,16 @@ pub struct SlamConfig {
     pub odometry_floor_deg: f64,
     /// Search for loop closures.
     pub loop_closure: bool,
-    /// Share of (node, nearby finished submap) pairs searched: the loop-closure rate.
+    /// Share of nodes searched for loop closures: the loop-closure rate.
     pub loop_closure_sampling_ratio: f64,
+    /// A searched node tries at most this many nearest finished submaps.
+    pub loop_closure_submaps_per_node: usize,
+    /// A finished submap is tried by at most this many earlier nodes near it.
+    pub loop_closure_nodes_per_submap: usize,
+    /// Returns farther than this are left out of the loop-closure search, metres.
+    pub loop_closure_max_range_m: f64,
+    /// At most this many returns (evenly spread) go into a loop-closure search.
+    pub loop_closure_max_points: usize,
     /// Only submaps within this distance of a node are searched, metres.
     pub loop_closure_max_distance_m: f64,
     /// Loop-closure search half-width in x and y, metres.
@@ -126,6 +134,10 @@ impl Default for SlamConfig {
             odometry_floor_deg: p.odometry_floor_rad.to_degrees(),
             loop_closure: p.loop_closure,
             loop_closure_sampling_ratio: p.loop_closure_sampling_ratio,
+            loop_closure_submaps_per_node: p.loop_closure_submaps_per_node,
+            loop_closure_nodes_per_submap: p.loop_closure_nodes_per_submap,
+            loop_closure_max_range_m: p.loop_closure_max_range_m,
+            loop_closure_max_points: p.loop_closure_max_points,
             loop_closure_max_distance_m: p.loop_closure_max_distance_m,
             loop_closure_linear_window_m: p.loop_closure_linear_window_m,
             loop_closure_angular_window_deg: p.loop_closure_angular_window_rad.to_degrees(),
@@ -218,6 +230,10 @@ impl SlamConfig {
             odometry_floor_rad: positive("odometry_floor_deg", self.odometry_floor_deg)?.to_radians(),
             loop_closure: self.loop_closure,
             loop_closure_sampling_ratio: ratio,
+            loop_closure_submaps_per_node: self.loop_closure_submaps_per_node,
+            loop_closure_nodes_per_submap: self.loop_closure_nodes_per_submap,
+            loop_closure_max_range_m: positive("loop_closure_max_range_m", self.loop_closure_max_range_m)?,
+            loop_closure_max_points: self.loop_closure_max_points,
             loop_closure_max_distance_m: non_negative("loop_closure_max_distance_m", self.loop_closure_max_distance_m)?,
             loop_closure_linear_window_m: non_negative("loop_closure_linear_window_m", self.loop_closure_linear_window_m)?
                 .min(100.0),

@@ -99,7 +99,11 @@ pub fn correlative_search(
     p: &LocalMatchParams,
 ) -> (Pose2, f32) {
     let r = grid.resolution();
-    let max_range = points.iter().map(|q| q.x.hypot(q.y)).fold(r, f64::max);
+    // Olson's step moves the farthest point by one cell; far returns of a long corridor
+    // would make it tiny. The refinement converges from a cell or two away, so the step is
+    // taken for points up to `STEP_RANGE_M` and farther ones may move a few cells.
+    const STEP_RANGE_M: f64 = 10.0;
+    let max_range = points.iter().map(|q| q.x.hypot(q.y)).fold(r, f64::max).min(STEP_RANGE_M);
     let step = (1.0 - r * r / (2.0 * max_range * max_range)).clamp(-1.0, 1.0).acos().max(1e-4);
     let n_ang = (p.angular_window_rad / step).ceil() as i64;
     let n_lin = (p.linear_window_m / r).ceil() as i64;

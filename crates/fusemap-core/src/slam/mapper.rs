@@ -32,8 +32,9 @@ pub struct ScanInput<'a> {
     /// The scan's stamp.
     pub stamp: Stamp,
     /// `map_from_base` at the stamp from the pose track (odometry or the estimator): only
-    /// its motion between scans is used.
-    pub track: Pose2,
+    /// its motion between scans is used. `None` inside a gap of the track: the scan is
+    /// matched from the previous scan's pose.
+    pub track: Option<Pose2>,
     /// The sensor's origin in the base frame.
     pub origin: Point2,
     /// Returns.
@@ -51,7 +52,7 @@ pub enum ScanOutcome {
     Degenerate,
     /// Too few usable returns (or no submap yet): the predicted pose was kept.
     Predicted,
-    /// Refused: a non-finite track pose.
+    /// Refused: a non-finite track pose or sensor origin.
     Refused,
 }
 
@@ -64,9 +65,10 @@ struct ScanRecord {
 struct Node {
     stamp: Stamp,
     local: Pose2,
-    track: Pose2,
+    track: Option<Pose2>,
     graph: usize,
     points: Vec<Point2>,
+    search_points: Vec<Point2>,
     submaps: Vec<usize>,
 }
 
@@ -77,11 +79,12 @@ pub struct Slam {
     submaps: Submaps,
     submap_graph: Vec<usize>,
     precomputed: Vec<Option<PrecomputedGrids>>,
-    samplers: Vec<f64>,
+    node_sampler: f64,
     graph: PoseGraph,
     nodes: Vec<Node>,
     scans: Vec<ScanRecord>,
-    last: Option<(Pose2, Pose2)>,
+    /// The last scan's local pose, and its track pose if it had one.
+    last: Option<(Pose2, Option<Pose2>)>,
     global_from_local: Pose2,
     since_optimisation: usize,
     closures_since_optimisation: usize,
@@ -116,7 +119,7 @@ impl Slam {
             p,
             submap_graph: Vec::new(),
             precomputed: Vec::new(),
-            samplers: Vec::new(),
+            node_sampler: 0.0,
             graph: PoseGraph::new(),
             nodes: Vec::new(),
             scans: Vec::new(),
@@ -136,7 +139,7 @@ impl Slam {
     /// Adds the next scan (stamps non-decreasing).
     pub fn add_scan(&mut self, scan: ScanInput) -> ScanOutcome {
         self.report.scans += 1;
-        if !scan.track.is_finite() || !scan.origin.is_finite() {
+        if scan.track.is_some_and(|t| !t.is_finite()) || !scan.origin.is_finite() {
             self.report.refused += 1;
             return ScanOutcome::Refused;
         }
@@ -146,10 +149,16 @@ impl Slam {
             q.is_finite() && dx * dx + dy * dy <= max2
         };
         let hits: Vec<Point2> = scan.hits.iter().filter(in_range).copied().collect();
-        let predicted = match self.last {
-            Some((local, track)) => local.compose(track.inverse().compose(scan.track)),
-            None => scan.track,
+        let predicted = match (self.last, scan.track) {
+            (Some((local, Some(before))), Some(now)) => local.compose(before.inverse().compose(now)),
+            // In or just out of a gap of the track: no motion known, the search finds it.
+            (Some((local, _)), _) => local,
+            (None, Some(now)) => now,
+            (None, None) => Pose2::IDENTITY,
         };
+        if scan.track.is_none() {
+            self.report.without_track += 1;
+        }
         let t0 = Instant::now();
         let (local, outcome, information) = self.match_local(&hits, predicted);
         self.report.matching_s += t0.elapsed().as_secs_f64();
@@ -225,7 +234,7 @@ impl Slam {
         &mut self,
         stamp: Stamp,
         local: Pose2,
-        track: Pose2,
+        track: Option<Pose2>,
         origin: Point2,
         hits: Vec<Point2>,
         misses: &[Point2],
@@ -240,7 +249,6 @@ impl Slam {
             let g = self.graph.add_node(self.global_from_local.compose(self.submaps.all()[s].local_pose));
             self.submap_graph.push(g);
             self.precomputed.push(None);
-            self.samplers.push(0.0);
         }
         let g = self.graph.add_node(self.global_from_local.compose(local));
         if self.nodes.is_empty() {
@@ -260,8 +268,8 @@ impl Slam {
             };
             self.graph.add_edge(e).expect("valid match edge");
         }
-        if let Some(prev) = self.nodes.last() {
-            let d = prev.track.inverse().compose(track);
+        if let Some((prev, before, now)) = self.nodes.last().and_then(|p| Some((p, p.track?, track?))) {
+            let d = before.inverse().compose(now);
             let st = self.p.odometry_floor_m + self.p.odometry_translation_per_m * d.x.hypot(d.y);
             let sr = self.p.odometry_floor_rad + self.p.odometry_rotation_per_rad * d.theta.abs();
             let e = Edge {
@@ -276,23 +284,30 @@ impl Slam {
                 self.graph.add_edge(e).expect("valid odometry edge");
             }
         }
-        self.nodes.push(Node { stamp, local, track, graph: g, points: hits, submaps: into });
+        // The global search's cost grows with the farthest point (its angular step), so
+        // it looks at the returns within `loop_closure_max_range_m`.
+        let r2 = self.p.loop_closure_max_range_m * self.p.loop_closure_max_range_m;
+        let near: Vec<Point2> = hits
+            .iter()
+            .filter(|q| {
+                let (dx, dy) = (q.x - origin.x, q.y - origin.y);
+                dx * dx + dy * dy <= r2
+            })
+            .copied()
+            .collect();
+        // … and at most `loop_closure_max_points` of them, evenly spread over the scan.
+        let stride = near.len().div_ceil(self.p.loop_closure_max_points.max(1)).max(1);
+        let search_points = near.into_iter().step_by(stride).collect();
+        self.nodes.push(Node { stamp, local, track, graph: g, points: hits, search_points, submaps: into });
         self.report.nodes += 1;
         self.report.submaps = self.submaps.all().len();
         if self.p.loop_closure {
             let t0 = Instant::now();
             if let Some(f) = finished {
                 self.precomputed[f] = Some(PrecomputedGrids::new(&self.submaps.all()[f].grid, self.p.branch_and_bound_depth));
-                for n in 0..self.nodes.len() {
-                    self.search(n, f);
-                }
+                self.search_nodes_against(f);
             }
-            let n = self.nodes.len() - 1;
-            for s in 0..self.submaps.all().len() {
-                if self.precomputed[s].is_some() && (finished != Some(s)) {
-                    self.search(n, s);
-                }
-            }
+            self.search_submaps_for(self.nodes.len() - 1);
             self.report.loop_search_s += t0.elapsed().as_secs_f64();
         }
         self.since_optimisation += 1;
@@ -301,21 +316,50 @@ impl Slam {
         }
     }
 
+    /// True when finished submap `s` is a candidate for node `n`: not one the node went
+    /// into, and near it in the current estimate.
+    fn candidate(&self, n: usize, s: usize) -> Option<f64> {
+        let node = &self.nodes[n];
+        if self.precomputed[s].is_none() || node.submaps.contains(&s) {
+            return None;
+        }
+        let (gn, gs) = (self.graph.nodes()[node.graph], self.graph.nodes()[self.submap_graph[s]]);
+        let d = (gn.x - gs.x).hypot(gn.y - gs.y);
+        (d <= self.p.loop_closure_max_distance_m).then_some(d)
+    }
+
+    /// A sampled new node against the nearest finished submaps (Hess et al. 2016 search
+    /// every node against every submap in reach, sampled; offline, a few nearest per node
+    /// are enough and bound the cost).
+    fn search_submaps_for(&mut self, n: usize) {
+        self.node_sampler += self.p.loop_closure_sampling_ratio;
+        if self.node_sampler < 1.0 {
+            return;
+        }
+        self.node_sampler -= 1.0;
+        let mut near: Vec<(f64, usize)> =
+            (0..self.submaps.all().len()).filter_map(|s| self.candidate(n, s).map(|d| (d, s))).collect();
+        near.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for &(_, s) in near.iter().take(self.p.loop_closure_submaps_per_node) {
+            self.search(n, s);
+        }
+    }
+
+    /// Earlier nodes, evenly sampled, against a submap just finished: a place revisited
+    /// later is found from both ends.
+    fn search_nodes_against(&mut self, s: usize) {
+        let near: Vec<usize> = (0..self.nodes.len()).filter(|&n| self.candidate(n, s).is_some()).collect();
+        let budget = self.p.loop_closure_nodes_per_submap;
+        let stride = near.len().div_ceil(budget.max(1)).max(1);
+        for &n in near.iter().step_by(stride) {
+            self.search(n, s);
+        }
+    }
+
     /// Searches node `n` against finished submap `s` for a loop closure.
     fn search(&mut self, n: usize, s: usize) {
         let node = &self.nodes[n];
-        if node.submaps.contains(&s) {
-            return;
-        }
         let (gn, gs) = (self.graph.nodes()[node.graph], self.graph.nodes()[self.submap_graph[s]]);
-        if (gn.x - gs.x).hypot(gn.y - gs.y) > self.p.loop_closure_max_distance_m {
-            return;
-        }
-        self.samplers[s] += self.p.loop_closure_sampling_ratio;
-        if self.samplers[s] < 1.0 {
-            return;
-        }
-        self.samplers[s] -= 1.0;
         let Some(pre) = &self.precomputed[s] else { return };
         let sm = &self.submaps.all()[s];
         let initial = sm.local_pose.compose(gs.inverse().compose(gn));
@@ -326,7 +370,7 @@ impl Slam {
             depth: self.p.branch_and_bound_depth,
         };
         self.report.loop_searches += 1;
-        let Some(found) = match_branch_and_bound(pre, &node.points, initial, &search) else {
+        let Some(found) = match_branch_and_bound(pre, &node.search_points, initial, &search) else {
             self.report.loop_rejected += 1;
             return;
         };

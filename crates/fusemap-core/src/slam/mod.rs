@@ -9,6 +9,8 @@
 //! | branch-and-bound loop-closure search | `global_match.rs` |
 //! | sparse pose-graph optimisation | `pose_graph.rs` |
 //! | the loop over scans | `mapper.rs` |
+//! | the corrected pose track | `corrected_track.rs` |
+mod corrected_track;
 pub mod global_match;
 pub mod grid;
 pub mod interpolation;
@@ -21,6 +23,7 @@ pub mod submap;
 #[cfg(test)]
 mod test_world;
 
+pub use corrected_track::CorrectedTrack;
 pub use local_match::LocalMatchParams;
 pub use mapper::{ScanInput, ScanOutcome, Slam, SlamResult};
 pub use params::SlamParams;

@@ -39,8 +39,17 @@ pub struct SlamParams {
     pub odometry_floor_rad: f64,
     /// Search for loop closures at all.
     pub loop_closure: bool,
-    /// Share of (node, finished submap) pairs searched for a loop closure.
+    /// Share of nodes searched for a loop closure against the finished submaps near them.
     pub loop_closure_sampling_ratio: f64,
+    /// A sampled node is searched against at most this many nearest finished submaps.
+    pub loop_closure_submaps_per_node: usize,
+    /// A submap just finished is searched by at most this many earlier nodes near it.
+    pub loop_closure_nodes_per_submap: usize,
+    /// Returns farther than this are left out of the branch-and-bound search (its angular
+    /// step, hence its cost, follows the farthest point), metres.
+    pub loop_closure_max_range_m: f64,
+    /// … and at most this many of them (evenly spread).
+    pub loop_closure_max_points: usize,
     /// Only submaps whose centre is within this distance of the node are searched, metres.
     pub loop_closure_max_distance_m: f64,
     /// Half-width of the loop-closure search in x and y, metres.
@@ -80,9 +89,13 @@ impl Default for SlamParams {
             odometry_floor_rad: 1f64.to_radians(),
             loop_closure: true,
             loop_closure_sampling_ratio: 0.3,
+            loop_closure_submaps_per_node: 6,
+            loop_closure_nodes_per_submap: 20,
+            loop_closure_max_range_m: 12.0,
+            loop_closure_max_points: 120,
             loop_closure_max_distance_m: 15.0,
-            loop_closure_linear_window_m: 7.0,
-            loop_closure_angular_window_rad: 30f64.to_radians(),
+            loop_closure_linear_window_m: 4.0,
+            loop_closure_angular_window_rad: 20f64.to_radians(),
             loop_closure_min_score: 0.55,
             loop_closure_huber: 1.0,
             loop_closure_sigma_m: 0.05,

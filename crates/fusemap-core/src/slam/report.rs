@@ -14,6 +14,8 @@ pub struct SlamReport {
     pub degenerate: u64,
     /// Scans not matched (too few returns, or no submap yet): predicted pose kept.
     pub predicted: u64,
+    /// Scans inside a gap of the pose track (matched from the previous scan's pose).
+    pub without_track: u64,
     /// Scans refused (non-finite track pose or sensor origin).
     pub refused: u64,
     /// Pose-graph nodes (scans that moved far enough).
