@@ -159,9 +159,12 @@ pub fn write(
     Ok(())
 }
 
+/// The trajectory of scan nodes and the loop closures (submap origin, node).
+type GraphPicture = (Vec<Point2>, Vec<(Point2, Point2)>);
+
 /// The scan nodes and the loop closures (submap origin, node) of the pose graph in a run
 /// report's `slam` section.
-fn pose_graph_of(log: &serde_json::Value) -> Option<(Vec<Point2>, Vec<(Point2, Point2)>)> {
+fn pose_graph_of(log: &serde_json::Value) -> Option<GraphPicture> {
     let slam = log.get("slam")?;
     let nodes: Vec<(bool, Point2)> = slam
         .get("nodes")?

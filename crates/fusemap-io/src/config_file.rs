@@ -296,6 +296,7 @@ mod tests {
         let c = load_config(&p).unwrap();
         let d = Config::default();
         assert_eq!((c.map, &c.log, &c.estimator), (d.map, &d.log, &d.estimator));
+        assert_eq!(format!("{:?}", c.slam.validate()), format!("{:?}", d.slam.validate()));
         // Its one sensor table is the default lidar, written out.
         assert_eq!(c.sensor.len(), 1);
         let (plan, default) = (c.validate().unwrap(), d.validate().unwrap());

@@ -14,7 +14,6 @@
 use crate::extrinsics::frame_tree;
 use crate::merge::{OrderedMerge, Pushed};
 use crate::recording::{for_each_range_message, Inventory, RangeMessage};
-use fusemap_io::log::ScanMessage;
 use crate::run::{lidar_setup, sync_mode, Progress};
 use crate::sensors::Bound;
 use crate::track::{ChosenTrack, TfTrack, Track, TrackCounts};
@@ -24,6 +23,7 @@ use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::slam::pose_graph::EdgeKind;
 use fusemap_core::slam::{CorrectedTrack, ScanInput, Slam, SlamReport, SlamResult};
 use fusemap_core::time::{PoseBuffer, Stamp};
+use fusemap_io::log::ScanMessage;
 use serde::Serialize;
 use std::time::Instant;
 

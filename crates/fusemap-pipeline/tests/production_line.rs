@@ -18,7 +18,7 @@ use fusemap_core::metrics::TolerantScore;
 use fusemap_core::sim::production::{simulate, Scenario, SimRecording};
 use fusemap_core::time::{InFrame, PoseBuffer, PoseTrack, Stamp, SyncMode};
 use fusemap_pipeline::recording::Inventory;
-use fusemap_pipeline::run::{prepare, topics_by_kind};
+use fusemap_pipeline::run::{prepare, prepare_track, topics_by_kind};
 use fusemap_pipeline::track::ChosenTrack;
 use fusemap_pipeline::{estimation, map_with_track, sensors};
 use std::collections::HashSet;
@@ -179,12 +179,17 @@ fn occupied(run: &fusemap_pipeline::MapRun) -> (HashSet<CellIndex>, HashSet<Cell
 }
 
 #[test]
-fn the_fused_map_scores_far_above_raw_odometry() {
+fn the_fused_map_scores_far_above_raw_odometry_and_slam_comes_within_003_of_true_poses() {
     let f = fixture();
-    let (bound, fused, track_s) = prepare(&f.plan, &f.inv).unwrap();
-    assert!(fused.name.starts_with("estimator"), "{}", fused.name);
     let mut quiet = |_: fusemap_pipeline::Progress| {};
+    // The estimator's track alone (odometry + IMU + RTK), then corrected by SLAM (scan
+    // matching and loop closure over it), as `map` does by default on this log.
+    let (bound, fused, track_s) = prepare_track(&f.plan, &f.inv).unwrap();
+    assert!(fused.name.starts_with("estimator"), "{}", fused.name);
     let fused_map = map_with_track(&f.plan, &f.inv, &bound, fused, track_s, None, &mut quiet).unwrap();
+    let (bound, slam, track_s) = prepare(&f.plan, &f.inv).unwrap();
+    assert!(slam.name.starts_with("SLAM") && slam.name.contains("estimator"), "{}", slam.name);
+    let slam_map = map_with_track(&f.plan, &f.inv, &bound, slam, track_s, None, &mut quiet).unwrap();
     let raw = ChosenTrack::given("raw odometry", Box::new(raw_odometry(f)));
     let raw_map = map_with_track(&f.plan, &f.inv, &bound, raw, 0.0, None, &mut quiet).unwrap();
     let truth = ChosenTrack::given("true poses", Box::new(truth_track(f)));
@@ -197,14 +202,15 @@ fn the_fused_map_scores_far_above_raw_odometry() {
     let (true_occ, true_known) = occupied(&true_map);
     let truth: HashSet<CellIndex> = t.occupied_cells().filter(|c| true_known.contains(c)).collect();
     let score = |m: &fusemap_pipeline::MapRun| TolerantScore::new(&occupied(m).0, &truth, 1);
-    let (r, u, p) = (score(&raw_map), score(&fused_map), TolerantScore::new(&true_occ, &truth, 1));
-    for (name, s) in [("raw odometry", r), ("fused", u), ("true poses", p)] {
+    let (r, u, s, p) = (score(&raw_map), score(&fused_map), score(&slam_map), TolerantScore::new(&true_occ, &truth, 1));
+    for (name, s) in [("raw odometry", r), ("estimator", u), ("SLAM", s), ("true poses", p)] {
         println!(
             "F1 {name:>12}: {:.3} (precision {:.3}, recall {:.3}, {} occupied cells, {} true)",
             s.f1, s.precision, s.recall, s.predicted, s.truth
         );
     }
     assert!(u.f1 >= r.f1 + 0.25, "fused F1 {:.3} vs raw odometry {:.3}", u.f1, r.f1);
+    assert!(s.f1 >= p.f1 - 0.03, "SLAM F1 {:.3} vs true poses {:.3}", s.f1, p.f1);
     // The trajectory written is the smoothed track.
     assert!(fused_map.trajectory.len() > 1000);
 }

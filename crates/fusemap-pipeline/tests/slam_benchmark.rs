@@ -69,10 +69,25 @@ fn score(log: &str, relations: &str) -> Option<Scored> {
     };
     let (_, raw, _) = prepare(&odo_plan, &inv).unwrap();
     let mut odometry: Vec<_> = match &raw.track {
-        Track::Timed(t) => stamps.iter().filter_map(|s| t.pose_at(*s, SyncMode::Interpolate).ok().map(|p| (*s, p))).collect(),
+        Track::Timed(t) => {
+            stamps.iter().filter_map(|s| t.pose_at(*s, SyncMode::Interpolate).ok().map(|p| (*s, p))).collect()
+        }
         Track::ScanLine => Vec::new(),
     };
     odometry.sort_by_key(|s| s.0);
+    if let Ok(dir) = std::env::var("FUSEMAP_SLAM_DUMP") {
+        let name = log.file_name().unwrap().to_string_lossy().to_string();
+        let lines: String =
+            slam.scan_poses.iter().map(|(t, p)| format!("{} {} {} {}\n", t.0, p.x, p.y, p.theta)).collect();
+        std::fs::write(format!("{dir}/{name}.slam.txt"), lines).unwrap();
+        let errs = fusemap_core::metrics::relation_errors(&relations, &slam.scan_poses, TOLERANCE_NS);
+        let lines: String = relations
+            .iter()
+            .zip(errs)
+            .filter_map(|(r, e)| e.map(|e| format!("{} {} {} {}\n", r.t1.0, r.t2.0, e.x.hypot(e.y), e.theta)))
+            .collect();
+        std::fs::write(format!("{dir}/{name}.errors.txt"), lines).unwrap();
+    }
     Some(Scored {
         slam: score_relations(&relations, &slam.scan_poses, TOLERANCE_NS),
         track: score_relations(&relations, &tracked, TOLERANCE_NS),
@@ -104,7 +119,13 @@ fn intel() {
 
 #[test]
 fn freiburg_079() {
-    check("Freiburg 079", "rosbag1-slam-benchmark/fr079.orig.bag", "slam-benchmark-relations/fr079.relations", 0.0452, 0.056);
+    check(
+        "Freiburg 079",
+        "rosbag1-slam-benchmark/fr079.orig.bag",
+        "slam-benchmark-relations/fr079.relations",
+        0.0452,
+        0.056,
+    );
 }
 
 #[test]

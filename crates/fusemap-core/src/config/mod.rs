@@ -8,13 +8,13 @@
 
 mod camera;
 mod fusion;
-mod slam;
 mod sensor;
+mod slam;
 
 pub use camera::{default_camera, ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
 pub use fusion::FusionConfig;
-pub use slam::{SlamConfig, SlamMode};
 pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
+pub use slam::{SlamConfig, SlamMode};
 
 use crate::estimator::EstimatorConfig;
 use crate::geometry::Point2;
@@ -256,8 +256,6 @@ pub struct Plan {
     pub slam_mode: SlamMode,
     /// SLAM's parameters (from `[slam]`).
     pub slam: crate::slam::SlamParams,
-    /// σ (metres, radians) of the optimised scan poses as pose-estimator inputs.
-    pub slam_pose_sigma: (f64, f64),
 }
 
 impl Config {
@@ -387,7 +385,6 @@ impl Config {
             dynamic,
             slam_mode: self.slam.mode,
             slam,
-            slam_pose_sigma: (self.slam.pose_sigma_m, self.slam.pose_sigma_deg.to_radians()),
         })
     }
 }

@@ -54,14 +54,17 @@ pub struct SlamConfig {
     pub translation_delta_cost: f64,
     /// Correlative motion penalty per radian.
     pub rotation_delta_cost: f64,
-    /// Refinement pull towards the correlative result, per metre.
+    /// Refinement pull of the translation towards the prediction, per metre.
     pub translation_weight: f64,
-    /// Refinement pull towards the correlative result, per radian.
+    /// Refinement pull of the heading towards the correlative result, per radian.
     pub rotation_weight: f64,
     /// σ of one point's residual (probability units) scaling the match information.
     pub match_residual_sigma: f64,
     /// Smallest/largest translational information below which a match is degenerate.
     pub degeneracy_ratio: f64,
+    /// The constant-velocity prediction replaces the track's when its match's mean
+    /// probability is higher by this much (odometry that stalls, then jumps).
+    pub moving_prediction_margin: f64,
     /// Odometry edge σ per metre travelled.
     pub odometry_translation_per_m: f64,
     /// Odometry edge σ floor, metres.
@@ -100,10 +103,6 @@ pub struct SlamConfig {
     pub optimize_every_n_nodes: usize,
     /// Levels of the branch-and-bound precomputation (2^(depth−1) cells at the top).
     pub branch_and_bound_depth: usize,
-    /// σ of the optimised scan poses given to the pose estimator, metres.
-    pub pose_sigma_m: f64,
-    /// σ of the optimised scan poses given to the pose estimator, degrees.
-    pub pose_sigma_deg: f64,
 }
 
 impl Default for SlamConfig {
@@ -128,6 +127,7 @@ impl Default for SlamConfig {
             rotation_weight: p.local.rotation_weight,
             match_residual_sigma: p.local.residual_sigma,
             degeneracy_ratio: p.local.degeneracy_ratio,
+            moving_prediction_margin: p.moving_prediction_margin,
             odometry_translation_per_m: p.odometry_translation_per_m,
             odometry_floor_m: p.odometry_floor_m,
             odometry_rotation_per_rad: p.odometry_rotation_per_rad,
@@ -147,8 +147,6 @@ impl Default for SlamConfig {
             loop_closure_sigma_deg: p.loop_closure_sigma_rad.to_degrees(),
             optimize_every_n_nodes: p.optimize_every_n_nodes,
             branch_and_bound_depth: p.branch_and_bound_depth,
-            pose_sigma_m: 0.01,
-            pose_sigma_deg: 0.25,
         }
     }
 }
@@ -188,21 +186,24 @@ impl SlamConfig {
         if !(0.005..=1.0).contains(&res) {
             return Err(err("slam.resolution_m", format!("must be within 0.005..=1 m, got {res}")));
         }
-        for (k, v) in [("scans_per_submap", self.scans_per_submap), ("optimize_every_n_nodes", self.optimize_every_n_nodes)] {
+        for (k, v) in
+            [("scans_per_submap", self.scans_per_submap), ("optimize_every_n_nodes", self.optimize_every_n_nodes)]
+        {
             if v == 0 {
                 return Err(err(format!("slam.{k}"), "must be at least 1"));
             }
         }
         if !(1..=12).contains(&self.branch_and_bound_depth) {
-            return Err(err("slam.branch_and_bound_depth", format!("must be within 1..=12, got {}", self.branch_and_bound_depth)));
+            return Err(err(
+                "slam.branch_and_bound_depth",
+                format!("must be within 1..=12, got {}", self.branch_and_bound_depth),
+            ));
         }
         let angular = non_negative("search_angular_window_deg", self.search_angular_window_deg)?;
         let lc_angular = non_negative("loop_closure_angular_window_deg", self.loop_closure_angular_window_deg)?;
         if angular > 180.0 || lc_angular > 180.0 {
             return Err(err("slam", "angular search windows must be at most 180°"));
         }
-        positive("pose_sigma_m", self.pose_sigma_m)?;
-        positive("pose_sigma_deg", self.pose_sigma_deg)?;
         Ok(SlamParams {
             resolution: res,
             scans_per_submap: self.scans_per_submap,
@@ -224,6 +225,7 @@ impl SlamConfig {
                 residual_sigma: positive("match_residual_sigma", self.match_residual_sigma)?,
                 degeneracy_ratio: non_negative("degeneracy_ratio", self.degeneracy_ratio)?,
             },
+            moving_prediction_margin: non_negative("moving_prediction_margin", self.moving_prediction_margin)?,
             odometry_translation_per_m: non_negative("odometry_translation_per_m", self.odometry_translation_per_m)?,
             odometry_floor_m: positive("odometry_floor_m", self.odometry_floor_m)?,
             odometry_rotation_per_rad: non_negative("odometry_rotation_per_rad", self.odometry_rotation_per_rad)?,
@@ -235,8 +237,11 @@ impl SlamConfig {
             loop_closure_max_range_m: positive("loop_closure_max_range_m", self.loop_closure_max_range_m)?,
             loop_closure_max_points: self.loop_closure_max_points,
             loop_closure_max_distance_m: non_negative("loop_closure_max_distance_m", self.loop_closure_max_distance_m)?,
-            loop_closure_linear_window_m: non_negative("loop_closure_linear_window_m", self.loop_closure_linear_window_m)?
-                .min(100.0),
+            loop_closure_linear_window_m: non_negative(
+                "loop_closure_linear_window_m",
+                self.loop_closure_linear_window_m,
+            )?
+            .min(100.0),
             loop_closure_angular_window_rad: lc_angular.to_radians(),
             loop_closure_min_score: score as f32,
             loop_closure_huber: positive("loop_closure_huber", self.loop_closure_huber)?,

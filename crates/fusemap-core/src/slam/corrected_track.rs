@@ -91,10 +91,8 @@ mod tests {
         }
         // SLAM says the robot was rotated by 0.1 rad and shifted: a constant correction.
         let c = Pose2::new(1.0, 2.0, 0.1);
-        let slam: Vec<(Stamp, Pose2)> = [0, 400, 1000]
-            .iter()
-            .map(|&t| (Stamp(t), c.compose(Pose2::new(t as f64 * 1e-3, 0.0, 0.0))))
-            .collect();
+        let slam: Vec<(Stamp, Pose2)> =
+            [0, 400, 1000].iter().map(|&t| (Stamp(t), c.compose(Pose2::new(t as f64 * 1e-3, 0.0, 0.0)))).collect();
         let track = CorrectedTrack::new(Box::new(odo), &slam);
         for &(t, p) in &slam {
             let q = track.pose_at(t, SyncMode::Interpolate).unwrap();

@@ -7,9 +7,9 @@
 //!    probability of the scan's points in the submap, times a Gaussian-shaped penalty on
 //!    the distance from the prediction (Olson's motion prior). A slip of a few centimetres
 //!    or a few degrees in the odometry cannot pull the match into a wrong local minimum.
-//! 2. **Refinement**: Gauss–Newton on `Σ (1 − M(T pᵢ))² · w_map²/N` plus quadratic pulls to
-//!    the correlative result (Hess et al. 2016, §IV, with `M` interpolated bicubically), to
-//!    sub-cell precision.
+//! 2. **Refinement**: Gauss–Newton on `Σ (1 − M(T pᵢ))² · w_map²/N` plus quadratic pulls of
+//!    the translation to the prediction and of the heading to the correlative result
+//!    (Hess et al. 2016, §IV, with `M` interpolated bicubically), to sub-cell precision.
 //! 3. **Information**: the curvature of the map cost at the optimum (see
 //!    [`match_information`]) is the information of the match (Olson 2009 §IV-C derives the covariance from the score
 //!    surface; its curvature is the Laplace approximation of the same). Along a featureless
@@ -126,7 +126,8 @@ pub fn correlative_search(
                 let score = sum * inv_n * penalty as f32;
                 if score > best_score {
                     best_score = score;
-                    best = Pose2::new(predicted.x + dx as f64 * r, predicted.y + dy as f64 * r, predicted.theta + dtheta);
+                    best =
+                        Pose2::new(predicted.x + dx as f64 * r, predicted.y + dy as f64 * r, predicted.theta + dtheta);
                 }
             }
         }
@@ -302,7 +303,12 @@ fn eigen_symmetric3(mut a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
 /// the optimum the points sit on the crests of the walls, where the gradient vanishes and
 /// the curvature lives in the second-derivative term it drops. Negative curvature (noise
 /// on a flat surface) is clipped to zero, so a flat direction carries no information.
-pub fn match_information(grid: &ProbabilityGrid, points: &[Point2], pose: Pose2, p: &LocalMatchParams) -> ([[f64; 3]; 3], bool) {
+pub fn match_information(
+    grid: &ProbabilityGrid,
+    points: &[Point2],
+    pose: Pose2,
+    p: &LocalMatchParams,
+) -> ([[f64; 3]; 3], bool) {
     if points.len() < 3 {
         return ([[0.0; 3]; 3], true);
     }
@@ -351,7 +357,12 @@ pub fn match_information(grid: &ProbabilityGrid, points: &[Point2], pose: Pose2,
 /// Matches `points` (scan frame) against `grid` around `predicted`.
 pub fn match_scan(grid: &ProbabilityGrid, points: &[Point2], predicted: Pose2, p: &LocalMatchParams) -> LocalMatch {
     let (coarse, search_score) = correlative_search(grid, points, predicted, p);
-    let pose = refine(grid, points, coarse, coarse, p);
+    // The translation is pulled to the prediction (the motion prior) and the heading to
+    // the search's best, as Cartographer's Ceres matcher does: along a featureless wall the
+    // search's best cell is noise and the prior carries the pose; a heading error of the
+    // prediction beyond the refinement's reach is the search's to find.
+    let target = Pose2::new(predicted.x, predicted.y, coarse.theta);
+    let pose = refine(grid, points, coarse, target, p);
     let (information, degenerate) = match_information(grid, points, pose, p);
     LocalMatch { pose, score: mean_probability(grid, points, pose), search_score, information, degenerate }
 }

@@ -26,7 +26,10 @@ fn a_perturbed_prediction_is_corrected_to_the_true_pose() {
         let m = match_scan(&g, &pts, predicted, &params);
         let e = (m.pose.x - truth.x).hypot(m.pose.y - truth.y);
         let eth = normalize_angle(m.pose.theta - truth.theta).abs();
-        assert!(e < 0.015 && eth < 0.3f64.to_radians(), "from ({dx},{dy},{dth}): error {e} m, {eth} rad");
+        // Within 0.4 cell: the optimum of a 5 cm grid sits about a centimetre off the
+        // truth, and the translation's pull to the prediction (the motion prior) adds a
+        // few millimetres from 10 cm off.
+        assert!(e < 0.02 && eth < 0.3f64.to_radians(), "from ({dx},{dy},{dth}): error {e} m, {eth} rad");
         assert!(!m.degenerate);
         assert!(m.score > 0.6, "score {}", m.score);
     }
@@ -59,7 +62,12 @@ fn a_corridor_match_is_degenerate_along_the_corridor() {
     assert!(m.information[1][1] > 20.0 * m.information[0][0], "{:?}", m.information);
     let room = World::room();
     let g = grid_of(&room, &[Pose2::new(6.0, 4.0, 0.0)]);
-    let m = match_scan(&g, &room.scan(Pose2::new(6.0, 4.0, 0.0), 180, 30.0), Pose2::new(6.0, 4.0, 0.0), &LocalMatchParams::default());
+    let m = match_scan(
+        &g,
+        &room.scan(Pose2::new(6.0, 4.0, 0.0), 180, 30.0),
+        Pose2::new(6.0, 4.0, 0.0),
+        &LocalMatchParams::default(),
+    );
     assert!(!m.degenerate);
 }
 
@@ -70,4 +78,3 @@ fn no_points_no_panic() {
     assert!(m.pose.is_finite());
     assert!(m.degenerate);
 }
-

@@ -85,6 +85,8 @@ pub struct Slam {
     scans: Vec<ScanRecord>,
     /// The last scan's local pose, and its track pose if it had one.
     last: Option<(Pose2, Option<Pose2>)>,
+    /// The last two scans' stamps and local poses (the constant-velocity prediction).
+    recent: [Option<(Stamp, Pose2)>; 2],
     global_from_local: Pose2,
     since_optimisation: usize,
     closures_since_optimisation: usize,
@@ -124,6 +126,7 @@ impl Slam {
             nodes: Vec::new(),
             scans: Vec::new(),
             last: None,
+            recent: [None, None],
             global_from_local: Pose2::IDENTITY,
             since_optimisation: 0,
             closures_since_optimisation: 0,
@@ -159,8 +162,20 @@ impl Slam {
         if scan.track.is_none() {
             self.report.without_track += 1;
         }
+        // The constant-velocity prediction from the last two matched poses: a second
+        // hypothesis for when the track's motion is wrong (odometry written on scan lines
+        // that stalls for a few scans and then catches up, a wheel that slips).
+        let moving = match self.recent {
+            [Some((t1, p1)), Some((t2, p2))] if t2 > t1 && scan.stamp > t2 => {
+                let k = (scan.stamp.0 - t2.0) as f64 / (t2.0 - t1.0) as f64;
+                let d = p1.inverse().compose(p2);
+                (k <= 3.0).then(|| p2.compose(Pose2::new(d.x * k, d.y * k, d.theta * k)))
+            }
+            _ => None,
+        };
         let t0 = Instant::now();
-        let (local, outcome, information) = self.match_local(&hits, predicted);
+        let (local, outcome, information) = self.match_local(&hits, predicted, moving);
+        self.recent = [self.recent[1], Some((scan.stamp, local))];
         self.report.matching_s += t0.elapsed().as_secs_f64();
         match outcome {
             ScanOutcome::Matched => self.report.matched += 1,
@@ -187,17 +202,38 @@ impl Slam {
         outcome
     }
 
-    fn match_local(&self, hits: &[Point2], predicted: Pose2) -> (Pose2, ScanOutcome, Option<[[f64; 3]; 3]>) {
+    fn match_local(
+        &mut self,
+        hits: &[Point2],
+        predicted: Pose2,
+        moving: Option<Pose2>,
+    ) -> (Pose2, ScanOutcome, Option<[[f64; 3]; 3]>) {
         let Some((_, submap)) = self.submaps.matching() else {
             return (predicted, ScanOutcome::Predicted, None);
         };
         if hits.len() < self.p.min_points {
             return (predicted, ScanOutcome::Predicted, None);
         }
-        let m = super::local_match::match_scan(&submap.grid, hits, predicted, &self.p.local);
+        let mut m = super::local_match::match_scan(&submap.grid, hits, predicted, &self.p.local);
+        let mut predicted = predicted;
+        // Outside half the search window of the track's prediction, the constant-velocity
+        // prediction is searched too, and kept only if its match is clearly better (mean
+        // probability higher by `moving_prediction_margin`): in a corridor both fit equally,
+        // and preferring the extrapolation there would feed its own slide back into the
+        // next prediction.
+        if let Some(alt) = moving {
+            let d = predicted.inverse().compose(alt);
+            if d.x.hypot(d.y) > 0.5 * self.p.local.linear_window_m
+                || d.theta.abs() > 0.5 * self.p.local.angular_window_rad
+            {
+                let m2 = super::local_match::match_scan(&submap.grid, hits, alt, &self.p.local);
+                if f64::from(m2.score) > f64::from(m.score) + self.p.moving_prediction_margin {
+                    self.report.moving_prediction_used += 1;
+                    (m, predicted) = (m2, alt);
+                }
+            }
+        }
         if m.degenerate {
-            // Keep the prediction along the weak direction: refine from the prediction
-            // with a pull towards it ten times stronger than usual.
             let strong = LocalMatchParams {
                 translation_weight: self.p.local.translation_weight * 10.0,
                 rotation_weight: self.p.local.rotation_weight,
@@ -217,12 +253,12 @@ impl Slam {
         let floor = information_diag(0.5, 10f64.to_radians());
         let cap = information_diag(0.005, 0.05f64.to_radians());
         let mut out = info.unwrap_or([[0.0; 3]; 3]);
-        for i in 0..3 {
-            out[i][i] += floor[i][i];
-            for j in 0..i {
-                let v = 0.5 * (out[i][j] + out[j][i]);
-                (out[i][j], out[j][i]) = (v, v);
-            }
+        for (i, f) in floor.iter().enumerate() {
+            out[i][i] += f[i];
+        }
+        for (i, j) in [(1, 0), (2, 0), (2, 1)] {
+            let v = 0.5 * (out[i][j] + out[j][i]);
+            (out[i][j], out[j][i]) = (v, v);
         }
         let over = (0..3).map(|i| out[i][i] / cap[i][i]).fold(1.0, f64::max);
         out.iter_mut().flatten().for_each(|v| *v /= over);
@@ -272,6 +308,14 @@ impl Slam {
             let d = before.inverse().compose(now);
             let st = self.p.odometry_floor_m + self.p.odometry_translation_per_m * d.x.hypot(d.y);
             let sr = self.p.odometry_floor_rad + self.p.odometry_rotation_per_rad * d.theta.abs();
+            // Odometry that disagrees with the matched motion by more than 5 σ (a jump, a
+            // stall, a slip) is left out of the graph and counted, not averaged in.
+            let m = prev.local.inverse().compose(local);
+            let consistent =
+                (d.x - m.x).hypot(d.y - m.y) <= 5.0 * st && normalize_angle(d.theta - m.theta).abs() <= 5.0 * sr;
+            if !consistent {
+                self.report.odometry_edges_rejected += 1;
+            }
             let e = Edge {
                 from: prev.graph,
                 to: g,
@@ -280,7 +324,7 @@ impl Slam {
                 loss: Loss::Trivial,
                 kind: EdgeKind::Odometry,
             };
-            if d.is_finite() {
+            if d.is_finite() && consistent {
                 self.graph.add_edge(e).expect("valid odometry edge");
             }
         }
@@ -304,7 +348,8 @@ impl Slam {
         if self.p.loop_closure {
             let t0 = Instant::now();
             if let Some(f) = finished {
-                self.precomputed[f] = Some(PrecomputedGrids::new(&self.submaps.all()[f].grid, self.p.branch_and_bound_depth));
+                self.precomputed[f] =
+                    Some(PrecomputedGrids::new(&self.submaps.all()[f].grid, self.p.branch_and_bound_depth));
                 self.search_nodes_against(f);
             }
             self.search_submaps_for(self.nodes.len() - 1);

@@ -27,6 +27,11 @@ pub struct SlamParams {
     pub node_angle_rad: f64,
     /// … or this much time has passed, seconds.
     pub node_time_s: f64,
+    /// The constant-velocity prediction (from the last two matched poses) replaces the
+    /// track's when its match's mean probability is higher by this much: odometry that
+    /// stalls for a few scans and then catches up is followed, a corridor (where both fit
+    /// equally) is not.
+    pub moving_prediction_margin: f64,
     /// The local matcher.
     pub local: LocalMatchParams,
     /// Odometry edge σ: translational, per metre travelled (plus `odometry_floor_m`).
@@ -82,6 +87,7 @@ impl Default for SlamParams {
             node_distance_m: 0.1,
             node_angle_rad: 2f64.to_radians(),
             node_time_s: 5.0,
+            moving_prediction_margin: 0.1,
             local: LocalMatchParams::default(),
             odometry_translation_per_m: 0.1,
             odometry_floor_m: 0.02,

@@ -18,6 +18,11 @@ pub struct SlamReport {
     pub without_track: u64,
     /// Scans refused (non-finite track pose or sensor origin).
     pub refused: u64,
+    /// Scans matched from the constant-velocity prediction because it matched better than
+    /// the track's (stalled or jumping odometry).
+    pub moving_prediction_used: u64,
+    /// Odometry edges left out: the odometry disagreed with the matched motion by > 5 σ.
+    pub odometry_edges_rejected: u64,
     /// Pose-graph nodes (scans that moved far enough).
     pub nodes: u64,
     /// Submaps built.

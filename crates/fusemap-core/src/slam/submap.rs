@@ -61,7 +61,13 @@ impl Submaps {
     /// Inserts a scan (points in the local frame) into the active submaps, starting a new
     /// submap when needed. Returns the indices of the submaps it went into, and the index
     /// of a submap finished by this insertion.
-    pub fn insert(&mut self, pose: Pose2, origin: Point2, hits: &[Point2], misses: &[Point2]) -> (Vec<usize>, Option<usize>) {
+    pub fn insert(
+        &mut self,
+        pose: Pose2,
+        origin: Point2,
+        hits: &[Point2],
+        misses: &[Point2],
+    ) -> (Vec<usize>, Option<usize>) {
         if self.active.is_empty() || self.all[*self.active.last().unwrap()].scans >= self.scans_per_submap {
             self.all.push(Submap {
                 local_pose: Pose2::new(pose.x, pose.y, 0.0),
@@ -78,7 +84,9 @@ impl Submaps {
         }
         let into = self.active.clone();
         let mut finished = None;
-        if self.active.len() > 2 || (self.active.len() == 2 && self.all[self.active[0]].scans >= 2 * self.scans_per_submap) {
+        if self.active.len() > 2
+            || (self.active.len() == 2 && self.all[self.active[0]].scans >= 2 * self.scans_per_submap)
+        {
             let i = self.active.remove(0);
             self.all[i].finished = true;
             finished = Some(i);

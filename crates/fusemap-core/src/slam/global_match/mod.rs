@@ -201,7 +201,7 @@ impl Search<'_> {
             }
         }
         let children = &mut children[..n];
-        children.sort_unstable_by(|a, b| b.bound.cmp(&a.bound));
+        children.sort_unstable_by_key(|c| std::cmp::Reverse(c.bound));
         for &child in children.iter() {
             if i64::from(child.bound) <= self.floor {
                 break;
@@ -228,7 +228,7 @@ fn branch_and_bound(grids: &PrecomputedGrids, problem: &Problem, levels: usize, 
             }
         }
     }
-    roots.sort_unstable_by(|a, b| b.bound.cmp(&a.bound));
+    roots.sort_unstable_by_key(|c| std::cmp::Reverse(c.bound));
     for &c in &roots {
         if i64::from(c.bound) <= state.floor {
             break;
