@@ -22,7 +22,7 @@ use fusemap_core::config::{Plan, PoseSource, SlamMode};
 use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::slam::pose_graph::EdgeKind;
 use fusemap_core::slam::{CorrectedTrack, ScanInput, Slam, SlamReport, SlamResult};
-use fusemap_core::time::{PoseBuffer, Stamp};
+use fusemap_core::time::{PoseBuffer, Stamp, SyncMode};
 use fusemap_io::log::ScanMessage;
 use serde::Serialize;
 use std::time::Instant;
@@ -95,8 +95,13 @@ pub fn applies(plan: &Plan, inv: &Inventory, bound: &Bound, chosen: &ChosenTrack
         PoseSource::Odometry => (true, "the poses are raw odometry".into()),
         PoseSource::Estimator => (true, "the poses come from the estimator (odometry, IMU, GNSS)".into()),
         PoseSource::ScanLine => {
+            // A raw CARMEN log writes its odometry as the pose of every scan line; so do
+            // corrected logs (the corrected pose in both fields), but those come out of
+            // GMapping with a `NEFF` line (effective particles) beside each scan.
             let t = &inv.scans[&bound.lidars[0].topic];
-            if t.with_pose > 0 && t.pose_is_odometry == t.with_pose {
+            if inv.stats.skipped_by_type.contains_key("NEFF") {
+                (false, "the poses on the scan lines are corrected (the log has GMapping's NEFF lines)".into())
+            } else if t.with_pose > 0 && t.pose_is_odometry == t.with_pose {
                 (true, "the poses on the scan lines are their raw odometry".into())
             } else {
                 (false, "the poses on the scan lines are corrected".into())
@@ -163,12 +168,31 @@ pub fn run(
         let hi = params.max_range.min(scan.range_max as f64);
         let (a0, inc) = (scan.scan.angle_min as f32 as f64, scan.scan.angle_increment as f32 as f64);
         let origin = mount.origin_in_base();
+        // De-skew as the mapping pass does: each beam placed with the track's motion from
+        // the scan's stamp to the beam's own time, so the matcher sees the scan as it would
+        // be from one pose (a scan swept while turning is otherwise bent).
+        let n = scan.scan.ranges.len();
+        let ti = scan.time_increment as f64;
+        let motion_at = |i: usize| -> Option<Pose2> {
+            let Track::Timed(track) = &chosen.track else { return None };
+            if !(cfg.deskew && mode == SyncMode::Interpolate && ti > 0.0 && n > 1) {
+                return None;
+            }
+            let p0 = track.pose_at(t, SyncMode::Interpolate).ok()?;
+            let tb = Stamp(t.0.saturating_add((ti * i as f64 * 1e9) as i64));
+            Some(p0.inverse().compose(track.pose_at(tb, SyncMode::Interpolate).ok()?))
+        };
+        let deskew = motion_at(n.saturating_sub(1)).is_some();
         hits.clear();
         hits.extend(scan.scan.ranges.iter().enumerate().filter_map(|(i, &r)| {
             let r = r as f64;
             (r.is_finite() && r >= lo && r < hi).then(|| {
                 let a = mount.beam_angle_in_base(a0 + i as f64 * inc);
-                Point2::new(origin.x + r * a.cos(), origin.y + r * a.sin())
+                let q = Point2::new(origin.x + r * a.cos(), origin.y + r * a.sin());
+                match deskew.then(|| motion_at(i)).flatten() {
+                    Some(m) => m.transform_point(q),
+                    None => q,
+                }
             })
         }));
         slam.add_scan(ScanInput { stamp: t, track: pose, origin, hits: &hits, misses: &[] });

@@ -52,7 +52,8 @@ fn a_simulated_bag_maps_with_the_estimator_and_a_third_party_copy_maps_the_same(
     assert!(o.status.success(), "{}", stderr(&o));
     let s = summary(&out);
     let l = &s["log"];
-    assert!(l["pose_source"].as_str().unwrap().starts_with("estimator ("), "{}", l["pose_source"]);
+    // The estimator's track, corrected by SLAM (on by default over the estimator).
+    assert!(l["pose_source"].as_str().unwrap().contains("over estimator ("), "{}", l["pose_source"]);
     assert_eq!(l["scans_read"], 1800);
     assert_eq!(l["estimator"]["gnss_input"][0]["datum_source"], "config");
     assert!(l["estimator"]["estimator"]["fixes"]["used"].as_u64().unwrap() > 600);

@@ -12,8 +12,9 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "snake_case")]
 pub enum SlamMode {
     /// On when the poses come from odometry, the estimator, TF under an `odom` frame or
-    /// the raw odometry of a CARMEN log; off when they are already corrected (corrected
-    /// CARMEN logs, TF from a `map` frame).
+    /// the raw odometry of a CARMEN log (pose = odometry on every scan line, no `NEFF`
+    /// lines); off when they are already corrected (corrected CARMEN logs, TF from a `map`
+    /// frame).
     #[default]
     Auto,
     /// Always (on a log with a lidar).

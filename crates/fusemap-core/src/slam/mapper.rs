@@ -481,3 +481,7 @@ impl Slam {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "mapper_tests.rs"]
+mod tests;

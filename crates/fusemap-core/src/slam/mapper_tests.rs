@@ -1,0 +1,200 @@
+use super::*;
+use crate::slam::test_world::World;
+
+/// A deterministic pseudo-random sequence in [-1, 1) (a 64-bit LCG), so the tests' noise
+/// is the same on every machine.
+struct Noise(u64);
+
+impl Noise {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
+/// True poses at 10 Hz: `loops` times around the room's free ring at 0.5 m/s, turning in
+/// place at 45°/s at the corners.
+fn ring_poses(loops: usize) -> Vec<Pose2> {
+    let corners = [(1.0, 1.0), (11.0, 1.0), (11.0, 7.2), (1.0, 7.2)];
+    let mut out = vec![Pose2::new(1.0, 1.0, 0.0)];
+    for _ in 0..loops {
+        for k in 0..4 {
+            let (x1, y1) = corners[(k + 1) % 4];
+            let last = *out.last().unwrap();
+            let heading = (y1 - last.y).atan2(x1 - last.x);
+            // Turn to the heading, 4.5° per scan …
+            let mut th = last.theta;
+            while normalize_angle(heading - th).abs() > 1e-9 {
+                th += normalize_angle(heading - th).clamp(-4.5f64.to_radians(), 4.5f64.to_radians());
+                out.push(Pose2::new(last.x, last.y, normalize_angle(th)));
+            }
+            // … then drive 5 cm per scan.
+            let d = (x1 - last.x).hypot(y1 - last.y);
+            let n = (d / 0.05).round() as usize;
+            for i in 1..=n {
+                let f = i as f64 / n as f64;
+                out.push(Pose2::new(last.x + f * (x1 - last.x), last.y + f * (y1 - last.y), heading));
+            }
+        }
+    }
+    out
+}
+
+/// Odometry of `truth`: each increment scaled by 1.03 and turned by 0.6° per metre (a
+/// wheel-radius difference), with a little noise.
+fn odometry(truth: &[Pose2], seed: u64) -> Vec<Pose2> {
+    let mut noise = Noise(seed);
+    let mut out = vec![truth[0]];
+    for w in truth.windows(2) {
+        let d = w[0].inverse().compose(w[1]);
+        let dist = d.x.hypot(d.y);
+        let step = Pose2::new(
+            d.x * 1.03 + 0.002 * noise.next(),
+            d.y * 1.03 + 0.002 * noise.next(),
+            d.theta * 1.02 + dist * 0.6f64.to_radians() + 0.002 * noise.next(),
+        );
+        out.push(out.last().unwrap().compose(step));
+    }
+    out
+}
+
+struct Run {
+    result: SlamResult,
+    truth: Vec<Pose2>,
+}
+
+/// Runs SLAM over `truth` with `track` as the pose track, scans of `beams` beams.
+fn run(truth: &[Pose2], track: &[Option<Pose2>], beams: usize) -> Run {
+    let world = World::room();
+    let mut noise = Noise(7);
+    let mut slam = Slam::new(SlamParams::default());
+    for (i, (pose, track)) in truth.iter().zip(track).enumerate() {
+        let hits: Vec<Point2> = world
+            .scan(*pose, beams, 30.0)
+            .into_iter()
+            .map(|q| {
+                // ±1 cm of range noise.
+                let r = q.x.hypot(q.y);
+                let k = (r + 0.01 * noise.next()) / r;
+                Point2::new(q.x * k, q.y * k)
+            })
+            .collect();
+        let stamp = Stamp(1_000_000_000 + i as i64 * 100_000_000);
+        slam.add_scan(ScanInput { stamp, track: *track, origin: Point2::new(0.0, 0.0), hits: &hits, misses: &[] });
+    }
+    Run { result: slam.finish(), truth: truth.to_vec() }
+}
+
+/// Mean and largest distance of the SLAM poses from the truth (the first pose is the
+/// track's, which is the truth's, so the frames agree).
+fn errors(r: &Run) -> (f64, f64) {
+    assert_eq!(r.result.trajectory.len(), r.truth.len(), "every scan has a pose");
+    let e: Vec<f64> =
+        r.result.trajectory.iter().zip(&r.truth).map(|((_, p), t)| (p.x - t.x).hypot(p.y - t.y)).collect();
+    (e.iter().sum::<f64>() / e.len() as f64, e.iter().cloned().fold(0.0, f64::max))
+}
+
+fn track_errors(track: &[Pose2], truth: &[Pose2]) -> f64 {
+    track.iter().zip(truth).map(|(p, t)| (p.x - t.x).hypot(p.y - t.y)).sum::<f64>() / truth.len() as f64
+}
+
+#[test]
+fn two_loops_with_drifting_odometry_are_closed_and_follow_the_truth() {
+    let truth = ring_poses(2);
+    let odo = odometry(&truth, 1);
+    let r = run(&truth, &odo.iter().map(|p| Some(*p)).collect::<Vec<_>>(), 360);
+    let (mean, max) = errors(&r);
+    let odo_mean = track_errors(&odo, &truth);
+    let rep = &r.result.report;
+    assert!(odo_mean > 0.3, "the odometry drifts: {odo_mean}");
+    assert!(mean < 0.03 && max < 0.1, "SLAM error mean {mean} m, max {max} m (odometry {odo_mean} m)");
+    assert!(rep.loop_accepted > 0, "{rep:?}");
+    assert_eq!(rep.matched + rep.degenerate + rep.predicted, truth.len() as u64);
+    assert!(rep.optimisation_failures.is_empty(), "{:?}", rep.optimisation_failures);
+}
+
+#[test]
+fn a_scan_with_too_few_returns_keeps_its_prediction_and_is_counted() {
+    let truth = ring_poses(1)[..300].to_vec();
+    let track: Vec<Option<Pose2>> = truth.iter().map(|p| Some(*p)).collect();
+    // Every scan but the first 100 has 8 beams: too few to match (min_points 20).
+    let world = World::room();
+    let mut slam = Slam::new(SlamParams::default());
+    for (i, (pose, t)) in truth.iter().zip(&track).enumerate() {
+        let hits = world.scan(*pose, if i < 100 { 360 } else { 8 }, 30.0);
+        let stamp = Stamp(i as i64 * 100_000_000);
+        let outcome =
+            slam.add_scan(ScanInput { stamp, track: *t, origin: Point2::new(0.0, 0.0), hits: &hits, misses: &[] });
+        if i >= 100 {
+            assert_eq!(outcome, ScanOutcome::Predicted, "scan {i}");
+        }
+    }
+    let result = slam.finish();
+    assert!(result.report.predicted >= 200, "{:?}", result.report);
+    // The predictions follow the (here exact) track.
+    let last = result.trajectory.last().unwrap().1;
+    let t = truth.last().unwrap();
+    assert!((last.x - t.x).hypot(last.y - t.y) < 0.05, "{last:?} vs {t:?}");
+}
+
+#[test]
+fn a_robot_that_never_moves_gives_one_pose() {
+    let truth = vec![Pose2::new(6.0, 4.0, 0.3); 300];
+    let track: Vec<Option<Pose2>> = truth.iter().map(|p| Some(*p)).collect();
+    let r = run(&truth, &track, 360);
+    let (mean, max) = errors(&r);
+    assert!(mean < 0.01 && max < 0.02, "mean {mean}, max {max}");
+    // Nodes only by time (every 5 s of 30 s).
+    assert!(r.result.report.nodes <= 7, "{:?}", r.result.report);
+}
+
+#[test]
+fn a_log_that_starts_mid_turn_is_followed() {
+    // Turning in place at 60°/s from the first scan, with odometry that under-reads the
+    // turn by 10 %.
+    let truth: Vec<Pose2> =
+        (0..120).map(|i| Pose2::new(6.0, 4.0, normalize_angle(0.2 + i as f64 * 6f64.to_radians()))).collect();
+    let track: Vec<Option<Pose2>> = (0..120)
+        .map(|i| Some(Pose2::new(6.0, 4.0, normalize_angle(0.2 + 0.9 * i as f64 * 6f64.to_radians()))))
+        .collect();
+    let r = run(&truth, &track, 360);
+    let worst = r
+        .result
+        .trajectory
+        .iter()
+        .zip(&truth)
+        .map(|((_, p), t)| normalize_angle(p.theta - t.theta).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1f64.to_radians(), "heading error up to {} deg", worst.to_degrees());
+    let (_, max) = errors(&r);
+    assert!(max < 0.05, "{max}");
+}
+
+#[test]
+fn odometry_that_jumps_is_left_out_and_the_scans_stay_on_the_truth() {
+    let truth = ring_poses(1);
+    let mut odo = odometry(&truth, 3);
+    // At scan 150 the odometry jumps 0.8 m sideways and stays there (a reset, a glitch).
+    for p in odo.iter_mut().skip(150) {
+        *p = Pose2::new(0.0, 0.8, 0.0).compose(*p);
+    }
+    let r = run(&truth, &odo.iter().map(|p| Some(*p)).collect::<Vec<_>>(), 360);
+    let (mean, max) = errors(&r);
+    let rep = &r.result.report;
+    assert!(rep.odometry_edges_rejected >= 1, "{rep:?}");
+    assert!(rep.moving_prediction_used >= 1, "{rep:?}");
+    assert!(mean < 0.05 && max < 0.15, "mean {mean}, max {max}");
+}
+
+#[test]
+fn a_non_finite_track_pose_is_refused_and_counted() {
+    let truth = ring_poses(1)[..50].to_vec();
+    let mut track: Vec<Option<Pose2>> = truth.iter().map(|p| Some(*p)).collect();
+    track[20] = Some(Pose2::new(f64::NAN, 0.0, 0.0));
+    track[21] = None;
+    let r = run(&truth, &track, 360);
+    assert_eq!(r.result.report.refused, 1);
+    assert_eq!(r.result.report.without_track, 1);
+    // The refused scan has no pose; the others do.
+    assert_eq!(r.result.trajectory.len(), truth.len() - 1);
+}
