@@ -4,12 +4,11 @@
 //! under an `odom` frame, the odometry written on raw CARMEN lines), a pass over the
 //! first lidar's scans runs [`fusemap_core::slam`]: each scan predicted from the track's
 //! motion, matched against the local submap, turned into a pose-graph node, searched
-//! against older submaps for loop closures, and the graph optimised. The optimised scan
-//! poses then enter the one pose estimator as absolute pose measurements beside the
-//! odometry, IMU and GNSS (GNSS fixes also enter the graph as position priors, so the two
-//! agree), and the estimator's smoothed track places every measurement — the scans,
-//! de-skewed, and the camera frames — at its own stamp. Without odometry to run the
-//! estimator on, the optimised scan poses are the track.
+//! against older submaps for loop closures, and the graph optimised. The track (odometry,
+//! or the estimator's fusion of odometry, IMU and GNSS) is then corrected at every scan by
+//! the optimised pose ([`track`]), and that corrected track places every measurement —
+//! the scans, de-skewed, and the camera frames — at its own stamp. With poses on the scan
+//! lines (raw CARMEN), the optimised scan poses are the track.
 
 use crate::extrinsics::frame_tree;
 use crate::merge::{OrderedMerge, Pushed};
@@ -173,14 +172,16 @@ pub fn run(
         // be from one pose (a scan swept while turning is otherwise bent).
         let n = scan.scan.ranges.len();
         let ti = scan.time_increment as f64;
-        let motion_at = |i: usize| -> Option<Pose2> {
-            let Track::Timed(track) = &chosen.track else { return None };
-            if !(cfg.deskew && mode == SyncMode::Interpolate && ti > 0.0 && n > 1) {
-                return None;
+        let sweep = match &chosen.track {
+            Track::Timed(track) if cfg.deskew && mode == SyncMode::Interpolate && ti > 0.0 && n > 1 => {
+                track.pose_at(t, SyncMode::Interpolate).ok().map(|p0| (track, p0.inverse()))
             }
-            let p0 = track.pose_at(t, SyncMode::Interpolate).ok()?;
+            _ => None,
+        };
+        let motion_at = |i: usize| -> Option<Pose2> {
+            let (track, from_base) = sweep?;
             let tb = Stamp(t.0.saturating_add((ti * i as f64 * 1e9) as i64));
-            Some(p0.inverse().compose(track.pose_at(tb, SyncMode::Interpolate).ok()?))
+            Some(from_base.compose(track.pose_at(tb, SyncMode::Interpolate).ok()?))
         };
         let deskew = motion_at(n.saturating_sub(1)).is_some();
         hits.clear();
@@ -292,8 +293,8 @@ fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, lat
 /// EKF + smoother beside the odometry. On the Intel log its χ² gate refused 88 % of them
 /// (the odometry's heading drifts faster than its noise model says) and the track's
 /// relation error was 9.4 m against 0.02 m for the optimised poses. The graph already
-/// fuses the estimator's motion, the matches, the loop closures and the fixes; the
-/// correction keeps its result exactly at every scan.
+/// fuses the estimator's motion (with the fixes in it), the matches and the loop
+/// closures; the correction keeps its result exactly at every scan.
 pub fn track(plan: &Plan, chosen: ChosenTrack, run: &mut SlamRun) -> ChosenTrack {
     match chosen.track {
         Track::Timed(base) => {

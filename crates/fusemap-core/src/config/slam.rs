@@ -106,6 +106,8 @@ pub struct SlamConfig {
     pub branch_and_bound_depth: usize,
 }
 
+/// Angles are written as the literal degrees of [`SlamParams::default`]: a round trip
+/// through radians would differ from a config that writes the same default in its last bit.
 impl Default for SlamConfig {
     fn default() -> Self {
         let p = SlamParams::default();
@@ -118,10 +120,10 @@ impl Default for SlamConfig {
             max_range_m: p.max_range_m,
             min_points: p.min_points,
             node_distance_m: p.node_distance_m,
-            node_angle_deg: p.node_angle_rad.to_degrees(),
+            node_angle_deg: 2.0,
             node_time_s: p.node_time_s,
             search_linear_window_m: p.local.linear_window_m,
-            search_angular_window_deg: p.local.angular_window_rad.to_degrees(),
+            search_angular_window_deg: 6.0,
             translation_delta_cost: p.local.translation_delta_cost,
             rotation_delta_cost: p.local.rotation_delta_cost,
             translation_weight: p.local.translation_weight,
@@ -132,7 +134,7 @@ impl Default for SlamConfig {
             odometry_translation_per_m: p.odometry_translation_per_m,
             odometry_floor_m: p.odometry_floor_m,
             odometry_rotation_per_rad: p.odometry_rotation_per_rad,
-            odometry_floor_deg: p.odometry_floor_rad.to_degrees(),
+            odometry_floor_deg: 1.0,
             loop_closure: p.loop_closure,
             loop_closure_sampling_ratio: p.loop_closure_sampling_ratio,
             loop_closure_submaps_per_node: p.loop_closure_submaps_per_node,
@@ -141,11 +143,11 @@ impl Default for SlamConfig {
             loop_closure_max_points: p.loop_closure_max_points,
             loop_closure_max_distance_m: p.loop_closure_max_distance_m,
             loop_closure_linear_window_m: p.loop_closure_linear_window_m,
-            loop_closure_angular_window_deg: p.loop_closure_angular_window_rad.to_degrees(),
+            loop_closure_angular_window_deg: 20.0,
             loop_closure_min_score: p.loop_closure_min_score as f64,
             loop_closure_huber: p.loop_closure_huber,
             loop_closure_sigma_m: p.loop_closure_sigma_m,
-            loop_closure_sigma_deg: p.loop_closure_sigma_rad.to_degrees(),
+            loop_closure_sigma_deg: 1.0,
             optimize_every_n_nodes: p.optimize_every_n_nodes,
             branch_and_bound_depth: p.branch_and_bound_depth,
         }

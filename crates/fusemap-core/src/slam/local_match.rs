@@ -33,14 +33,14 @@ pub struct LocalMatchParams {
     pub rotation_delta_cost: f64,
     /// Weight of the map term in the refinement.
     pub map_weight: f64,
-    /// Pull of the refinement towards the correlative result, per metre.
+    /// Pull of the refinement's translation towards the prediction, per metre.
     pub translation_weight: f64,
-    /// Pull of the refinement towards the correlative result, per radian.
+    /// Pull of the refinement's heading towards the correlative result, per radian.
     pub rotation_weight: f64,
     /// σ of one point's residual (probability units) for the information matrix.
     pub residual_sigma: f64,
     /// A match whose smallest/largest translational information ratio is below this is
-    /// degenerate (corridor): its information along the weak direction is dropped.
+    /// degenerate (a corridor); the caller decides what to trust (see `Slam`).
     pub degeneracy_ratio: f64,
 }
 

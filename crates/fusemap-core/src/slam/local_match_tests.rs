@@ -60,6 +60,13 @@ fn a_corridor_match_is_degenerate_along_the_corridor() {
     assert!(m.degenerate, "{:?}", m.information);
     // Across the corridor the match is confident, along it almost not.
     assert!(m.information[1][1] > 20.0 * m.information[0][0], "{:?}", m.information);
+    // Along the corridor the translation stays where the prediction put it (the pull to
+    // the prediction), wherever the search's best cell fell; from 5 cm across it, the
+    // match pulls it back onto the walls.
+    let predicted = Pose2::new(0.5, 0.15, 0.0);
+    let m = match_scan(&g, &pts, predicted, &LocalMatchParams::default());
+    assert!((m.pose.x - 0.5).abs() < 0.01, "along: {:?}", m.pose);
+    assert!((m.pose.y - 0.1).abs() < 0.02, "across: {:?}", m.pose);
     let room = World::room();
     let g = grid_of(&room, &[Pose2::new(6.0, 4.0, 0.0)]);
     let m = match_scan(

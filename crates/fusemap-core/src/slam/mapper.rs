@@ -5,8 +5,9 @@
 //! scan's matched pose and the pose track's motion between the two stamps (odometry, IMU
 //! and fixes already fused by the estimator), then matched against the older active
 //! submap. The predicted motion is the prior of the match: where the lidar sees structure
-//! the match dominates, and where the match is degenerate (a corridor) the prediction is
-//! kept along the weak direction.
+//! the match dominates (the refinement pulls the translation to the prediction, weakly),
+//! and where the match is degenerate (a corridor) it is refined again from the prediction
+//! with ten times that pull, so the prediction carries the pose there.
 //!
 //! Global SLAM (§V): every scan that moved far enough becomes a node; it is tied to the
 //! submaps it went into by its local pose (information from the match's curvature) and to
@@ -48,7 +49,8 @@ pub struct ScanInput<'a> {
 pub enum ScanOutcome {
     /// Matched against a submap.
     Matched,
-    /// Matched, but the match was degenerate: the prediction was kept along its weak direction.
+    /// Matched, but degenerate (a corridor): refined again from the prediction with ten
+    /// times the pull towards it.
     Degenerate,
     /// Too few usable returns (or no submap yet): the predicted pose was kept.
     Predicted,
@@ -162,7 +164,7 @@ impl Slam {
         if scan.track.is_none() {
             self.report.without_track += 1;
         }
-        // The constant-velocity prediction from the last two matched poses: a second
+        // The constant-velocity prediction from the last two scans' poses: a second
         // hypothesis for when the track's motion is wrong (odometry written on scan lines
         // that stalls for a few scans and then catches up, a wheel that slips).
         let moving = match self.recent {

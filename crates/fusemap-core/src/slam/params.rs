@@ -27,7 +27,7 @@ pub struct SlamParams {
     pub node_angle_rad: f64,
     /// … or this much time has passed, seconds.
     pub node_time_s: f64,
-    /// The constant-velocity prediction (from the last two matched poses) replaces the
+    /// The constant-velocity prediction (from the last two scans' poses) replaces the
     /// track's when its match's mean probability is higher by this much: odometry that
     /// stalls for a few scans and then catches up is followed, a corridor (where both fit
     /// equally) is not.

@@ -10,7 +10,7 @@ pub struct SlamReport {
     pub scans: u64,
     /// Scans matched against a submap.
     pub matched: u64,
-    /// Scans whose match was degenerate (the prediction kept along the weak direction).
+    /// Scans whose match was degenerate (refined again from the prediction, pulled to it ten times harder).
     pub degenerate: u64,
     /// Scans not matched (too few returns, or no submap yet): predicted pose kept.
     pub predicted: u64,
