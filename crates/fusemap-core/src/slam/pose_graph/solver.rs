@@ -312,12 +312,7 @@ pub(super) fn optimize(graph: &mut PoseGraph, opts: &OptimizeOptions) -> Result<
     let reusable = matches!(&graph.cache, Some(st) if st.n_edges == graph.edges.len() && st.free == free);
     let mut st = match graph.cache.take() {
         Some(st) if reusable => st,
-        _ => {
-            let t = std::time::Instant::now();
-            let s = Structure::build(graph, free, n_free)?;
-            eprintln!("DBG build {:?}", t.elapsed());
-            s
-        }
+        _ => Structure::build(graph, free, n_free)?,
     };
     report.reused_symbolic = reusable;
     let start = graph.nodes.clone();
