@@ -54,6 +54,7 @@ pub fn parse_config_str(text: &str, path: &Path) -> Result<Config> {
 
 /// Reads a UTF-8 text file; invalid UTF-8 is a format error at the line where it starts.
 pub(crate) fn read_text(path: &Path) -> Result<String> {
+    crate::input_file::refuse_special_file(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();

@@ -10,6 +10,7 @@ pub mod camera;
 pub mod comparison;
 pub mod config_file;
 pub mod error;
+pub mod input_file;
 pub mod log;
 pub mod map_server;
 pub mod npz;

@@ -131,8 +131,15 @@ pub fn run_scanfile(path: &std::path::Path, max_scans: Option<usize>) -> Result<
     let t0 = Instant::now();
     let mut f = fusemap_io::scanfile::read_scanfile(path)?;
     if let Some(n) = max_scans {
+        let Some(beams) = n.checked_mul(f.beams) else {
+            bail!(
+                "--max-scans {n}: {n} scans of {} beams overflow a count; give at most {}",
+                f.beams,
+                usize::MAX / f.beams.max(1)
+            );
+        };
         f.poses.truncate(n);
-        f.ranges.truncate(n * f.beams);
+        f.ranges.truncate(beams);
     }
     let simulate_s = t0.elapsed().as_secs_f64();
     let geometry = GridGeometry::new(f.resolution, fusemap_core::geometry::Point2::new(f.origin[0], f.origin[1]))?;

@@ -403,3 +403,45 @@ fn map_refuses_a_log_and_a_world() {
     assert_no_map(&out);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `bench --max-scans` with a count whose beams overflow: one clear error, no panic.
+#[test]
+fn bench_max_scans_overflow_is_an_error() {
+    let dir = temp_dir("bench-overflow");
+    // A SCAN2D01 file: 2 scans of 3 beams (header, geometry, poses, ranges).
+    let mut b = b"SCAN2D01".to_vec();
+    for v in [2i64, 3, 10, 10] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in [-1.0f64, 0.5, 0.1, 10.0, 0.05, -5.0, -5.0] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in [0.0f64, 1.0, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0] {
+        b.extend(v.to_le_bytes());
+    }
+    let f = dir.join("a.scan");
+    std::fs::write(&f, &b).unwrap();
+    let ok = run(&["bench", "--scanfile", path_str(&f), "--max-scans", "1"]);
+    assert_success(&ok);
+    let o = run(&["bench", "--scanfile", path_str(&f), "--max-scans", &i64::MAX.to_string()]);
+    let line = one_line_error(&o);
+    assert_names(&line, &["--max-scans", "overflow"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A FIFO given as the log or the config is refused at once (reading it would block).
+#[cfg(unix)]
+#[test]
+fn a_fifo_as_log_or_config_is_refused() {
+    let dir = temp_dir("fifo");
+    let fifo = dir.join("pipe");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().expect("mkfifo runs");
+    assert!(made.success());
+    let out = dir.join("out");
+    let line = one_line_error(&run(&["map", "--out", path_str(&out), path_str(&fifo)]));
+    assert_names(&line, &["pipe", "FIFO"]);
+    let line = one_line_error(&run(&["demo", "--config", path_str(&fifo), "--out", path_str(&out)]));
+    assert_names(&line, &["pipe", "FIFO"]);
+    assert_no_map(&out);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -40,6 +40,7 @@ pub struct OpenedLog {
 
 /// Recognises the format of `path` by content.
 pub fn detect(path: &Path) -> Result<LogFormat> {
+    crate::input_file::refuse_special_file(path)?;
     if path.is_dir() {
         if super::ros2::is_rosbag2_dir(path) {
             return Ok(LogFormat::Rosbag2);

@@ -14,6 +14,33 @@ use fusemap_core::time::Stamp;
 use rusqlite::{Connection, OpenFlags, OptionalExtension};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// SQLite virtual-machine steps between two looks at the statement's time budget.
+const PROGRESS_OPS: i32 = 100_000;
+/// The longest one statement may run: ordering the ids of a bag of millions of messages
+/// takes seconds; a crafted file (a recursive query behind a table name) is stopped here.
+const QUERY_BUDGET: Duration = Duration::from_secs(60);
+
+/// `path` for an SQLite URI: bytes other than unreserved ones and `/` percent-encoded,
+/// so `?`, `#` and `%` in a file name stay part of it.
+fn uri_path(path: &Path) -> String {
+    #[cfg(unix)]
+    let bytes = std::os::unix::ffi::OsStrExt::as_bytes(path.as_os_str()).to_vec();
+    #[cfg(not(unix))]
+    let bytes = path.to_string_lossy().as_bytes().to_vec();
+    let mut out = String::with_capacity(bytes.len());
+    for b in bytes {
+        if b.is_ascii_alphanumeric() || b"-._~/".contains(&b) {
+            out.push(b as char);
+        } else {
+            out.push_str(&format!("%{b:02X}"));
+        }
+    }
+    out
+}
 
 /// One `.db3` file being read.
 pub(crate) struct Db3Source {
@@ -23,6 +50,9 @@ pub(crate) struct Db3Source {
     /// Row ids in timestamp order.
     order: Vec<i64>,
     next: usize,
+    /// The running statement's deadline, nanoseconds after `started`.
+    deadline: Arc<AtomicU64>,
+    started: Instant,
 }
 
 impl Db3Source {
@@ -33,9 +63,49 @@ impl Db3Source {
         let sql_error = |what: &str, e: rusqlite::Error| {
             Error::format(path, Location::File, format!("SQLite: {what}: {}", error_chain(&e)))
         };
-        let conn =
-            Connection::open_with_flags(path, OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX)
-                .map_err(|e| sql_error("cannot open", e))?;
+        // Read-only and immutable: SQLite then takes no locks and writes no `-wal`/`-shm`
+        // file beside the input (which also lets a bag on read-only media be read).
+        let uri = format!("file:{}?immutable=1", uri_path(path));
+        let flags = OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_URI | OpenFlags::SQLITE_OPEN_NO_MUTEX;
+        let conn = Connection::open_with_flags(uri, flags).map_err(|e| sql_error("cannot open", e))?;
+        // Every statement gets a time budget: a crafted file must not run a query forever.
+        let deadline = Arc::new(AtomicU64::new(0));
+        let started = Instant::now();
+        {
+            let deadline = Arc::clone(&deadline);
+            conn.progress_handler(
+                PROGRESS_OPS,
+                Some(move || started.elapsed().as_nanos() as u64 > deadline.load(Ordering::Relaxed)),
+            )
+            .map_err(|e| sql_error("setting a time budget", e))?;
+        }
+        let arm = || deadline.store((started.elapsed() + QUERY_BUDGET).as_nanos() as u64, Ordering::Relaxed);
+        // The rosbag2 schema: `topics` and `messages` are tables (a view can be any query).
+        for table in ["topics", "messages"] {
+            arm();
+            let kind: Option<String> = conn
+                .query_row("SELECT type FROM sqlite_master WHERE name = ?1", [table], |row| row.get(0))
+                .optional()
+                .map_err(|e| sql_error("reading the schema", e))?;
+            match kind.as_deref() {
+                Some("table") => {}
+                Some(other) => {
+                    return Err(Error::format(
+                        path,
+                        Location::File,
+                        format!("`{table}` is a {other}, not a table: not a rosbag2 database"),
+                    ))
+                }
+                None => {
+                    return Err(Error::format(
+                        path,
+                        Location::File,
+                        format!("no table `{table}`: not a rosbag2 database"),
+                    ))
+                }
+            }
+        }
+        arm();
 
         let mut topics = HashMap::new();
         {
@@ -56,6 +126,7 @@ impl Db3Source {
             }
         }
 
+        arm();
         let order = {
             let mut stmt = conn
                 .prepare("SELECT id FROM messages ORDER BY timestamp, id")
@@ -65,11 +136,12 @@ impl Db3Source {
             rows.collect::<rusqlite::Result<Vec<i64>>>().map_err(|e| sql_error("reading table `messages`", e))?
         };
 
-        Ok(Self { path: path.to_path_buf(), conn, topics, order, next: 0 })
+        Ok(Self { path: path.to_path_buf(), conn, topics, order, next: 0, deadline, started })
     }
 
     /// Fetches row `id` and hands it to `visit`, its payload borrowed from SQLite.
     fn fetch(&mut self, index: u64, id: i64, visit: &mut dyn FnMut(RawMessage<'_>)) -> Result<()> {
+        self.deadline.store((self.started.elapsed() + QUERY_BUDGET).as_nanos() as u64, Ordering::Relaxed);
         let path = &self.path;
         let at = |topic: String, message: String| Error::format(path, Location::Message { index, topic }, message);
         let topics = &self.topics;

@@ -229,6 +229,14 @@ impl Rosbag2Dir {
         let storage = meta.storage_identifier.to_ascii_lowercase();
         let mut files = Vec::new();
         for rel in &meta.relative_file_paths {
+            // The bag names its files relative to its own directory: an absolute path or a
+            // `..` would let a bag someone sent make fusemap open any file.
+            if !stays_inside(rel) {
+                return Err(field_error(
+                    "relative_file_paths",
+                    format!("lists `{}`, which is outside the bag directory; refused", rel.escape_debug()),
+                ));
+            }
             let path = resolve(dir, rel).ok_or_else(|| {
                 field_error("relative_file_paths", format!("lists `{rel}`, which is not in {}", dir.display()))
             })?;
@@ -268,6 +276,13 @@ impl Rosbag2Dir {
     }
 }
 
+/// True when `rel` is a relative path without `..`: it cannot name a file outside the
+/// bag directory (symbolic links inside it are the bag owner's choice).
+fn stays_inside(rel: &str) -> bool {
+    use std::path::Component;
+    !rel.is_empty() && Path::new(rel).components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+}
+
 /// The storage file `rel` names: relative to the bag directory, or (as early rosbag2
 /// versions wrote it, with the directory name in front) just its file name there.
 fn resolve(dir: &Path, rel: &str) -> Option<PathBuf> {
@@ -282,6 +297,29 @@ fn resolve(dir: &Path, rel: &str) -> Option<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn storage_paths_outside_the_bag_are_refused() {
+        for rel in ["../../etc/passwd", "/etc/passwd", "a/../../b.db3", "..", ""] {
+            assert!(!stays_inside(rel), "{rel}");
+        }
+        for rel in ["bag_0.db3", "./bag_0.mcap", "db3_bag/c_0.db3", "my bag: 1_0.mcap"] {
+            assert!(stays_inside(rel), "{rel}");
+        }
+        let dir = crate::testdata::temp_dir("rosbag2-outside");
+        std::fs::write(dir.join("secret.db3"), b"x").unwrap();
+        let bag = dir.join("bag");
+        std::fs::create_dir_all(&bag).unwrap();
+        std::fs::write(
+            bag.join(METADATA_FILE),
+            "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n  relative_file_paths:\n    - ../secret.db3\n",
+        )
+        .unwrap();
+        let e = Rosbag2Dir::open(&bag).err().expect("refused");
+        let text = e.to_string();
+        assert!(text.contains("outside the bag directory") && text.contains("metadata.yaml"), "{text}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn reads_the_rosbag2_cli_layout() {

@@ -607,6 +607,43 @@ fn db3_errors() {
 }
 
 #[test]
+fn db3_views_instead_of_tables_are_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    // `messages` as an endless recursive query: reading it would never end.
+    let path = dir.path().join("view.db3");
+    rusqlite::Connection::open(&path)
+        .unwrap()
+        .execute_batch(
+            "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT, type TEXT, serialization_format TEXT,
+                                 offered_qos_profiles TEXT);
+             CREATE VIEW messages AS WITH RECURSIVE n(id) AS (SELECT 1 UNION ALL SELECT id + 1 FROM n)
+                 SELECT id, 1 AS topic_id, id AS timestamp, x'00' AS data FROM n;",
+        )
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    let e = open_ros2(&path).err().expect("refused");
+    assert!(e.to_string().contains("`messages` is a view, not a table"), "{e}");
+    assert!(t0.elapsed() < std::time::Duration::from_secs(1));
+}
+
+#[test]
+fn db3_is_read_without_writing_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("wal.db3");
+    write_db3(&path, &sample_log(), false);
+    let conn = rusqlite::Connection::open(&path).unwrap();
+    let mode: String = conn.query_row("PRAGMA journal_mode=WAL", [], |r| r.get(0)).unwrap();
+    assert_eq!(mode, "wal");
+    drop(conn);
+    let before: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let mut r = open_ros2(&path).unwrap();
+    let all = read_all(r.as_mut());
+    assert!(!all.is_empty() && all.iter().all(|m| m.is_ok()));
+    let after: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(before, after, "no -wal or -shm file beside the input");
+}
+
+#[test]
 fn unknown_files_are_refused_by_content() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("x.mcap");
