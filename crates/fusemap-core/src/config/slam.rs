@@ -86,6 +86,8 @@ pub struct SlamConfig {
     pub loop_closure_max_range_m: f64,
     /// At most this many returns (evenly spread) go into a loop-closure search.
     pub loop_closure_max_points: usize,
+    /// Memory for the submaps' branch-and-bound grids, MiB (least recently used rebuilt).
+    pub loop_closure_grid_cache_mib: usize,
     /// Only submaps within this distance of a node are searched, metres.
     pub loop_closure_max_distance_m: f64,
     /// Loop-closure search half-width in x and y, metres.
@@ -141,6 +143,7 @@ impl Default for SlamConfig {
             loop_closure_nodes_per_submap: p.loop_closure_nodes_per_submap,
             loop_closure_max_range_m: p.loop_closure_max_range_m,
             loop_closure_max_points: p.loop_closure_max_points,
+            loop_closure_grid_cache_mib: p.loop_closure_grid_cache_mib,
             loop_closure_max_distance_m: p.loop_closure_max_distance_m,
             loop_closure_linear_window_m: p.loop_closure_linear_window_m,
             loop_closure_angular_window_deg: 20.0,
@@ -239,6 +242,7 @@ impl SlamConfig {
             loop_closure_nodes_per_submap: self.loop_closure_nodes_per_submap,
             loop_closure_max_range_m: positive("loop_closure_max_range_m", self.loop_closure_max_range_m)?,
             loop_closure_max_points: self.loop_closure_max_points,
+            loop_closure_grid_cache_mib: self.loop_closure_grid_cache_mib,
             loop_closure_max_distance_m: non_negative("loop_closure_max_distance_m", self.loop_closure_max_distance_m)?,
             loop_closure_linear_window_m: non_negative(
                 "loop_closure_linear_window_m",

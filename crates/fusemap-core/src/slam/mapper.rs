@@ -17,7 +17,8 @@
 //! Every scan's final pose is its nearest earlier node's optimised pose composed with the
 //! local offset between the two.
 
-use super::global_match::{match_branch_and_bound, GlobalSearch, PrecomputedGrids};
+use super::global_match::{match_branch_and_bound, GlobalSearch};
+use super::grid_cache::GridCache;
 use super::local_match::{mean_probability, refine, LocalMatchParams};
 use super::params::SlamParams;
 use super::pose_graph::{Edge, EdgeKind, Loss, OptimizeOptions, PoseGraph};
@@ -80,7 +81,9 @@ pub struct Slam {
     p: SlamParams,
     submaps: Submaps,
     submap_graph: Vec<usize>,
-    precomputed: Vec<Option<PrecomputedGrids>>,
+    /// Finished submaps (searched for loop closures).
+    finished: Vec<bool>,
+    grids: GridCache,
     node_sampler: f64,
     graph: PoseGraph,
     nodes: Vec<Node>,
@@ -122,7 +125,8 @@ impl Slam {
             submaps: Submaps::new(p.resolution, p.scans_per_submap, p.hit_probability, p.miss_probability),
             p,
             submap_graph: Vec::new(),
-            precomputed: Vec::new(),
+            finished: Vec::new(),
+            grids: GridCache::new(p.loop_closure_grid_cache_mib.saturating_mul(1 << 20), p.branch_and_bound_depth),
             node_sampler: 0.0,
             graph: PoseGraph::new(),
             nodes: Vec::new(),
@@ -286,7 +290,8 @@ impl Slam {
         for s in before..self.submaps.all().len() {
             let g = self.graph.add_node(self.global_from_local.compose(self.submaps.all()[s].local_pose));
             self.submap_graph.push(g);
-            self.precomputed.push(None);
+            self.finished.push(false);
+            self.grids.add_submap();
         }
         let g = self.graph.add_node(self.global_from_local.compose(local));
         if self.nodes.is_empty() {
@@ -350,8 +355,8 @@ impl Slam {
         if self.p.loop_closure {
             let t0 = Instant::now();
             if let Some(f) = finished {
-                self.precomputed[f] =
-                    Some(PrecomputedGrids::new(&self.submaps.all()[f].grid, self.p.branch_and_bound_depth));
+                self.finished[f] = true;
+                self.grids.get(f, &self.submaps.all()[f].grid);
                 self.search_nodes_against(f);
             }
             self.search_submaps_for(self.nodes.len() - 1);
@@ -367,7 +372,7 @@ impl Slam {
     /// into, and near it in the current estimate.
     fn candidate(&self, n: usize, s: usize) -> Option<f64> {
         let node = &self.nodes[n];
-        if self.precomputed[s].is_none() || node.submaps.contains(&s) {
+        if !self.finished[s] || node.submaps.contains(&s) {
             return None;
         }
         let (gn, gs) = (self.graph.nodes()[node.graph], self.graph.nodes()[self.submap_graph[s]]);
@@ -407,8 +412,11 @@ impl Slam {
     fn search(&mut self, n: usize, s: usize) {
         let node = &self.nodes[n];
         let (gn, gs) = (self.graph.nodes()[node.graph], self.graph.nodes()[self.submap_graph[s]]);
-        let Some(pre) = &self.precomputed[s] else { return };
+        if !self.finished[s] {
+            return;
+        }
         let sm = &self.submaps.all()[s];
+        let pre = self.grids.get(s, &sm.grid);
         let initial = sm.local_pose.compose(gs.inverse().compose(gn));
         let search = GlobalSearch {
             linear_window_m: self.p.loop_closure_linear_window_m,
@@ -460,6 +468,8 @@ impl Slam {
 
     /// Optimises once more and returns every scan's pose.
     pub fn finish(mut self) -> SlamResult {
+        self.report.grids_built = self.grids.built;
+        self.report.grids_peak_bytes = self.grids.peak_bytes;
         if !self.nodes.is_empty() {
             self.optimise();
         }

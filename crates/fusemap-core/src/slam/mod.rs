@@ -7,12 +7,14 @@
 //! | correlative search + Gauss–Newton refinement + information | `local_match.rs` |
 //! | two active submaps, finished ones kept | `submap.rs` |
 //! | branch-and-bound loop-closure search | `global_match.rs` |
+//! | its precomputed grids within a memory budget | `grid_cache.rs` |
 //! | sparse pose-graph optimisation | `pose_graph.rs` |
 //! | the loop over scans | `mapper.rs` |
 //! | the corrected pose track | `corrected_track.rs` |
 mod corrected_track;
 pub mod global_match;
 pub mod grid;
+mod grid_cache;
 pub mod interpolation;
 pub mod local_match;
 mod mapper;

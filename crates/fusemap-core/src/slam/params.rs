@@ -55,6 +55,9 @@ pub struct SlamParams {
     pub loop_closure_max_range_m: f64,
     /// … and at most this many of them (evenly spread).
     pub loop_closure_max_points: usize,
+    /// Memory for the finished submaps' branch-and-bound grids, MiB: past it the least
+    /// recently searched are dropped and rebuilt when needed (same results, more time).
+    pub loop_closure_grid_cache_mib: usize,
     /// Only submaps whose centre is within this distance of the node are searched, metres.
     pub loop_closure_max_distance_m: f64,
     /// Half-width of the loop-closure search in x and y, metres.
@@ -99,6 +102,7 @@ impl Default for SlamParams {
             loop_closure_nodes_per_submap: 20,
             loop_closure_max_range_m: 12.0,
             loop_closure_max_points: 120,
+            loop_closure_grid_cache_mib: 64,
             loop_closure_max_distance_m: 15.0,
             loop_closure_linear_window_m: 4.0,
             loop_closure_angular_window_rad: 20f64.to_radians(),

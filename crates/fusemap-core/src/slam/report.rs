@@ -33,6 +33,11 @@ pub struct SlamReport {
     pub loop_accepted: u64,
     /// Loop-closure searches that found nothing above the score threshold.
     pub loop_rejected: u64,
+    /// Branch-and-bound grids built for finished submaps (first builds and rebuilds after
+    /// the memory budget dropped them).
+    pub grids_built: u64,
+    /// The most bytes of branch-and-bound grids held at once.
+    pub grids_peak_bytes: usize,
     /// Pose-graph optimisations run.
     pub optimisations: u64,
     /// Optimisations that failed (the previous poses were kept), with the reason.
