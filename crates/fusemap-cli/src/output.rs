@@ -138,6 +138,30 @@ pub fn write(
     if let Some(t) = trajectory {
         fusemap_io::trajectory::write_tum(&files.trajectory, t)?;
     }
+    // Files of an earlier run into the same directory that this run does not write are
+    // removed first: a run never leaves files beside its summary that look like its own.
+    let graph = summary.log.as_ref().and_then(pose_graph_of);
+    let mut stale: Vec<&PathBuf> = Vec::new();
+    if trajectory.is_none() {
+        stale.push(&files.trajectory);
+    }
+    if raster.is_none() {
+        stale.extend([&files.npz, &files.yaml, &files.pgm, &files.png]);
+    }
+    if raster.is_none() || layers.is_none() {
+        stale.extend([&files.semantic, &files.semantic_png, &files.dynamic]);
+    }
+    if raster.is_none() || graph.is_none() {
+        stale.push(&files.slam);
+    }
+    for f in stale {
+        match std::fs::remove_file(f) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(e).with_context(|| format!("cannot remove the earlier run's {}", f.display()))
+            }
+            _ => {}
+        }
+    }
     if let Some(r) = raster {
         match layers {
             Some(l) => {
@@ -150,7 +174,7 @@ pub fn write(
         }
         fusemap_io::map_server::write_map_server(&files.yaml, r)?;
         fusemap_io::picture::write_map_png(&files.png, r)?;
-        if let Some((trajectory, closures)) = summary.log.as_ref().and_then(pose_graph_of) {
+        if let Some((trajectory, closures)) = graph {
             fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, &trajectory, &closures)?;
         }
     }

@@ -74,6 +74,16 @@ pub fn map(config: Option<&Path>, world: Option<&Path>, log: Option<&Path>, out:
     };
     summary.print();
     println!("outputs       {}", out.display());
+    // A run that observed no cell wrote only its summary: that is a failure a script must
+    // see, with the reason.
+    if summary.entropy.is_none() {
+        bail!(
+            "no map was written: no cell was observed in {} scans ({} valid returns); {} says what was skipped and why",
+            summary.scans,
+            summary.returns.valid,
+            out.join("summary.json").display()
+        );
+    }
     Ok(())
 }
 

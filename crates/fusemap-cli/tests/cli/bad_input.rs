@@ -445,3 +445,26 @@ fn a_fifo_as_log_or_config_is_refused() {
     assert_no_map(&out);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A run that observes no cell (every return a no-return) fails with the reason, writes
+/// its summary, and removes the map files an earlier run left in the same directory.
+#[test]
+fn a_run_with_no_map_fails_and_leaves_no_stale_map() {
+    let dir = temp_dir("no-map");
+    let out = dir.join("out");
+    // An earlier, good run into the same directory.
+    assert_success(&run(&["map", "--world", path_str(&repo_file("worlds/corridor.toml")), "--out", path_str(&out)]));
+    assert!(out.join("map.png").is_file());
+    // Three scans whose every beam is CARMEN's no-return (81.91 m): nothing to map.
+    let mut text = String::new();
+    for i in 0..3 {
+        let t = 1.0 + i as f64 * 0.1;
+        text.push_str(&format!("FLASER 4 81.91 81.91 81.91 81.91 0 0 0 0 0 0 {t} host {t}\n"));
+    }
+    let log = write_file(&dir, "empty.log", text);
+    let line = one_line_error(&run(&["map", "--out", path_str(&out), path_str(&log)]));
+    assert_names(&line, &["no map was written", "3 scans", "summary.json"]);
+    assert!(out.join("summary.json").is_file());
+    assert_no_map(&out);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
