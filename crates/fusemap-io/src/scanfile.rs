@@ -87,16 +87,8 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("fusemap-scanfile-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let p = dir.join("a.scan");
-        let mut b = MAGIC.to_vec();
-        for v in [2i64, 3, 10, 10] {
-            b.extend(v.to_le_bytes());
-        }
-        for v in [-1.0f64, 0.5, 0.1, 10.0, 0.05, -5.0, -5.0] {
-            b.extend(v.to_le_bytes());
-        }
-        for v in [0.0f64, 1.0, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0] {
-            b.extend(v.to_le_bytes());
-        }
+        let b = crate::testdata::tiny_scanfile_bytes();
+        assert_eq!(&b[..8], MAGIC);
         std::fs::write(&p, &b).unwrap();
         let f = read_scanfile(&p).unwrap();
         assert_eq!(f.beams, 3);

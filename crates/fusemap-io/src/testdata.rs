@@ -80,3 +80,19 @@ pub fn temp_dir(tag: &str) -> PathBuf {
     std::fs::create_dir_all(&d).unwrap_or_else(|e| panic!("cannot create {}: {e}", d.display()));
     d
 }
+
+/// A tiny `SCAN2D01` scan file: 2 scans of 3 beams, poses (0, 1, 0.5) and (4, 5, 6),
+/// ranges 1, 2, 3 and 7, 8, 9, grid origin (−5, −5).
+pub fn tiny_scanfile_bytes() -> Vec<u8> {
+    let mut b = b"SCAN2D01".to_vec();
+    for v in [2i64, 3, 10, 10] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in [-1.0f64, 0.5, 0.1, 10.0, 0.05, -5.0, -5.0] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in [0.0f64, 1.0, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0] {
+        b.extend(v.to_le_bytes());
+    }
+    b
+}

@@ -408,19 +408,9 @@ fn map_refuses_a_log_and_a_world() {
 #[test]
 fn bench_max_scans_overflow_is_an_error() {
     let dir = temp_dir("bench-overflow");
-    // A SCAN2D01 file: 2 scans of 3 beams (header, geometry, poses, ranges).
-    let mut b = b"SCAN2D01".to_vec();
-    for v in [2i64, 3, 10, 10] {
-        b.extend(v.to_le_bytes());
-    }
-    for v in [-1.0f64, 0.5, 0.1, 10.0, 0.05, -5.0, -5.0] {
-        b.extend(v.to_le_bytes());
-    }
-    for v in [0.0f64, 1.0, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0] {
-        b.extend(v.to_le_bytes());
-    }
+    // A SCAN2D01 file: 2 scans of 3 beams.
     let f = dir.join("a.scan");
-    std::fs::write(&f, &b).unwrap();
+    std::fs::write(&f, fusemap_io::testdata::tiny_scanfile_bytes()).unwrap();
     let ok = run(&["bench", "--scanfile", path_str(&f), "--max-scans", "1"]);
     assert_success(&ok);
     let o = run(&["bench", "--scanfile", path_str(&f), "--max-scans", &i64::MAX.to_string()]);
