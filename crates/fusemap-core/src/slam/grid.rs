@@ -9,6 +9,12 @@
 //! once, so an update is a table lookup. Each cell changes at most once per scan: a table
 //! entry carries a marker bit, and cells marked during a scan are left alone until the scan
 //! ends (the same once-per-scan rule as the mapper's grid).
+//!
+//! While a submap is being built it is also the local matcher's target, read ~50 times per
+//! point per heading; so an active grid keeps a mirror of its cells as `f32`
+//! probabilities, updated with the cells each scan changes, which the matchers add up with
+//! vector instructions. [`ProbabilityGrid::freeze`] drops the mirror when the submap is
+//! finished (loop closure reads its own precomputed grids).
 
 use crate::geometry::Point2;
 use crate::grid::{CellIndex, CellRay};
@@ -25,6 +31,15 @@ const MARK: u16 = 1 << 15;
 pub fn value_to_probability(v: u16) -> f32 {
     let v = (v & !MARK).max(1);
     P_MIN + (v - 1) as f32 * ((P_MAX - P_MIN) / (MAX_VALUE - 1) as f32)
+}
+
+/// `⌊x⌋` as an integer, as `x.floor() as i64` gives it (saturating, NaN → 0), without the
+/// libm call that `floor` is on baseline x86-64: the matchers take it for every point of
+/// every candidate pose.
+#[inline]
+pub fn floor_i64(x: f64) -> i64 {
+    let i = x as i64;
+    i.saturating_sub(i64::from(i as f64 > x))
 }
 
 /// The stored value nearest to probability `p` (clamped to `[P_MIN, P_MAX]`).
@@ -92,6 +107,8 @@ pub struct ProbabilityGrid {
     limits: CellLimits,
     cells: Vec<u16>,
     marked: Vec<u32>,
+    /// `value_to_probability` of every cell, while the grid is active.
+    mirror: Option<Vec<f32>>,
 }
 
 impl ProbabilityGrid {
@@ -103,6 +120,7 @@ impl ProbabilityGrid {
             limits: CellLimits { min: CellIndex::new(0, 0), width: 0, height: 0 },
             cells: Vec::new(),
             marked: Vec::new(),
+            mirror: Some(Vec::new()),
         }
     }
 
@@ -121,6 +139,17 @@ impl ProbabilityGrid {
         &self.cells
     }
 
+    /// The probabilities of [`values`](Self::values) as `f32`, while the grid is active
+    /// (not [frozen](Self::freeze)).
+    pub fn probabilities(&self) -> Option<&[f32]> {
+        self.mirror.as_deref()
+    }
+
+    /// Drops the `f32` mirror: the grid will not be matched against locally again.
+    pub fn freeze(&mut self) {
+        self.mirror = None;
+    }
+
     /// The probability of cell `(x, y)`; [`P_MIN`] when unknown or outside.
     #[inline]
     pub fn probability(&self, x: i64, y: i64) -> f32 {
@@ -128,6 +157,17 @@ impl ProbabilityGrid {
             Some(i) => value_to_probability(self.cells[i]),
             None => P_MIN,
         }
+    }
+
+    /// The index in [`values`](Self::values) of cell `(x, y)` when the `w × h` block of
+    /// cells from it lies wholly inside the grid, so a matcher may read the block's rows
+    /// as slices with no per-cell bounds check.
+    #[inline]
+    pub fn block_start(&self, x: i64, y: i64, w: usize, h: usize) -> Option<usize> {
+        let l = self.limits;
+        let (dx, dy) = (x.wrapping_sub(l.min.x), y.wrapping_sub(l.min.y));
+        (dx >= 0 && dy >= 0 && (dx as usize).checked_add(w)? <= l.width && (dy as usize).checked_add(h)? <= l.height)
+            .then(|| dy as usize * l.width + dx as usize)
     }
 
     /// True when cell `(x, y)` was ever updated.
@@ -171,6 +211,15 @@ impl ProbabilityGrid {
             let y = l.min.y + row as i64;
             let start = (y - ny0) as usize * w + (l.min.x - nx0) as usize;
             cells[start..start + l.width].copy_from_slice(src);
+        }
+        if let Some(old) = &self.mirror {
+            let mut mirror = vec![P_MIN; w * h];
+            for row in 0..l.height {
+                let y = l.min.y + row as i64;
+                let start = (y - ny0) as usize * w + (l.min.x - nx0) as usize;
+                mirror[start..start + l.width].copy_from_slice(&old[row * l.width..(row + 1) * l.width]);
+            }
+            self.mirror = Some(mirror);
         }
         self.cells = cells;
         self.limits = CellLimits { min: CellIndex::new(nx0, ny0), width: w, height: h };
@@ -223,7 +272,11 @@ impl ProbabilityGrid {
             }
         }
         for i in self.marked.drain(..) {
-            self.cells[i as usize] &= !MARK;
+            let v = self.cells[i as usize] & !MARK;
+            self.cells[i as usize] = v;
+            if let Some(m) = &mut self.mirror {
+                m[i as usize] = value_to_probability(v);
+            }
         }
     }
 }
@@ -238,6 +291,65 @@ mod tests {
             assert!((value_to_probability(probability_to_value(p)) - p).abs() < 1e-4);
         }
         assert_eq!(value_to_probability(0), P_MIN);
+    }
+
+    #[test]
+    fn floor_i64_is_floor_everywhere() {
+        for x in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.9999,
+            -2.0001,
+            1e18,
+            -1e18,
+            1e300,
+            -1e300,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ] {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
+        }
+    }
+
+    #[test]
+    fn blocks_are_inside_or_refused() {
+        let (hit, miss) = (UpdateTable::new(0.55), UpdateTable::new(0.49));
+        let mut g = ProbabilityGrid::new(0.1);
+        g.insert(Point2::new(0.0, 0.0), &[Point2::new(1.0, 1.0)], &[], &hit, &miss);
+        let l = g.limits();
+        let (x1, y1) = (l.min.x + l.width as i64, l.min.y + l.height as i64);
+        assert_eq!(g.block_start(l.min.x, l.min.y, l.width, l.height), Some(0));
+        assert_eq!(g.block_start(x1 - 3, y1 - 2, 3, 2), Some((l.height - 2) * l.width + l.width - 3));
+        assert_eq!(g.block_start(x1 - 2, y1 - 2, 3, 2), None);
+        assert_eq!(g.block_start(l.min.x - 1, l.min.y, 3, 2), None);
+        assert_eq!(g.block_start(i64::MAX, i64::MIN, 3, 2), None);
+        let i = g.block_start(10, 10, 1, 1).unwrap();
+        assert_eq!(value_to_probability(g.values()[i]), g.probability(10, 10));
+    }
+
+    #[test]
+    fn the_mirror_follows_every_update_and_growth_until_frozen() {
+        let (hit, miss) = (UpdateTable::new(0.55), UpdateTable::new(0.49));
+        let mut g = ProbabilityGrid::new(0.1);
+        let check = |g: &ProbabilityGrid| {
+            let m = g.probabilities().expect("active");
+            assert_eq!(m.len(), g.values().len());
+            assert!(g.values().iter().zip(m).all(|(&v, &p)| value_to_probability(v) == p));
+        };
+        g.insert(Point2::new(0.0, 0.0), &[Point2::new(1.0, 1.0)], &[], &hit, &miss);
+        check(&g);
+        g.insert(Point2::new(0.0, 0.0), &[Point2::new(-30.0, -20.0)], &[Point2::new(25.0, 40.0)], &hit, &miss);
+        g.insert(Point2::new(0.5, 0.0), &[Point2::new(1.0, 1.0)], &[Point2::new(-3.0, 2.0)], &hit, &miss);
+        check(&g);
+        g.freeze();
+        assert!(g.probabilities().is_none());
+        g.insert(Point2::new(0.0, 0.0), &[Point2::new(2.0, 1.0)], &[], &hit, &miss);
+        assert!(g.probabilities().is_none());
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //! the refinement chatter between cells. Hess et al. 2016 (§IV) interpolate bicubically
 //! for the same reason; Hector SLAM (Kohlbrecher et al. 2011) makes do with bilinear.
 
-use super::grid::ProbabilityGrid;
+use super::grid::{floor_i64, value_to_probability, ProbabilityGrid};
 
 /// Keys' kernel weights and their derivatives for fractional offset `t ∈ [0, 1)` from the
 /// second of four samples.
@@ -25,15 +25,40 @@ fn keys(t: f64) -> ([f64; 4], [f64; 4]) {
 #[inline]
 pub fn probability_and_gradient(grid: &ProbabilityGrid, u: f64, v: f64) -> (f64, f64, f64) {
     let (fu, fv) = (u - 0.5, v - 0.5);
-    let (i0, j0) = (fu.floor(), fv.floor());
-    let (wu, du) = keys(fu - i0);
-    let (wv, dv) = keys(fv - j0);
-    let (i0, j0) = (i0 as i64 - 1, j0 as i64 - 1);
+    let (i0, j0) = (floor_i64(fu), floor_i64(fv));
+    let (wu, du) = keys(fu - i0 as f64);
+    let (wv, dv) = keys(fv - j0 as f64);
+    let (i0, j0) = (i0 - 1, j0 - 1);
+    // The 4 × 4 samples; inside the grid (nearly always) straight from its rows.
+    let mut samples = [[0f64; 4]; 4];
+    let width = grid.limits().width;
+    match (grid.probabilities(), grid.block_start(i0, j0, 4, 4)) {
+        (Some(probabilities), Some(start)) => {
+            for (b, row) in samples.iter_mut().enumerate() {
+                for (s, &p) in row.iter_mut().zip(&probabilities[start + b * width..][..4]) {
+                    *s = p as f64;
+                }
+            }
+        }
+        (None, Some(start)) => {
+            for (b, row) in samples.iter_mut().enumerate() {
+                for (s, &v) in row.iter_mut().zip(&grid.values()[start + b * width..][..4]) {
+                    *s = value_to_probability(v) as f64;
+                }
+            }
+        }
+        (_, None) => {
+            for (b, row) in samples.iter_mut().enumerate() {
+                for (a, s) in row.iter_mut().enumerate() {
+                    *s = grid.probability(i0 + a as i64, j0 + b as i64) as f64;
+                }
+            }
+        }
+    }
     let (mut p, mut gu, mut gv) = (0.0, 0.0, 0.0);
-    for (b, (&wvb, &dvb)) in wv.iter().zip(&dv).enumerate() {
+    for ((&wvb, &dvb), row) in wv.iter().zip(&dv).zip(&samples) {
         let (mut row_w, mut row_d) = (0.0, 0.0);
-        for (a, (&wua, &dua)) in wu.iter().zip(&du).enumerate() {
-            let s = grid.probability(i0 + a as i64, j0 + b as i64) as f64;
+        for ((&wua, &dua), &s) in wu.iter().zip(&du).zip(row) {
             row_w += wua * s;
             row_d += dua * s;
         }

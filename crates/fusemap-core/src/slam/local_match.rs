@@ -16,7 +16,7 @@
 //!    corridor the curvature is nearly zero, so the match says nothing there: the ratio of
 //!    the smallest to the largest translational eigenvalue flags a degenerate match.
 
-use super::grid::ProbabilityGrid;
+use super::grid::{floor_i64, ProbabilityGrid};
 use super::interpolation::probability_and_gradient;
 use crate::geometry::{normalize_angle, Point2, Pose2};
 
@@ -81,14 +81,15 @@ pub fn mean_probability(grid: &ProbabilityGrid, points: &[Point2], pose: Pose2) 
         return 0.0;
     }
     let r = grid.resolution();
-    let s: f32 = points
+    let (s, c) = pose.theta.sin_cos();
+    let sum: f32 = points
         .iter()
-        .map(|p| {
-            let q = pose.transform_point(*p);
-            grid.probability((q.x / r).floor() as i64, (q.y / r).floor() as i64)
+        .map(|q| {
+            let (wx, wy) = (pose.x + c * q.x - s * q.y, pose.y + s * q.x + c * q.y);
+            grid.probability(floor_i64(wx / r), floor_i64(wy / r))
         })
         .sum();
-    s / points.len() as f32
+    sum / points.len() as f32
 }
 
 /// The correlative search: the best pose of the window around `predicted`.
@@ -107,20 +108,50 @@ pub fn correlative_search(
     let step = (1.0 - r * r / (2.0 * max_range * max_range)).clamp(-1.0, 1.0).acos().max(1e-4);
     let n_ang = (p.angular_window_rad / step).ceil() as i64;
     let n_lin = (p.linear_window_m / r).ceil() as i64;
-    let mut cells: Vec<(i64, i64)> = Vec::with_capacity(points.len());
+    let side = (2 * n_lin + 1) as usize;
+    // One sum per translation of the window, accumulated point by point: each point's
+    // `side × side` patch is a few contiguous rows of the grid, read once per heading and
+    // added eight lanes at a time from the active grid's `f32` mirror (lanes past `side`
+    // are read and ignored). Every sum still adds its points in scan order, so the scores
+    // are those of the textbook loop (translation outer, points inner) to the last bit.
+    const LANES: usize = 8;
+    let chunks = side.div_ceil(LANES);
+    let mut sums = vec![[0f32; LANES]; side * chunks];
+    let mirror = grid.probabilities();
+    let row_stride = grid.limits().width;
     let (mut best, mut best_score) = (predicted, f32::MIN);
     let inv_n = 1.0 / points.len().max(1) as f32;
     for a in -n_ang..=n_ang {
         let dtheta = a as f64 * step;
-        let rotated = Pose2::new(predicted.x, predicted.y, predicted.theta + dtheta);
-        cells.clear();
-        cells.extend(points.iter().map(|q| {
-            let w = rotated.transform_point(*q);
-            ((w.x / r).floor() as i64, (w.y / r).floor() as i64)
-        }));
+        let (s, c) = (predicted.theta + dtheta).sin_cos();
+        sums.iter_mut().for_each(|v| *v = [0.0; LANES]);
+        for q in points {
+            let (wx, wy) = (predicted.x + c * q.x - s * q.y, predicted.y + s * q.x + c * q.y);
+            let (cx, cy) = (floor_i64(wx / r), floor_i64(wy / r));
+            let (x0, y0) = (cx - n_lin, cy - n_lin);
+            match mirror.zip(grid.block_start(x0, y0, chunks * LANES, side)) {
+                Some((probabilities, start)) => {
+                    for (row, acc) in sums.chunks_exact_mut(chunks).enumerate() {
+                        let cells = &probabilities[start + row * row_stride..][..chunks * LANES];
+                        for (lanes, cells) in acc.iter_mut().zip(cells.chunks_exact(LANES)) {
+                            for (sum, &p) in lanes.iter_mut().zip(cells) {
+                                *sum += p;
+                            }
+                        }
+                    }
+                }
+                None => {
+                    for (row, acc) in sums.chunks_exact_mut(chunks).enumerate() {
+                        for (col, sum) in acc.as_flattened_mut()[..side].iter_mut().enumerate() {
+                            *sum += grid.probability(x0 + col as i64, y0 + row as i64);
+                        }
+                    }
+                }
+            }
+        }
         for dy in -n_lin..=n_lin {
             for dx in -n_lin..=n_lin {
-                let sum: f32 = cells.iter().map(|&(cx, cy)| grid.probability(cx + dx, cy + dy)).sum();
+                let sum = sums[(dy + n_lin) as usize * chunks..][..chunks].as_flattened()[(dx + n_lin) as usize];
                 let dist = ((dx * dx + dy * dy) as f64).sqrt() * r;
                 let penalty = (-(dist * p.translation_delta_cost + dtheta.abs() * p.rotation_delta_cost).powi(2)).exp();
                 let score = sum * inv_n * penalty as f32;
@@ -246,11 +277,12 @@ pub fn refine(grid: &ProbabilityGrid, points: &[Point2], start: Pose2, target: P
 /// `Σ (1 − M(T pᵢ))²` at `pose` (the unweighted map cost).
 fn map_cost(grid: &ProbabilityGrid, points: &[Point2], pose: Pose2) -> f64 {
     let inv_r = 1.0 / grid.resolution();
+    let (s, c) = pose.theta.sin_cos();
     points
         .iter()
         .map(|q| {
-            let w = pose.transform_point(*q);
-            let (m, _, _) = probability_and_gradient(grid, w.x * inv_r, w.y * inv_r);
+            let (wx, wy) = (pose.x + c * q.x - s * q.y, pose.y + s * q.x + c * q.y);
+            let (m, _, _) = probability_and_gradient(grid, wx * inv_r, wy * inv_r);
             (1.0 - m) * (1.0 - m)
         })
         .sum()

@@ -89,6 +89,7 @@ impl Submaps {
         {
             let i = self.active.remove(0);
             self.all[i].finished = true;
+            self.all[i].grid.freeze();
             finished = Some(i);
         }
         (into, finished)
