@@ -114,6 +114,7 @@ enum Command {
 }
 
 fn main() {
+    fusemap_core::slam::adopt_calling_thread();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo { out, config, corridor } => {

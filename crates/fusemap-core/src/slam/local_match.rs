@@ -16,8 +16,9 @@
 //!    corridor the curvature is nearly zero, so the match says nothing there: the ratio of
 //!    the smallest to the largest translational eigenvalue flags a degenerate match.
 
-use super::grid::{floor_i64, ProbabilityGrid};
+use super::grid::{floor_i64, ProbabilityGrid, P_MAX};
 use super::interpolation::probability_and_gradient;
+use super::parallel::{join, map_halves};
 use crate::geometry::{normalize_angle, Point2, Pose2};
 
 /// Parameters of one scan-to-submap match.
@@ -108,6 +109,45 @@ pub fn correlative_search(
     let step = (1.0 - r * r / (2.0 * max_range * max_range)).clamp(-1.0, 1.0).acos().max(1e-4);
     let n_ang = (p.angular_window_rad / step).ceil() as i64;
     let n_lin = (p.linear_window_m / r).ceil() as i64;
+    // The headings in two halves on two threads; the first half wins a tie, as the first
+    // heading does in one loop, so the result does not depend on the split.
+    // Each half is visited from the prediction's heading outwards, where the best scores
+    // are, so that the bound below cuts the far headings short.
+    let mid = -n_ang + (2 * n_ang + 1) / 2;
+    let search = |headings: Vec<i64>| search_headings(grid, points, predicted, p, Window { step, n_lin, headings });
+    let ((b1, s1), (b2, s2)) = join(|| search((-n_ang..mid).rev().collect()), || search((mid..=n_ang).collect()));
+    let (best, best_score) = if s2 > s1 { (b2, s2) } else { (b1, s1) };
+    (best.normalized(), best_score)
+}
+
+/// The candidate poses of one part of the correlative search: heading steps `headings`
+/// (in the order to visit them) of `step` radians, translations of up to `n_lin` cells.
+struct Window {
+    step: f64,
+    n_lin: i64,
+    headings: Vec<i64>,
+}
+
+/// Points added between two checks of a heading's bound.
+const BOUND_EVERY: usize = 32;
+
+/// The best pose of `w` around `predicted` and its score (`f32::MIN` when `w` is empty);
+/// of equal scores, the first in heading (lowest step), then row, then column order,
+/// whatever the order of visit.
+///
+/// A heading is given up part-way when even its best partial sum plus [`P_MAX`] for every
+/// point still to come, times the largest penalty of the heading, falls short of the best
+/// score so far (branch and bound on the points, Olson 2009 §IV's bound on a coarser
+/// axis): it cannot hold the best pose. The bound is inflated by the worst rounding of
+/// the `f32` sums, so the result is that of the full search to the bit.
+fn search_headings(
+    grid: &ProbabilityGrid,
+    points: &[Point2],
+    predicted: Pose2,
+    p: &LocalMatchParams,
+    w: Window,
+) -> (Pose2, f32) {
+    let (r, step, n_lin) = (grid.resolution(), w.step, w.n_lin);
     let side = (2 * n_lin + 1) as usize;
     // One sum per translation of the window, accumulated point by point: each point's
     // `side × side` patch is a few contiguous rows of the grid, read once per heading and
@@ -119,13 +159,24 @@ pub fn correlative_search(
     let mut sums = vec![[0f32; LANES]; side * chunks];
     let mirror = grid.probabilities();
     let row_stride = grid.limits().width;
-    let (mut best, mut best_score) = (predicted, f32::MIN);
+    let (mut best, mut best_score, mut best_a) = (predicted, f32::MIN, i64::MAX);
     let inv_n = 1.0 / points.len().max(1) as f32;
-    for a in -n_ang..=n_ang {
+    let cell_max = P_MAX * (1.0 + f32::EPSILON);
+    let rounding = 1.0 + 2.0 * points.len() as f32 * f32::EPSILON;
+    'headings: for a in w.headings {
         let dtheta = a as f64 * step;
         let (s, c) = (predicted.theta + dtheta).sin_cos();
+        // The heading's largest penalty: the candidate at the prediction's translation.
+        let top_penalty = (-(dtheta.abs() * p.rotation_delta_cost).powi(2)).exp() as f32 * (1.0 + f32::EPSILON);
         sums.iter_mut().for_each(|v| *v = [0.0; LANES]);
-        for q in points {
+        for (k, q) in points.iter().enumerate() {
+            if k > 0 && k % BOUND_EVERY == 0 && best_score > f32::MIN {
+                let top = sums.as_flattened().iter().fold(0f32, |m, &v| m.max(v));
+                let bound = (top + (points.len() - k) as f32 * cell_max) * rounding;
+                if bound * inv_n * top_penalty < best_score {
+                    continue 'headings;
+                }
+            }
             let (wx, wy) = (predicted.x + c * q.x - s * q.y, predicted.y + s * q.x + c * q.y);
             let (cx, cy) = (floor_i64(wx / r), floor_i64(wy / r));
             let (x0, y0) = (cx - n_lin, cy - n_lin);
@@ -155,15 +206,15 @@ pub fn correlative_search(
                 let dist = ((dx * dx + dy * dy) as f64).sqrt() * r;
                 let penalty = (-(dist * p.translation_delta_cost + dtheta.abs() * p.rotation_delta_cost).powi(2)).exp();
                 let score = sum * inv_n * penalty as f32;
-                if score > best_score {
-                    best_score = score;
+                if score > best_score || (score == best_score && a < best_a) {
+                    (best_score, best_a) = (score, a);
                     best =
                         Pose2::new(predicted.x + dx as f64 * r, predicted.y + dy as f64 * r, predicted.theta + dtheta);
                 }
             }
         }
     }
-    (best.normalized(), best_score)
+    (best, best_score)
 }
 
 /// Solves the 3×3 system `a x = b` (symmetric positive definite) by Cholesky.
@@ -199,10 +250,13 @@ fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
 fn map_system(grid: &ProbabilityGrid, points: &[Point2], pose: Pose2) -> ([[f64; 3]; 3], [f64; 3], f64) {
     let inv_r = 1.0 / grid.resolution();
     let (s, c) = pose.theta.sin_cos();
-    let (mut h, mut g, mut cost) = ([[0.0; 3]; 3], [0.0; 3], 0.0);
-    for q in points {
+    // The interpolation (nearly all of the work) on two threads, the sums in point order.
+    let samples = map_halves(points, |q| {
         let (wx, wy) = (pose.x + c * q.x - s * q.y, pose.y + s * q.x + c * q.y);
-        let (m, gu, gv) = probability_and_gradient(grid, wx * inv_r, wy * inv_r);
+        probability_and_gradient(grid, wx * inv_r, wy * inv_r)
+    });
+    let (mut h, mut g, mut cost) = ([[0.0; 3]; 3], [0.0; 3], 0.0);
+    for (q, &(m, gu, gv)) in points.iter().zip(&samples) {
         let res = 1.0 - m;
         // d res / d (x, y, θ) = −∇M · d(world)/d(pose), ∇M per metre.
         let (gx, gy) = (gu * inv_r, gv * inv_r);
@@ -347,23 +401,42 @@ pub fn match_information(
     let r = grid.resolution();
     let mean_range = points.iter().map(|q| q.x.hypot(q.y)).sum::<f64>() / points.len() as f64;
     let h = [0.5 * r, 0.5 * r, (0.5 * r / mean_range.max(r)).min(0.05)];
-    let at = |d: [f64; 3]| map_cost(grid, points, Pose2::new(pose.x + d[0], pose.y + d[1], pose.theta + d[2]));
-    let c0 = at([0.0; 3]);
+    // The 19 costs of the central differences (centre, ±1 along each axis, the four
+    // corners of each pair of axes), evaluated on two threads and read back in order.
     let unit = |i: usize, s: f64| {
         let mut d = [0.0; 3];
         d[i] = s * h[i];
         d
     };
+    let corner = |i: usize, j: usize, si: f64, sj: f64| {
+        let mut d = unit(i, si);
+        d[j] = sj * h[j];
+        d
+    };
+    let mut offsets = vec![[0.0; 3]];
+    for i in 0..3 {
+        offsets.extend([unit(i, 1.0), unit(i, -1.0)]);
+        for j in 0..i {
+            offsets.extend([
+                corner(i, j, 1.0, 1.0),
+                corner(i, j, 1.0, -1.0),
+                corner(i, j, -1.0, 1.0),
+                corner(i, j, -1.0, -1.0),
+            ]);
+        }
+    }
+    let costs =
+        map_halves(&offsets, |d| map_cost(grid, points, Pose2::new(pose.x + d[0], pose.y + d[1], pose.theta + d[2])));
+    let mut next = costs[1..].iter().copied();
+    let mut take = || next.next().expect("one cost per offset");
+    let c0 = costs[0];
     let mut hess = [[0.0; 3]; 3];
     for i in 0..3 {
-        hess[i][i] = (at(unit(i, 1.0)) - 2.0 * c0 + at(unit(i, -1.0))) / (h[i] * h[i]);
+        let (plus, minus) = (take(), take());
+        hess[i][i] = (plus - 2.0 * c0 + minus) / (h[i] * h[i]);
         for j in 0..i {
-            let d = |si: f64, sj: f64| {
-                let mut d = unit(i, si);
-                d[j] = sj * h[j];
-                at(d)
-            };
-            let v = (d(1.0, 1.0) - d(1.0, -1.0) - d(-1.0, 1.0) + d(-1.0, -1.0)) / (4.0 * h[i] * h[j]);
+            let (pp, pm, mp, mm) = (take(), take(), take(), take());
+            let v = (pp - pm - mp + mm) / (4.0 * h[i] * h[j]);
             hess[i][j] = v;
             hess[j][i] = v;
         }

@@ -20,6 +20,7 @@
 use super::global_match::{match_branch_and_bound, GlobalSearch};
 use super::grid_cache::GridCache;
 use super::local_match::{mean_probability, refine, LocalMatchParams};
+use super::parallel::{join, on_worker};
 use super::params::SlamParams;
 use super::pose_graph::{Edge, EdgeKind, Loss, OptimizeOptions, PoseGraph};
 use super::report::SlamReport;
@@ -180,7 +181,7 @@ impl Slam {
             _ => None,
         };
         let t0 = Instant::now();
-        let (local, outcome, information) = self.match_local(&hits, predicted, moving);
+        let (local, outcome, information) = on_worker(|| self.match_local(&hits, predicted, moving));
         self.recent = [self.recent[1], Some((scan.stamp, local))];
         self.report.matching_s += t0.elapsed().as_secs_f64();
         match outcome {
@@ -220,23 +221,30 @@ impl Slam {
         if hits.len() < self.p.min_points {
             return (predicted, ScanOutcome::Predicted, None);
         }
-        let mut m = super::local_match::match_scan(&submap.grid, hits, predicted, &self.p.local);
-        let mut predicted = predicted;
         // Outside half the search window of the track's prediction, the constant-velocity
-        // prediction is searched too, and kept only if its match is clearly better (mean
-        // probability higher by `moving_prediction_margin`): in a corridor both fit equally,
-        // and preferring the extrapolation there would feed its own slide back into the
-        // next prediction.
-        if let Some(alt) = moving {
-            let d = predicted.inverse().compose(alt);
-            if d.x.hypot(d.y) > 0.5 * self.p.local.linear_window_m
-                || d.theta.abs() > 0.5 * self.p.local.angular_window_rad
-            {
-                let m2 = super::local_match::match_scan(&submap.grid, hits, alt, &self.p.local);
-                if f64::from(m2.score) > f64::from(m.score) + self.p.moving_prediction_margin {
-                    self.report.moving_prediction_used += 1;
-                    (m, predicted) = (m2, alt);
-                }
+        // prediction is searched too (on the other thread), and kept only if its match is
+        // clearly better (mean probability higher by `moving_prediction_margin`): in a
+        // corridor both fit equally, and preferring the extrapolation there would feed its
+        // own slide back into the next prediction.
+        let local = &self.p.local;
+        let alt = moving.filter(|alt| {
+            let d = predicted.inverse().compose(*alt);
+            d.x.hypot(d.y) > 0.5 * local.linear_window_m || d.theta.abs() > 0.5 * local.angular_window_rad
+        });
+        let search = |at: Pose2| super::local_match::match_scan(&submap.grid, hits, at, local);
+        let (mut m, m2) = match alt {
+            Some(alt) => {
+                let (m, m2) = join(|| search(predicted), || search(alt));
+                (m, Some((m2, alt)))
+            }
+            None => (search(predicted), None),
+        };
+        let mut predicted = predicted;
+        if let Some((m2, alt)) = m2 {
+            self.report.moving_prediction_searched += 1;
+            if f64::from(m2.score) > f64::from(m.score) + self.p.moving_prediction_margin {
+                self.report.moving_prediction_used += 1;
+                (m, predicted) = (m2, alt);
             }
         }
         if m.degenerate {

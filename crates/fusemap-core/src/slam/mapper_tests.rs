@@ -183,6 +183,7 @@ fn odometry_that_jumps_is_left_out_and_the_scans_stay_on_the_truth() {
     let rep = &r.result.report;
     assert!(rep.odometry_edges_rejected >= 1, "{rep:?}");
     assert!(rep.moving_prediction_used >= 1, "{rep:?}");
+    assert!(rep.moving_prediction_searched >= rep.moving_prediction_used, "{rep:?}");
     assert!(mean < 0.05 && max < 0.15, "mean {mean}, max {max}");
 }
 

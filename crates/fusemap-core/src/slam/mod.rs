@@ -11,6 +11,7 @@
 //! | sparse pose-graph optimisation | `pose_graph.rs` |
 //! | the loop over scans | `mapper.rs` |
 //! | the corrected pose track | `corrected_track.rs` |
+//! | the matcher's exact two-way parallelism | `parallel.rs` |
 mod corrected_track;
 pub mod global_match;
 pub mod grid;
@@ -18,6 +19,7 @@ mod grid_cache;
 pub mod interpolation;
 pub mod local_match;
 mod mapper;
+mod parallel;
 mod params;
 pub mod pose_graph;
 mod report;
@@ -28,5 +30,6 @@ mod test_world;
 pub use corrected_track::CorrectedTrack;
 pub use local_match::LocalMatchParams;
 pub use mapper::{ScanInput, ScanOutcome, Slam, SlamResult};
+pub use parallel::adopt_calling_thread;
 pub use params::SlamParams;
 pub use report::SlamReport;

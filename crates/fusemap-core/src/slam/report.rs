@@ -18,6 +18,9 @@ pub struct SlamReport {
     pub without_track: u64,
     /// Scans refused (non-finite track pose or sensor origin).
     pub refused: u64,
+    /// Scans also matched from the constant-velocity prediction, because it lay outside
+    /// half the search window of the track's prediction.
+    pub moving_prediction_searched: u64,
     /// Scans matched from the constant-velocity prediction because it matched better than
     /// the track's (stalled or jumping odometry).
     pub moving_prediction_used: u64,

@@ -1,0 +1,74 @@
+//! Two-way fork–join for the scan matcher (rayon's work-stealing `join` with the `parallel`
+//! feature, the same calls one after the other without it).
+//!
+//! Only work whose result does not depend on how it is split goes through here: halves of
+//! an argmax whose ties are broken by order, independent cost evaluations collected in a
+//! fixed order. So a run's poses are the same to the bit on one thread or many.
+
+/// Runs `a` and `b`, in parallel when the `parallel` feature is on.
+#[inline]
+pub fn join<A, B, RA, RB>(a: A, b: B) -> (RA, RB)
+where
+    A: FnOnce() -> RA + Send,
+    B: FnOnce() -> RB + Send,
+    RA: Send,
+    RB: Send,
+{
+    #[cfg(feature = "parallel")]
+    {
+        rayon::join(a, b)
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        (a(), b())
+    }
+}
+
+/// Runs `f` on a worker of the thread pool, so that the [`join`]s inside it hand work to
+/// the other worker through its local queue; a `join` called from outside the pool
+/// instead sends both halves there and sleeps until they are done, which costs more than
+/// a small match saves. The caller's thread waits; results are those of `f()`.
+#[inline]
+pub fn on_worker<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    #[cfg(feature = "parallel")]
+    {
+        rayon::scope(|_| f())
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        f()
+    }
+}
+
+/// Makes the calling thread a worker of the global thread pool (call it first thing in
+/// `main`), so the matcher's [`join`]s from it are pushes onto its own queue rather than
+/// hand-offs to the pool and back. Without the `parallel` feature, or when the pool was
+/// already set up, it does nothing: the results are the same either way.
+pub fn adopt_calling_thread() {
+    #[cfg(feature = "parallel")]
+    {
+        let _ = rayon::ThreadPoolBuilder::new().use_current_thread().build_global();
+    }
+}
+
+/// `items.iter().map(f)` collected in order, the two halves computed by [`join`].
+pub fn map_halves<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    let (left, right) = items.split_at(items.len() / 2);
+    let (mut a, b) = join(|| left.iter().map(&f).collect::<Vec<R>>(), || right.iter().map(&f).collect::<Vec<R>>());
+    a.extend(b);
+    a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn halves_keep_the_order() {
+        let v: Vec<u32> = (0..11).collect();
+        assert_eq!(map_halves(&v, |x| x * 2), (0..11).map(|x| x * 2).collect::<Vec<_>>());
+        assert!(map_halves(&[] as &[u32], |x| *x).is_empty());
+        assert_eq!(join(|| 1, || "b"), (1, "b"));
+        assert_eq!(on_worker(|| join(|| 2, || 3)), (2, 3));
+    }
+}
