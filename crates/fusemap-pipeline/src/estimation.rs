@@ -19,13 +19,13 @@
 use crate::extrinsics::{frame_tree, from_tf, resolve};
 use crate::recording::{planar_covariance, Inventory};
 use crate::sensors::{Bound, BoundSensor};
-use crate::track::{ChosenTrack, Track, TrackCounts};
+use crate::track::{glitch_note, ChosenTrack, Track, TrackCounts};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SensorKind};
 use fusemap_core::estimator::{estimate, EstimatorConfig, EstimatorInput, FixQuality};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{geodetic::Datum, quaternion_yaw, Mount3, Point2, Pose2, Pose3};
-use fusemap_core::time::Stamp;
+use fusemap_core::time::{plausible_samples, Stamp};
 use fusemap_io::log::GnssMessage;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -65,6 +65,8 @@ pub struct Inputs {
     pub config: EstimatorConfig,
     /// Facts a user should know.
     pub notes: Vec<String>,
+    /// Odometry samples rejected as pose glitches.
+    pub odometry_glitches: u64,
 }
 
 fn offset(t: Stamp, s: &BoundSensor) -> Stamp {
@@ -104,6 +106,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
     let mut notes = Vec::new();
     let mut out = Vec::new();
     let mut gnss_reports = Vec::new();
+    let mut odometry_glitches = 0;
     let datum = shared_datum(inv, bound);
     let odometers: Vec<&str> =
         bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::WheelOdometry).map(|s| s.topic.as_str()).collect();
@@ -137,7 +140,15 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                 // The growth is in `odom`; the estimator takes the increment's covariance in
                 // the base frame at the start of the increment: rotated by Rᵀ(θ_prev).
                 let mut prev: Option<([[f64; 3]; 3], f64)> = None;
-                for m in &inv.odom[&s.topic] {
+                let msgs = &inv.odom[&s.topic];
+                let samples: Vec<(Stamp, Pose2)> = msgs.iter().map(|m| (offset(m.stamp, s), m.pose)).collect();
+                let keep = plausible_samples(&samples, &cfg.motion_limits());
+                let glitches = keep.iter().filter(|k| !**k).count() as u64;
+                if glitches > 0 {
+                    notes.push(glitch_note(&format!("odometry `{}`", s.topic), glitches, cfg));
+                }
+                odometry_glitches += glitches;
+                for (m, _) in msgs.iter().zip(&keep).filter(|(_, k)| **k) {
                     let increment = match (m.covariance, prev) {
                         (Some(c), Some((p, yaw))) if yaw.is_finite() => {
                             let mut d = [[0.0; 3]; 3];
@@ -227,7 +238,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
             SensorKind::Lidar | SensorKind::Camera => {}
         }
     }
-    Ok(Inputs { inputs: out, gnss: gnss_reports, config: est, notes })
+    Ok(Inputs { inputs: out, gnss: gnss_reports, config: est, notes, odometry_glitches })
 }
 
 /// One map frame for every GNSS sensor: the first configured datum, else the earliest good
@@ -330,7 +341,7 @@ fn gnss_inputs(
 
 /// Runs the estimator and its smoother over the log's pose sensors.
 pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<ChosenTrack, PipelineError> {
-    let Inputs { inputs, gnss, config, notes } = inputs(plan, inv, bound)?;
+    let Inputs { inputs, gnss, config, notes, odometry_glitches } = inputs(plan, inv, bound)?;
     let e = estimate(&inputs, &config).map_err(|e| PipelineError::Refused(format!("pose estimator: {e}")))?;
     let odom = bound.first(SensorKind::WheelOdometry);
     let names: Vec<String> =
@@ -347,6 +358,7 @@ pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Ch
         used: e.report.odometry.used as u64,
         duplicates: e.report.odometry.duplicate_stamps as u64,
         not_finite: e.report.odometry.not_finite as u64,
+        glitches: odometry_glitches,
         ..Default::default()
     };
     Ok(ChosenTrack {

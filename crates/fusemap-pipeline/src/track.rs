@@ -15,7 +15,7 @@ use crate::PipelineError;
 use fusemap_core::config::{LogConfig, PoseSource, SensorKind};
 use fusemap_core::frames::{FrameTree, LookupError};
 use fusemap_core::geometry::{Mount3, Pose2};
-use fusemap_core::time::{NoPose, PoseBuffer, PoseTrack, PushOutcome, Stamp, SyncMode};
+use fusemap_core::time::{plausible_samples, NoPose, PoseBuffer, PoseTrack, PushOutcome, Stamp, SyncMode};
 use serde::Serialize;
 
 /// Counters of the pose track.
@@ -31,6 +31,9 @@ pub struct TrackCounts {
     pub reordered: u64,
     /// NaN or infinite poses (a zero quaternion among them).
     pub not_finite: u64,
+    /// Pose glitches: samples implying a motion beyond `log.max_speed_m_s` or
+    /// `log.max_turn_rate_deg_s` from their neighbours, rejected.
+    pub glitches: u64,
 }
 
 /// Where scans get their poses.
@@ -146,13 +149,15 @@ pub fn count_reordered(stamps: impl IntoIterator<Item = Stamp>) -> u64 {
 }
 
 /// A buffer of `samples` put in stamp order (stable: equal stamps keep their log order, and
-/// the first one is used).
+/// the first one is used), pose glitches left out and counted.
 pub fn buffer_of(cfg: &LogConfig, samples: Vec<(Stamp, Pose2)>, counts: &mut TrackCounts) -> PoseBuffer {
     let mut buffer = PoseBuffer::new(cfg.max_pose_gap_s)
         .bridging_gaps(cfg.gap_bridge_motion_m, cfg.gap_bridge_motion_deg.to_radians());
     counts.samples += samples.len() as u64;
     counts.reordered += count_reordered(samples.iter().map(|s| s.0));
-    let mut samples = samples;
+    let keep = plausible_samples(&samples, &cfg.motion_limits());
+    counts.glitches += keep.iter().filter(|k| !**k).count() as u64;
+    let mut samples: Vec<(Stamp, Pose2)> = samples.into_iter().zip(keep).filter_map(|(s, k)| k.then_some(s)).collect();
     samples.sort_by_key(|s| s.0);
     for (stamp, pose) in samples {
         match buffer.push(stamp, pose) {
@@ -162,6 +167,18 @@ pub fn buffer_of(cfg: &LogConfig, samples: Vec<(Stamp, Pose2)>, counts: &mut Tra
         }
     }
     buffer
+}
+
+/// The note a run prints when `source` had pose glitches.
+pub fn glitch_note(source: &str, glitches: u64, cfg: &LogConfig) -> String {
+    format!(
+        "{source}: {glitches} pose sample(s) rejected as glitches, implying more than log.max_speed_m_s = {} m/s or log.max_turn_rate_deg_s = {} °/s from their neighbours",
+        cfg.max_speed_m_s, cfg.max_turn_rate_deg_s
+    )
+}
+
+fn glitch_notes(source: &str, counts: &TrackCounts, cfg: &LogConfig) -> Vec<String> {
+    (counts.glitches > 0).then(|| glitch_note(source, counts.glitches, cfg)).into_iter().collect()
 }
 
 /// Whether the log carries a sensor the estimator fuses beyond odometry.
@@ -259,11 +276,11 @@ pub fn choose(
                 source,
                 track: Track::Timed(Box::new(buffer)),
                 name: format!("odometry `{}`", o.topic),
+                notes: glitch_notes(&format!("odometry `{}`", o.topic), &counts, cfg),
                 counts,
                 stamps: msgs.iter().map(|m| m.stamp).collect(),
                 receive: msgs.iter().map(|m| m.receive_stamp).collect(),
                 estimator: None,
-                notes: Vec::new(),
                 slam: None,
             })
         }
@@ -303,11 +320,11 @@ pub fn choose(
                 source,
                 track: Track::Timed(Box::new(buffer)),
                 name: format!("TF `… → {}`", cfg.base_frame),
+                notes: glitch_notes(&format!("TF `… → {}`", cfg.base_frame), &counts, cfg),
                 counts,
                 receive: vec![None; stamps.len()],
                 stamps,
                 estimator: None,
-                notes: Vec::new(),
                 slam: None,
             })
         }

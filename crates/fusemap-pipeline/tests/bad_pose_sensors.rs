@@ -134,3 +134,50 @@ fn imu_orientation_is_used_when_the_message_provides_it() {
     assert!(e["headings"]["used"].as_u64().unwrap() > 1000, "{}", e["headings"]);
     assert_eq!(e["heading_init"]["source"]["kind"], "imu_heading", "{}", e["heading_init"]);
 }
+
+/// One odometry sample a kilometre off (a real driver glitch) is rejected and counted, on
+/// the odometry track and in the estimator's input alike: the map is the map of the same
+/// log without it, not one stretched to cover a kilometre.
+#[test]
+fn one_odometry_glitch_maps_like_the_log_without_it() {
+    use fusemap_core::config::{PoseSource, SlamMode};
+    use fusemap_core::grid::CellIndex;
+    use fusemap_core::metrics::Confusion;
+    let clean = short_run();
+    let mut glitched = clean.clone();
+    let mut odoms = 0;
+    for m in &mut glitched.messages {
+        if let SimMessage::Odometry(o) = m {
+            odoms += 1;
+            if odoms == 300 {
+                o.position[0] += 1000.0;
+            }
+        }
+    }
+    for (source, slam) in [(PoseSource::Odometry, SlamMode::Off), (PoseSource::Estimator, SlamMode::Off)] {
+        let mut cfg = Config::default();
+        cfg.log.pose_source = source;
+        cfg.slam.mode = slam;
+        let a = map(&clean, "glitch-clean", &cfg).expect("the clean log maps");
+        let b = map(&glitched, "glitch-one", &cfg).expect("the glitched log maps");
+        assert_eq!(a.report.pose_track.glitches, 0, "{source:?}");
+        assert_eq!(b.report.pose_track.glitches, 1, "{source:?}");
+        assert!(b.notes.iter().any(|n| n.contains("rejected as glitches")), "{:?}", b.notes);
+        let (ga, gb) = (a.engine.grid(), b.engine.grid());
+        let (ba, bb) = (ga.known_box().unwrap(), gb.known_box().unwrap());
+        assert!(
+            (ba.min.x - bb.min.x).abs() <= 2
+                && (ba.min.y - bb.min.y).abs() <= 2
+                && (ba.max.x - bb.max.x).abs() <= 2
+                && (ba.max.y - bb.max.y).abs() <= 2,
+            "{source:?}: {ba:?} vs {bb:?}"
+        );
+        let occupied = |g: &fusemap_core::grid::FusionGrid, c| g.log_odds(c).is_some_and(|l| l > 0.0);
+        let pairs = (ba.min.y..=ba.max.y)
+            .flat_map(|y| (ba.min.x..=ba.max.x).map(move |x| CellIndex::new(x, y)))
+            .map(|c| (occupied(ga, c), occupied(gb, c)));
+        let f1 = Confusion::from_pairs(pairs).f1();
+        println!("{source:?}: occupied cells F1 with and without the glitch {f1:.4}");
+        assert!(f1 > 0.98, "{source:?}: F1 {f1}");
+    }
+}

@@ -114,6 +114,11 @@ pub struct LogConfig {
     pub gap_bridge_motion_m: f64,
     /// … and turned at most this much, degrees.
     pub gap_bridge_motion_deg: f64,
+    /// A pose sample implying a faster motion than this (from its neighbours in stamp
+    /// order) is a glitch: rejected and counted, on every pose source. Metres per second.
+    pub max_speed_m_s: f64,
+    /// … or a faster turn than this, degrees per second.
+    pub max_turn_rate_deg_s: f64,
     /// Place each beam with the pose at its own time (needs `time_increment`).
     pub deskew: bool,
     /// Where the laser mount comes from.
@@ -130,6 +135,16 @@ pub struct LogConfig {
     pub reorder_window_s: f64,
 }
 
+impl LogConfig {
+    /// The pose-glitch limits (`max_speed_m_s`, `max_turn_rate_deg_s`).
+    pub fn motion_limits(&self) -> crate::time::MotionLimits {
+        crate::time::MotionLimits {
+            max_speed_m_s: self.max_speed_m_s,
+            max_turn_rate_rad_s: self.max_turn_rate_deg_s.to_radians(),
+        }
+    }
+}
+
 impl Default for LogConfig {
     fn default() -> Self {
         Self {
@@ -140,6 +155,8 @@ impl Default for LogConfig {
             max_pose_gap_s: 0.5,
             gap_bridge_motion_m: 0.05,
             gap_bridge_motion_deg: 2.0,
+            max_speed_m_s: 20.0,
+            max_turn_rate_deg_s: 720.0,
             deskew: true,
             extrinsics: ExtrinsicsSource::Auto,
             extrinsics_tolerance_m: 0.02,
@@ -332,6 +349,8 @@ impl Config {
         }
         for (name, v) in [
             ("log.max_pose_gap_s", g.max_pose_gap_s),
+            ("log.max_speed_m_s", g.max_speed_m_s),
+            ("log.max_turn_rate_deg_s", g.max_turn_rate_deg_s),
             ("log.extrinsics_tolerance_m", g.extrinsics_tolerance_m),
             ("log.extrinsics_tolerance_deg", g.extrinsics_tolerance_deg),
             ("log.far_delay_s", g.far_delay_s),

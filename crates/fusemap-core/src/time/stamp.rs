@@ -54,15 +54,23 @@ impl Stamp {
         self.0 as f64 * 1e-9
     }
 
-    /// `self - earlier` in seconds.
+    /// `self - earlier` in seconds, exact in the integer difference for any two stamps (a
+    /// 584-year gap between extreme stamps does not wrap round to a short one).
     pub fn secs_since(self, earlier: Stamp) -> f64 {
-        (self.0 - earlier.0) as f64 * 1e-9
+        (i128::from(self.0) - i128::from(earlier.0)) as f64 * 1e-9
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn differences_of_extreme_stamps_do_not_wrap() {
+        assert_eq!(Stamp(i64::MAX).secs_since(Stamp(i64::MIN)), (u64::MAX as f64) * 1e-9);
+        assert!(Stamp(i64::MIN).secs_since(Stamp(i64::MAX)) < -1.8e10);
+        assert_eq!(Stamp(3_000_000_000).secs_since(Stamp(1_000_000_000)), 2.0);
+    }
 
     #[test]
     fn conversions() {
