@@ -41,7 +41,7 @@ pub fn on_worker<R: Send>(f: impl FnOnce() -> R + Send) -> R {
 }
 
 /// Makes the calling thread a worker of the global thread pool (call it first thing in
-/// `main`), so the matcher's [`join`]s from it are pushes onto its own queue rather than
+/// `main`), so the matcher's joins from it are pushes onto its own queue rather than
 /// hand-offs to the pool and back. Without the `parallel` feature, or when the pool was
 /// already set up, it does nothing: the results are the same either way.
 pub fn adopt_calling_thread() {

@@ -39,7 +39,7 @@ impl MotionLimits {
 
 /// Which of `samples` to keep (`true`) when read in stamp order (equal stamps in the
 /// order given). Non-finite poses are left for the caller to refuse and never anchor a
-/// run. A stream with fewer than [`RUN`] finite samples is kept whole: nothing to judge by.
+/// run. A stream with fewer than `RUN` (3) finite samples is kept whole: nothing to judge by.
 pub fn plausible_samples(samples: &[(Stamp, Pose2)], limits: &MotionLimits) -> Vec<bool> {
     let mut keep = vec![true; samples.len()];
     let mut order: Vec<usize> = (0..samples.len()).filter(|&i| samples[i].1.is_finite()).collect();
