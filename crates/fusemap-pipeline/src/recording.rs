@@ -9,12 +9,12 @@
 //! plus one merge window of scans, whatever the number of scans.
 
 use fusemap_core::geometry::Pose2;
-use fusemap_core::time::Stamp;
+use fusemap_core::time::{plausible_samples, MotionLimits, Stamp};
 use fusemap_io::log::{
     CameraInfoMessage, GnssMessage, ImageMessage, ImuMessage, LogFormat, LogMessage, OdomMessage, PoseMessage,
     ReadOptions, ReadStats, ScanMessage, Transform,
 };
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -35,13 +35,43 @@ pub struct ScanTopic {
     /// The first (robot pose, laser pose) pair of a line that carries both (CARMEN
     /// `ROBOTLASER1`), from which the mount follows.
     pub first_laser_pose: Option<(Pose2, Pose2)>,
+    /// The finite poses on the scan lines in file order, each with its stamp (24 + 8
+    /// bytes a scan, for the pose-glitch check).
+    pub line_poses: Vec<(Stamp, Pose2)>,
 }
 
 impl ScanTopic {
+    /// The scan-line poses that are glitches (see [`plausible_samples`]), as
+    /// `(stamp, pose)` keys of [`line_key`]. The lines are judged in file order, the order
+    /// their poses are applied in (a stamp that goes backwards is taken as its
+    /// predecessor's).
+    pub fn line_glitches(&self, limits: &MotionLimits) -> HashSet<LineKey> {
+        let mut last = Stamp(i64::MIN);
+        let ordered: Vec<(Stamp, Pose2)> = self
+            .line_poses
+            .iter()
+            .map(|&(t, p)| {
+                last = last.max(t);
+                (last, p)
+            })
+            .collect();
+        let keep = plausible_samples(&ordered, limits);
+        self.line_poses.iter().zip(keep).filter(|(_, k)| !k).map(|(&(t, p), _)| line_key(t, p)).collect()
+    }
+
     /// The most common non-empty frame id.
     pub fn frame(&self) -> Option<&str> {
         self.frames.iter().filter(|(f, _)| !f.is_empty()).max_by_key(|(_, n)| **n).map(|(f, _)| f.as_str())
     }
+}
+
+/// A scan line's stamp and pose, bit for bit: how a rejected line is recognised again in
+/// the mapping pass.
+pub type LineKey = (i64, [u64; 3]);
+
+/// The [`LineKey`] of a line.
+pub fn line_key(t: Stamp, p: Pose2) -> LineKey {
+    (t.0, [p.x.to_bits(), p.y.to_bits(), p.theta.to_bits()])
 }
 
 /// What the first pass learnt about one image topic (headers only: pixels are read in the
@@ -240,6 +270,9 @@ impl Inventory {
                     *t.frames.entry(s.frame_id).or_default() += 1;
                     if let Some(p) = s.pose {
                         t.with_pose += 1;
+                        if p.is_finite() {
+                            t.line_poses.push((s.scan.stamp, p));
+                        }
                         if s.odom_pose == Some(p) {
                             t.pose_is_odometry += 1;
                         }

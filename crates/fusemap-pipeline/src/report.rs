@@ -20,6 +20,8 @@ pub struct Skipped {
     pub no_pose_within_tolerance: u64,
     /// No pose on the scan line.
     pub no_pose_on_line: u64,
+    /// The pose on the scan line is a glitch (`log.max_speed_m_s`, `max_turn_rate_deg_s`).
+    pub pose_glitch: u64,
     /// Arrived later than the merge's reorder window behind the other scans.
     pub late: u64,
 }
@@ -42,6 +44,7 @@ impl Skipped {
             + self.in_pose_gap
             + self.no_pose_within_tolerance
             + self.no_pose_on_line
+            + self.pose_glitch
             + self.late
     }
 
@@ -52,6 +55,7 @@ impl Skipped {
         self.in_pose_gap += o.in_pose_gap;
         self.no_pose_within_tolerance += o.no_pose_within_tolerance;
         self.no_pose_on_line += o.no_pose_on_line;
+        self.pose_glitch += o.pose_glitch;
         self.late += o.late;
     }
 }

@@ -11,7 +11,7 @@
 use crate::camera::{build_camera, MappedCamera};
 use crate::extrinsics::{frame_tree, lidar_mount_from_log, resolve, ExtrinsicsReport};
 use crate::merge::{OrderedMerge, Pushed};
-use crate::recording::{for_each_range_message, Inventory, RangeMessage};
+use crate::recording::{for_each_range_message, line_key, Inventory, LineKey, RangeMessage};
 use crate::report::{LidarReport, LogReport, Skipped};
 use crate::sensors::{bind, Bound, BoundLidar};
 use crate::track::{choose, count_reordered, ChosenTrack, Track};
@@ -25,7 +25,7 @@ use fusemap_core::measurement::{ObservationId, SensorId};
 use fusemap_core::sensor::{LaserScan, LidarModel};
 use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
 use fusemap_io::log::{LogFormat, ScanMessage};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
 use std::time::Instant;
 
@@ -147,6 +147,8 @@ struct Mapped {
     offset_ns: i64,
     stream: usize,
     report: LidarReport,
+    /// Scan lines whose pose is a glitch (a scan-line track only).
+    line_glitches: HashSet<LineKey>,
 }
 
 /// A bound lidar's frame, its resolved mount and its sensor model.
@@ -305,6 +307,10 @@ pub fn map_with_track(
                 time_offset_s: b.lidar.time_offset_s,
                 timing,
                 extrinsics: ext,
+            },
+            line_glitches: match chosen.track {
+                Track::ScanLine => topic.line_glitches(&cfg.motion_limits()),
+                Track::Timed(_) => HashSet::new(),
             },
         });
     }
@@ -605,6 +611,10 @@ impl Inserter<'_> {
                     l.report.scans_skipped.no_pose_on_line += 1;
                     return Ok(());
                 };
+                if l.line_glitches.contains(&line_key(stamp, pose)) {
+                    l.report.scans_skipped.pose_glitch += 1;
+                    return Ok(());
+                }
                 // Line poses do not depend on the stamp: applied in file order.
                 scan.stamp = self.last.map_or(stamp, |last| last.max(stamp));
                 self.engine.insert_scan_observed(l.id, id, scan, msg.range_min, msg.range_max, |_| pose)?;

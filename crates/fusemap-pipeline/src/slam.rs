@@ -12,7 +12,7 @@
 
 use crate::extrinsics::frame_tree;
 use crate::merge::{OrderedMerge, Pushed};
-use crate::recording::{for_each_range_message, Inventory, RangeMessage};
+use crate::recording::{for_each_range_message, line_key, Inventory, RangeMessage};
 use crate::run::{lidar_setup, sync_mode, Progress};
 use crate::sensors::Bound;
 use crate::track::{ChosenTrack, TfTrack, Track, TrackCounts};
@@ -140,6 +140,10 @@ pub fn run(
     let stamps = &inv.scans[&b.topic].stamps;
     let mode = sync_mode(cfg, stamps);
     let mut slam = Slam::new(plan.slam);
+    let line_glitches = match chosen.track {
+        Track::ScanLine => inv.scans[&b.topic].line_glitches(&cfg.motion_limits()),
+        Track::Timed(_) => Default::default(),
+    };
     // The track refuses to interpolate across its gaps (a map must not guess); a
     // prediction may: the match corrects it.
     let samples = match &chosen.track {
@@ -157,7 +161,9 @@ pub fn run(
     let mut feed = |t: Stamp, scan: ScanMessage| {
         progress(Progress::Advance(1));
         let pose = match &chosen.track {
-            Track::ScanLine => scan.pose.filter(|p| p.is_finite()),
+            Track::ScanLine => {
+                scan.pose.filter(|p| p.is_finite() && !line_glitches.contains(&line_key(scan.scan.stamp, *p)))
+            }
             Track::Timed(track) => track.pose_at(t, mode).ok().or_else(|| across_gap(&samples, t)),
         };
         if pose.is_none() {

@@ -244,15 +244,26 @@ pub fn choose(
                     "log.pose_source = \"scan_line\" but the scans carry no pose".into(),
                 ));
             }
+            // The mapping pass leaves the glitches out (`Skipped::pose_glitch`); counted here
+            // for the track's report.
+            for l in &bound.lidars {
+                let topic = &inv.scans[&l.topic];
+                counts.samples += topic.with_pose;
+                counts.used += topic.line_poses.len() as u64;
+                counts.not_finite += topic.with_pose - topic.line_poses.len() as u64;
+                let glitches = topic.line_glitches(&cfg.motion_limits()).len() as u64;
+                counts.used -= glitches;
+                counts.glitches += glitches;
+            }
             Ok(ChosenTrack {
                 source,
                 track: Track::ScanLine,
                 name: "pose on each scan line".into(),
+                notes: glitch_notes("pose on each scan line", &counts, cfg),
                 counts,
                 stamps: Vec::new(),
                 receive: Vec::new(),
                 estimator: None,
-                notes: Vec::new(),
                 slam: None,
             })
         }
