@@ -342,6 +342,46 @@ fn log_malformed_carmen_lines_are_skipped_and_counted() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A corrected CARMEN log (pose and odometry differ) whose line 13 carries a pose a
+/// kilometre off: the line is rejected as a pose glitch and counted, and the map is the
+/// map of the log without that line, byte for byte, not one stretched over a kilometre.
+#[test]
+fn log_carmen_pose_glitch_is_rejected_and_the_map_is_not_stretched() {
+    let dir = temp_dir("log-carmen-glitch");
+    let ranges = vec!["2.0"; 180].join(" ");
+    let line = |i: usize, dx: f64| {
+        let (x, t) = (0.05 * i as f64, 1.0 + 0.1 * i as f64);
+        format!("FLASER 180 {ranges} {:.2} 0 0 {:.2} 0.5 0 {t:.3} host {t:.3}", x + dx, x)
+    };
+    let glitched: Vec<String> = (0..40).map(|i| line(i, if i == 12 { 1000.0 } else { 0.0 })).collect();
+    let without: Vec<String> = (0..40).filter(|&i| i != 12).map(|i| line(i, 0.0)).collect();
+    let mut maps = Vec::new();
+    for (name, lines) in [("glitched", &glitched), ("without", &without)] {
+        let log = write_file(&dir, &format!("{name}.log"), lines.join("\n") + "\n");
+        let out = dir.join(name);
+        let o = run(&["map", "--out", path_str(&out), path_str(&log)]);
+        assert_success(&o);
+        let s = read_json(&out.join("summary.json"));
+        let glitches = &s["log"]["pose_track"]["glitches"];
+        let skipped = &s["log"]["lidars"][0]["scans_skipped"]["pose_glitch"];
+        if name == "glitched" {
+            assert_eq!(glitches, 1, "{}", s["log"]["pose_track"]);
+            assert_eq!(skipped, 1, "{}", s["log"]["lidars"][0]["scans_skipped"]);
+            assert_eq!(s["scans"], 39);
+            assert!(stdout(&o).contains("rejected as glitches"), "{}", stdout(&o));
+        } else {
+            assert_eq!(glitches, 0);
+        }
+        maps.push((
+            std::fs::read(out.join("map.pgm")).unwrap(),
+            std::fs::read_to_string(out.join("map.yaml")).unwrap(),
+        ));
+    }
+    assert_eq!(maps[0].1, maps[1].1, "the same origin and size");
+    assert!(maps[0].0 == maps[1].0, "the same cells");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Writes a bare MCAP (with the third-party `mcap` writer) holding one
 /// `sensor_msgs/msg/LaserScan` on `/scan` whose CDR encapsulation header is 00 00
 /// (big-endian).
