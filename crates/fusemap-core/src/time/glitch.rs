@@ -7,6 +7,12 @@
 //! implies. A few consecutive samples that agree with each other but not with what came
 //! before are a real discontinuity (an odometry reset, a relocalisation), not a glitch:
 //! a run of [`RUN`] mutually consistent samples is kept, a shorter one is rejected.
+//!
+//! Samples that share a stamp say nothing about speed: each is judged against the last
+//! sample of its run with an *earlier* stamp. A stream whose stamps are too coarse to
+//! tell its samples apart (the `%g`-printed stamps of some CARMEN logs, where hundreds of
+//! scans carry `1.13486e+09`) is therefore not judged where they coincide, rather than
+//! read as moving metres in no time.
 
 use super::Stamp;
 use crate::geometry::{normalize_angle, Pose2};
@@ -51,31 +57,61 @@ pub fn plausible_samples(samples: &[(Stamp, Pose2)], limits: &MotionLimits) -> V
     // joins `main` when consistent with its last sample, else `pending`, else starts a new
     // `pending` (the old one, too short, was a glitch). A `pending` run that reaches RUN
     // samples becomes `main`: a real jump; the old main is kept only if it was a run.
-    let mut main: Vec<usize> = Vec::new();
-    let mut pending: Vec<usize> = Vec::new();
-    let mut reject = |run: &[usize]| run.iter().for_each(|&i| keep[i] = false);
+    let mut main = Run::default();
+    let mut pending = Run::default();
+    let mut reject = |run: &Run| run.items.iter().for_each(|&i| keep[i] = false);
     for i in order {
-        let fits = |run: &[usize]| run.last().is_none_or(|&j| limits.plausible(samples[j], samples[i]));
+        let fits = |run: &Run| run.anchor(samples, i).is_none_or(|j| limits.plausible(samples[j], samples[i]));
         if fits(&main) {
-            main.push(i);
-        } else if !pending.is_empty() && fits(&pending) {
-            pending.push(i);
+            main.push(samples, i);
+        } else if !pending.items.is_empty() && fits(&pending) {
+            pending.push(samples, i);
         } else {
             reject(&pending);
-            pending = vec![i];
+            pending = Run::default();
+            pending.push(samples, i);
         }
-        if pending.len() >= RUN {
-            if main.len() < RUN {
+        if pending.items.len() >= RUN {
+            if main.items.len() < RUN {
                 reject(&main);
             }
             main = std::mem::take(&mut pending);
         }
     }
     reject(&pending);
-    if main.len() < RUN {
+    if main.items.len() < RUN {
         reject(&main);
     }
     keep
+}
+
+/// Samples in stamp order, with the last one whose stamp is before the newest one's.
+#[derive(Default)]
+struct Run {
+    items: Vec<usize>,
+    before_last: Option<usize>,
+}
+
+impl Run {
+    fn push(&mut self, samples: &[(Stamp, Pose2)], i: usize) {
+        if let Some(&j) = self.items.last() {
+            if samples[j].0 < samples[i].0 {
+                self.before_last = Some(j);
+            }
+        }
+        self.items.push(i);
+    }
+
+    /// The sample `i` (not earlier than any in the run) is judged against: the run's last
+    /// sample with an earlier stamp; `None` when every sample shares `i`'s stamp.
+    fn anchor(&self, samples: &[(Stamp, Pose2)], i: usize) -> Option<usize> {
+        let &j = self.items.last()?;
+        if samples[j].0 < samples[i].0 {
+            Some(j)
+        } else {
+            self.before_last
+        }
+    }
 }
 
 #[cfg(test)]
@@ -146,6 +182,24 @@ mod tests {
         s[11].1.x += 300.0;
         assert_eq!(rejected(&plausible_samples(&s, &LIMITS)), vec![11]);
         assert!(plausible_samples(&s[..2], &LIMITS).iter().all(|k| *k));
+    }
+
+    #[test]
+    fn samples_sharing_a_stamp_are_judged_against_the_last_earlier_one() {
+        // Stamps printed too coarsely to tell samples apart: metres between samples of one
+        // stamp are no glitch.
+        let s: Vec<_> = drive(200).into_iter().map(|(_, p)| (Stamp(1_134_860_000_000_000_000), p)).collect();
+        let s: Vec<_> = s.into_iter().map(|(t, p)| (t, Pose2::new(p.x * 40.0, p.y, p.theta * 20.0))).collect();
+        assert!(rejected(&plausible_samples(&s, &LIMITS)).is_empty());
+        // Repeated stamps: a far sample sharing its predecessor's stamp is still caught, and
+        // so is one sharing its successor's.
+        let mut s = drive(100);
+        for k in (0..100).step_by(2) {
+            s[k + 1].0 = s[k].0;
+        }
+        s[41].1.x += 500.0;
+        s[60].1.y -= 500.0;
+        assert_eq!(rejected(&plausible_samples(&s, &LIMITS)), vec![41, 60]);
     }
 
     proptest! {
