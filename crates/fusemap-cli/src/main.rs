@@ -1,6 +1,7 @@
 //! `fusemap`: multi-sensor occupancy-grid mapping.
 
 mod commands;
+mod export;
 mod output;
 mod progress;
 mod summary;
@@ -47,6 +48,10 @@ enum Command {
         out: PathBuf,
         /// The log, recognised by its content.
         log: Option<PathBuf>,
+        /// Export this region densely (metres: x0,y0,x1,y1) instead of everything observed;
+        /// also how to get a dense raster of part of a map past limits.export_cells.
+        #[arg(long, value_parser = export::parse_crop, allow_hyphen_values = true)]
+        crop: Option<export::Crop>,
     },
     /// Check a log's timing: rates, jitter, delays, stamps going backwards, gaps, and how
     /// many scans get a pose.
@@ -124,8 +129,8 @@ fn main() {
                 commands::demo::production(&out, config.as_deref())
             }
         }
-        Command::Map { config, world, out, log } => {
-            commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out)
+        Command::Map { config, world, out, log, crop } => {
+            commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out, crop)
         }
         Command::Doctor { config, log } => commands::doctor::run(config.as_deref(), &log),
         Command::Relations { relations, trajectory, tolerance_ms, json } => {

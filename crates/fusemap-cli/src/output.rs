@@ -1,6 +1,7 @@
 //! Writing a run's outputs: `map.npz`, `map.pgm` + `map.yaml`, `map.png`, `summary.json`.
 //! Every file is written atomically (temp file + rename) and never over an input.
 
+use crate::export::{view_of, ExportOptions, MapView};
 use crate::summary::{CellsUpdated, MapInfo, Summary};
 use anyhow::{Context, Result};
 use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells};
@@ -8,7 +9,7 @@ use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::grid::{CellBox, CellIndex, CellRaster, DynamicParams, FusionGrid, Raster};
 use fusemap_core::measurement::SensorId;
-use fusemap_core::metrics::map_entropy;
+use fusemap_core::metrics::{map_entropy, sparse_entropy};
 use fusemap_core::sensor::ReturnCounts;
 use fusemap_core::time::Stamp;
 use fusemap_io::atomic::{ensure_not_input, write_atomic};
@@ -95,13 +96,18 @@ pub struct Layers {
     pub dynamic: CellRaster<f32>,
 }
 
+/// The engine's first camera model, if it has one.
+fn camera_of(engine: &Engine) -> Option<&fusemap_core::sensor::camera::CameraModel> {
+    (0..u16::MAX)
+        .map(SensorId)
+        .take_while(|&id| engine.sensor_kind(id).is_some())
+        .find_map(|id| engine.camera_model(id))
+}
+
 /// The layers of `grid` over `raster`'s cells when the engine has a camera (its class
 /// table names the classes), `None` otherwise.
 pub fn layers_of(engine: &Engine, grid: &FusionGrid, raster: &Raster) -> Option<Layers> {
-    let camera = (0..u16::MAX)
-        .map(SensorId)
-        .take_while(|&id| engine.sensor_kind(id).is_some())
-        .find_map(|id| engine.camera_model(id))?;
+    let camera = camera_of(engine)?;
     let classes = camera.classes();
     let area = CellBox {
         min: raster.first_cell,
@@ -126,11 +132,10 @@ pub fn layers_of(engine: &Engine, grid: &FusionGrid, raster: &Raster) -> Option<
     Some(Layers { semantic, dynamic })
 }
 
-/// Writes the map files (if anything is known), the trajectory (when there is one) and
-/// the summary.
+/// Writes the map files of `view`, the trajectory (when there is one) and the summary.
 pub fn write(
     files: &OutputFiles,
-    raster: Option<&Raster>,
+    view: &MapView,
     layers: Option<&Layers>,
     summary: &Summary,
     trajectory: Option<&[(Stamp, Pose2)]>,
@@ -141,17 +146,23 @@ pub fn write(
     // Files of an earlier run into the same directory that this run does not write are
     // removed first: a run never leaves files beside its summary that look like its own.
     let graph = summary.log.as_ref().and_then(pose_graph_of);
+    let dense = match view {
+        MapView::Dense(r) => Some(r),
+        _ => None,
+    };
     let mut stale: Vec<&PathBuf> = Vec::new();
     if trajectory.is_none() {
         stale.push(&files.trajectory);
     }
-    if raster.is_none() {
-        stale.extend([&files.npz, &files.yaml, &files.pgm, &files.png]);
+    match view {
+        MapView::Empty => stale.extend([&files.npz, &files.yaml, &files.pgm, &files.png]),
+        MapView::Sparse { .. } => stale.extend([&files.yaml, &files.pgm]),
+        MapView::Dense(_) => {}
     }
-    if raster.is_none() || layers.is_none() {
+    if dense.is_none() || layers.is_none() {
         stale.extend([&files.semantic, &files.semantic_png, &files.dynamic]);
     }
-    if raster.is_none() || graph.is_none() {
+    if dense.is_none() || graph.is_none() {
         stale.push(&files.slam);
     }
     for f in stale {
@@ -162,7 +173,11 @@ pub fn write(
             _ => {}
         }
     }
-    if let Some(r) = raster {
+    if let MapView::Sparse { tiles, overview, .. } = view {
+        fusemap_io::npz::write_sparse_map_npz(&files.npz, tiles)?;
+        fusemap_io::picture::write_map_png(&files.png, overview)?;
+    }
+    if let Some(r) = dense {
         match layers {
             Some(l) => {
                 let with = NpzLayers { semantic: Some(&l.semantic), dynamic: Some(&l.dynamic) };
@@ -214,21 +229,27 @@ fn pose_graph_of(log: &serde_json::Value) -> Option<GraphPicture> {
     Some((trajectory, closures))
 }
 
-/// Builds the summary of a finished engine and writes every output.
+/// Builds the summary of a finished engine and writes every output: the view of the map
+/// `export` asks for (see [`view_of`]).
 #[allow(clippy::too_many_arguments)]
 pub fn finish(
     engine: &Engine,
     files: &OutputFiles,
+    export: &ExportOptions,
     source_kind: &str,
     source: &str,
     started: Instant,
-    notes: Vec<String>,
+    mut notes: Vec<String>,
     log: Option<serde_json::Value>,
     trajectory: Option<&[(Stamp, Pose2)]>,
 ) -> Result<Summary> {
     let grid = engine.grid();
-    let raster = grid.known_raster();
-    let layers = raster.as_ref().and_then(|r| layers_of(engine, grid, r));
+    let view = view_of(grid, export, &mut notes)?;
+    let raster = match &view {
+        MapView::Dense(r) => Some(r),
+        _ => None,
+    };
+    let layers = raster.and_then(|r| layers_of(engine, grid, r));
     let st = engine.stats();
     let mut returns = ReturnCounts::default();
     let mut scans = 0;
@@ -236,6 +257,23 @@ pub fn finish(
         returns.add(&s.returns);
         scans += s.scans;
     }
+    let (map, entropy) = match &view {
+        MapView::Empty => (MapInfo::new(None, grid.geometry().resolution(), grid.tile_count()), None),
+        MapView::Dense(r) => {
+            (MapInfo::new(Some(r), grid.geometry().resolution(), grid.tile_count()), Some(map_entropy(r)))
+        }
+        MapView::Sparse { tiles, area, .. } => {
+            let cells = area.width() as u64 * area.height() as u64;
+            let info = MapInfo {
+                resolution: grid.geometry().resolution(),
+                origin: [grid.geometry().cell_corner(area.min).x, grid.geometry().cell_corner(area.min).y],
+                width: area.width(),
+                height: area.height(),
+                tiles: grid.tile_count(),
+            };
+            (info, Some(sparse_entropy(tiles, cells, grid.table().prior)))
+        }
+    };
     let mut summary = Summary {
         fusemap_version: env!("CARGO_PKG_VERSION"),
         source_kind: source_kind.to_string(),
@@ -248,17 +286,20 @@ pub fn finish(
         cell_visits: st.insert.cell_visits,
         cell_visits_attenuated: st.insert.cell_visits_attenuated,
         cells_updated: CellsUpdated::from(&st.insert),
-        map: MapInfo::new(raster.as_ref(), grid.geometry().resolution(), grid.tile_count()),
-        entropy: raster.as_ref().map(map_entropy),
+        map,
+        entropy,
         wall_time_s: 0.0,
         notes,
         log,
     };
-    if raster.is_none() {
+    if matches!(view, MapView::Empty) {
         summary.notes.push("no cell was observed: only summary.json was written".into());
     }
+    if matches!(view, MapView::Sparse { .. }) && camera_of(engine).is_some() {
+        summary.notes.push("the semantic and dynamic layers are written only with a dense map (--crop)".into());
+    }
     summary.wall_time_s = started.elapsed().as_secs_f64();
-    write(files, raster.as_ref(), layers.as_ref(), &summary, trajectory)?;
+    write(files, &view, layers.as_ref(), &summary, trajectory)?;
     summary.wall_time_s = started.elapsed().as_secs_f64();
     Ok(summary)
 }

@@ -79,9 +79,19 @@ struct TrackSync {
     nearest_tolerance_s: f64,
 }
 
-/// The doctor's report as text (deterministic, for snapshot tests).
-pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
-    let log = Inventory::read(path)?;
+/// What the doctor found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    /// The report as text (deterministic, for snapshot tests).
+    pub text: String,
+    /// Why `fusemap map` would refuse the log, when it would: a script running the doctor
+    /// must see that as a failure, not only read it in the findings.
+    pub refusal: Option<String>,
+}
+
+/// The doctor's report on the log at `path`.
+pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
+    let log = Inventory::read_with(path, plan.limits.decompressed_bytes())?;
     let cfg = &plan.log;
     let limits = limits(cfg);
     let mut out = String::new();
@@ -163,9 +173,10 @@ pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
     let mut notes = Vec::new();
     let mut findings: Vec<String> = Vec::new();
     let mut sync = None;
+    let mut refusal = None;
     match crate::run::prepare_track(plan, &log) {
         Ok((bound, _, _)) if bound.lidars.is_empty() => {
-            findings.push("cannot be mapped: every [[sensor]] of kind lidar is disabled".into())
+            refusal = Some("every [[sensor]] of kind lidar is disabled".to_string());
         }
         Ok((bound, chosen, _)) => {
             notes.extend(bound.notes.iter().cloned());
@@ -220,7 +231,10 @@ pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
             }
             notes.extend(chosen.notes.iter().cloned());
         }
-        Err(e) => findings.push(format!("cannot be mapped: {e}")),
+        Err(e) => refusal = Some(e.to_string()),
+    }
+    if let Some(why) = &refusal {
+        findings.push(format!("cannot be mapped: {why}"));
     }
 
     crate::pose_sensors_report::gnss_quality(&log, &mut out, &mut findings)?;
@@ -347,5 +361,5 @@ pub fn report(plan: &Plan, path: &Path) -> Result<String, PipelineError> {
     for f in findings {
         writeln!(out, "- {f}")?;
     }
-    Ok(out)
+    Ok(Report { text: out, refusal })
 }

@@ -182,6 +182,9 @@ impl From<&ImuMessage> for ImuSample {
 pub struct Inventory {
     /// The file.
     pub path: PathBuf,
+    /// The most bytes one chunk, message or line may inflate to, for every pass over the
+    /// file (`[limits] decompressed_mib`).
+    pub max_decompressed_bytes: u64,
     /// Its format.
     pub format: LogFormat,
     /// Scan topics.
@@ -238,13 +241,21 @@ fn merged_stats(reader: &ReadStats, undecodable: ReadStats) -> ReadStats {
 }
 
 impl Inventory {
-    /// The first pass over `path`.
+    /// The first pass over `path`, with the default decompression limit.
     pub fn read(path: &Path) -> fusemap_io::Result<Inventory> {
+        Self::read_with(path, fusemap_io::log::DEFAULT_MAX_DECOMPRESSED_BYTES)
+    }
+
+    /// The first pass over `path`; no chunk, message or line may inflate past
+    /// `max_decompressed_bytes`, in this pass or the later ones.
+    pub fn read_with(path: &Path, max_decompressed_bytes: u64) -> fusemap_io::Result<Inventory> {
         let t0 = Instant::now();
-        let opened = fusemap_io::log::open_log(path)?;
+        let options = ReadOptions { max_decompressed_bytes, ..ReadOptions::default() };
+        let opened = fusemap_io::log::open_log_with(path, &options)?;
         let mut reader = opened.reader;
         let mut inv = Inventory {
             path: path.to_path_buf(),
+            max_decompressed_bytes,
             format: opened.format,
             scans: BTreeMap::new(),
             images: BTreeMap::new(),
@@ -399,22 +410,26 @@ pub fn for_each_scan(
     topics: &[String],
     mut f: impl FnMut(ScanMessage) -> Result<(), crate::PipelineError>,
 ) -> Result<f64, crate::PipelineError> {
-    for_each_range_message(path, topics, &[], |m| match m {
+    let limit = fusemap_io::log::DEFAULT_MAX_DECOMPRESSED_BYTES;
+    for_each_range_message(path, limit, topics, &[], |m| match m {
         RangeMessage::Scan(s) => f(s),
         RangeMessage::Image(_) => Ok(()),
     })
 }
 
 /// The second pass over scans of `scan_topics` and images of `image_topics` (with their
-/// pixels; other images are not decoded), in log order.
+/// pixels; other images are not decoded), in log order; nothing inflates past
+/// `max_decompressed_bytes`.
 pub fn for_each_range_message(
     path: &Path,
+    max_decompressed_bytes: u64,
     scan_topics: &[String],
     image_topics: &[String],
     mut f: impl FnMut(RangeMessage) -> Result<(), crate::PipelineError>,
 ) -> Result<f64, crate::PipelineError> {
     let t0 = Instant::now();
-    let options = ReadOptions::with_image_topics(image_topics.iter().cloned());
+    let options =
+        ReadOptions { max_decompressed_bytes, ..ReadOptions::with_image_topics(image_topics.iter().cloned()) };
     let opened = fusemap_io::log::open_log_with(path, &options)?;
     let mut reader = opened.reader;
     let mut ignored = ReadStats::default();

@@ -5,6 +5,7 @@
 //! document's §3.3 corridor instead.
 
 use crate::commands::map::run_simulated;
+use crate::export::ExportOptions;
 use crate::output::{self, finish, layers_of, OutputFiles};
 use crate::progress;
 use anyhow::{Context, Result};
@@ -35,6 +36,7 @@ pub fn corridor(out: &Path, config: Option<&Path>) -> Result<()> {
     let inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
     let summary = run_simulated(
         &plan,
+        &ExportOptions { crop: None, export_cells: plan.limits.export_cells },
         &fusemap_core::sim::corridor(),
         &ScannerSpec::document(),
         run.poses,
@@ -86,6 +88,7 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     let summary = finish(
         &run.engine,
         &files,
+        &ExportOptions { crop: None, export_cells: plan.limits.export_cells },
         "rosbag2 (simulated production line)",
         &source,
         started,

@@ -4,13 +4,19 @@ use anyhow::Result;
 use fusemap_core::config::Config;
 use std::path::Path;
 
-/// `fusemap doctor`.
+/// `fusemap doctor`: the report on stdout; a log `fusemap map` would refuse exits
+/// non-zero with the reason.
 pub fn run(config: Option<&Path>, path: &Path) -> Result<()> {
     let cfg = match config {
         Some(p) => fusemap_io::config_file::load_config(p)?,
         None => Config::default(),
     };
     let plan = cfg.validate().map_err(|e| anyhow::anyhow!("configuration: {e}"))?;
-    print!("{}", fusemap_pipeline::doctor::report(&plan, path)?);
-    Ok(())
+    let report = fusemap_pipeline::doctor::report(&plan, path)?;
+    print!("{}", report.text);
+    match report.refusal {
+        // The report is printed whole; the exit status says what a script needs to know.
+        Some(why) => anyhow::bail!("{} cannot be mapped: {why}", path.display()),
+        None => Ok(()),
+    }
 }

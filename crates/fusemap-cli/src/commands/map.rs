@@ -1,5 +1,6 @@
 //! `fusemap demo` and `fusemap map`: build a map and write its outputs.
 
+use crate::export::{Crop, ExportOptions};
 use crate::output::{self, finish};
 use crate::progress;
 use crate::summary::Summary;
@@ -15,6 +16,7 @@ use std::time::Instant;
 /// An engine with the plan's grid and lidars.
 pub fn engine_for(plan: &Plan) -> Engine {
     let mut engine = Engine::new(FusionGrid::new(plan.geometry, plan.occupancy));
+    engine.set_map_cells_limit(&plan.limits);
     for l in &plan.lidars {
         engine.add_lidar(l.name.clone(), l.model);
     }
@@ -22,8 +24,10 @@ pub fn engine_for(plan: &Plan) -> Engine {
 }
 
 /// Maps a simulated run of `world` with `scanner` along `poses`.
+#[allow(clippy::too_many_arguments)]
 pub fn run_simulated(
     plan: &Plan,
+    export: &ExportOptions,
     world: &World,
     scanner: &ScannerSpec,
     poses: Vec<Pose2>,
@@ -41,31 +45,43 @@ pub fn run_simulated(
             let mount = plan.lidars[k].model.mount();
             let stamp = fusemap_core::time::Stamp::from_secs_f64(i as f64 / scanner.rate_hz).unwrap_or_default();
             let scan = fusemap_core::sim::simulate_scan(world, scanner, mount, *pose, stamp);
-            engine.insert_scan(*id, &scan, *pose)?;
+            // The engine's refusals (a map past limits.map_cells) name the world file.
+            engine.insert_scan(*id, &scan, *pose).map_err(|e| anyhow::anyhow!("{source}: scan {i}: {e}"))?;
         }
         pb.inc(1);
     }
     pb.finish_and_clear();
-    finish(&engine, &files, "world", source, started, Vec::new(), None, None)
+    finish(&engine, &files, export, "world", source, started, Vec::new(), None, None)
 }
 
-/// `fusemap map`: a world file (simulated) or a robot log.
-pub fn map(config: Option<&Path>, world: Option<&Path>, log: Option<&Path>, out: &Path) -> Result<()> {
+/// `fusemap map`: a world file (simulated) or a robot log; `crop` exports that region
+/// densely.
+pub fn map(
+    config: Option<&Path>,
+    world: Option<&Path>,
+    log: Option<&Path>,
+    out: &Path,
+    crop: Option<Crop>,
+) -> Result<()> {
     let cfg = match config {
         Some(p) => fusemap_io::config_file::load_config(p)?,
         None => Config::default(),
     };
     let plan = cfg.validate().map_err(|e| anyhow::anyhow!("configuration: {e}"))?;
+    let export = ExportOptions { crop, export_cells: plan.limits.export_cells };
+    if let Some(c) = &crop {
+        crate::export::crop_area(&plan.geometry, c, export.export_cells)?;
+    }
     let mut inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
     let summary = match (world, log) {
         (Some(w), None) => {
             inputs.push(w.to_path_buf());
             let wf = fusemap_io::world_file::load_world(w)?;
-            run_simulated(&plan, &wf.world, &wf.scanner, wf.poses, out, &w.display().to_string(), &inputs)?
+            run_simulated(&plan, &export, &wf.world, &wf.scanner, wf.poses, out, &w.display().to_string(), &inputs)?
         }
         (None, Some(l)) => {
             inputs.push(l.to_path_buf());
-            run_log(&plan, l, out, &inputs)?
+            run_log(&plan, &export, l, out, &inputs)?
         }
         (Some(_), Some(_)) => bail!("give either --world FILE or a LOG, not both"),
         (None, None) => {
@@ -88,15 +104,20 @@ pub fn map(config: Option<&Path>, world: Option<&Path>, log: Option<&Path>, out:
 }
 
 /// Maps a robot log through the pipeline and writes the outputs.
-fn run_log(plan: &Plan, path: &Path, out: &Path, inputs: &[PathBuf]) -> Result<Summary> {
+fn run_log(plan: &Plan, export: &ExportOptions, path: &Path, out: &Path, inputs: &[PathBuf]) -> Result<Summary> {
     let started = Instant::now();
     let files = output::prepare(out, inputs)?;
     // fusemap-io errors already name the file (and the line or message): no context.
-    let run = fusemap_pipeline::map_log(plan, path, &mut progress::reporter())?;
+    // The engine's refusals (a map past limits.map_cells) do not know the file: named here.
+    let run = fusemap_pipeline::map_log(plan, path, &mut progress::reporter()).map_err(|e| match e {
+        fusemap_pipeline::PipelineError::Engine(e) => anyhow::anyhow!("{}: {e}", path.display()),
+        other => other.into(),
+    })?;
     let value = serde_json::to_value(&run.report)?;
     finish(
         &run.engine,
         &files,
+        export,
         &run.format.to_string(),
         &path.display().to_string(),
         started,

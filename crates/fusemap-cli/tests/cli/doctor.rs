@@ -40,3 +40,25 @@ fn doctor_mit_csail_clf() {
     let Some(clf) = fusemap_io::testdata::dataset("mit-csail-raw/mit-csail.clf") else { return };
     insta::assert_snapshot!(doctor(&clf));
 }
+
+/// A log `fusemap map` refuses (odometry and no scan): the doctor prints its report and
+/// exits non-zero with the same reason, so a script cannot take it for a healthy log.
+#[test]
+fn doctor_fails_on_a_log_map_would_refuse() {
+    let dir = crate::util::temp_dir("doctor-no-scans");
+    let log = crate::util::write_file(
+        &dir,
+        "odometry-only.log",
+        "ODOM 0.0 0.0 0.0 0.0 0.0 0.0 100.0 host 0.0\nODOM 0.1 0.0 0.0 0.0 0.0 0.0 100.1 host 0.1\n",
+    );
+    let o = run(&["doctor", log.to_str().unwrap()]);
+    let (out, err) = (stdout(&o), stderr(&o));
+    assert!(!o.status.success(), "{out}");
+    assert!(out.contains("- cannot be mapped:") && !out.contains("no clock faults found"), "{out}");
+    assert!(
+        err.starts_with("error: ") && err.contains("cannot be mapped") && err.contains("odometry-only.log"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

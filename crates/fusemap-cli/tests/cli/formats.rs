@@ -62,6 +62,7 @@ fn raw(npz: &Path, name: &str) -> (Vec<usize>, Vec<u8>) {
         NpyValues::F32(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
         NpyValues::F64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
         NpyValues::I32(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+        NpyValues::I64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
         NpyValues::I16(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
         NpyValues::Bool(v) => v.iter().map(|&b| u8::from(b)).collect(),
         NpyValues::U8(v) => v,

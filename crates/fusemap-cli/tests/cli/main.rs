@@ -5,6 +5,7 @@ mod bad_input;
 mod demo;
 mod doctor;
 mod formats;
+mod limits;
 mod real_logs;
 mod relations;
 mod scenario_demo;

@@ -8,11 +8,13 @@
 
 mod camera;
 mod fusion;
+mod limits;
 mod sensor;
 mod slam;
 
 pub use camera::{default_camera, ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
 pub use fusion::FusionConfig;
+pub use limits::LimitsConfig;
 pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 pub use slam::{SlamConfig, SlamMode};
 
@@ -44,6 +46,9 @@ pub struct Config {
     /// Scan matching, submaps and loop closure.
     #[serde(default)]
     pub slam: SlamConfig,
+    /// Resource budgets: map cells, cells per ray, cells of a dense export.
+    #[serde(default)]
+    pub limits: LimitsConfig,
     /// The semantic classes of the cameras' label images, one `[[class]]` table each;
     /// none: [`ClassTable::production_default`].
     #[serde(default)]
@@ -273,6 +278,8 @@ pub struct Plan {
     pub slam_mode: SlamMode,
     /// SLAM's parameters (from `[slam]`).
     pub slam: crate::slam::SlamParams,
+    /// The resource budgets (`[limits]`).
+    pub limits: LimitsConfig,
 }
 
 impl Config {
@@ -380,6 +387,20 @@ impl Config {
         })?;
         let dynamic = self.fusion.validate(occ_t)?;
         let slam = self.slam.validate()?;
+        let limits = self.limits;
+        limits.validate()?;
+        for (i, l) in lidars.iter().enumerate() {
+            limits.check_ray(
+                &lidar_key(&self.sensor, i, "max_range"),
+                l.model.params().max_range,
+                "map.resolution",
+                res,
+            )?;
+        }
+        for (i, c) in cameras.iter().enumerate() {
+            limits.check_ray(&camera_key(&self.sensor, i), c.params.max_depth_m, "map.resolution", res)?;
+        }
+        limits.check_ray("slam.max_range_m", slam.max_range_m, "slam.resolution_m", slam.resolution)?;
         for (i, group) in self.fusion.correlated.iter().enumerate() {
             for name in group {
                 let known = lidars.iter().any(|l| &l.name == name)
@@ -404,7 +425,27 @@ impl Config {
             dynamic,
             slam_mode: self.slam.mode,
             slam,
+            limits,
         })
+    }
+}
+
+/// The key of the `i`-th planned lidar's `key` (`sensor[2].max_range`), or the default
+/// lidar's (no `[[sensor]] kind = "lidar"` listed).
+fn lidar_key(tables: &[SensorConfig], i: usize, key: &str) -> String {
+    let listed = tables.iter().enumerate().filter(|(_, s)| s.kind == SensorKind::Lidar && s.enabled).nth(i);
+    match listed {
+        Some((k, _)) => format!("sensor[{k}].{key}"),
+        None => format!("the default lidar's {key}"),
+    }
+}
+
+/// The key of the `i`-th planned camera's depth limit.
+fn camera_key(tables: &[SensorConfig], i: usize) -> String {
+    let listed = tables.iter().enumerate().filter(|(_, s)| s.kind == SensorKind::Camera && s.enabled).nth(i);
+    match listed {
+        Some((k, _)) => format!("sensor[{k}].max_depth_m"),
+        None => "the default camera's max_depth_m".into(),
     }
 }
 

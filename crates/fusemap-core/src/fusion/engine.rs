@@ -71,6 +71,21 @@ pub enum EngineError {
         /// Its registered kind.
         kind: SensorKind,
     },
+    /// The observation needed more map than `[limits] map_cells` allows. The map missed
+    /// part of it: the run must stop.
+    #[error(
+        "the map reached limits.map_cells = {cells} cells ({tiles} tile(s) of 64 x 64) at the measurement stamped {:.6} s; \
+         raise limits.map_cells, coarsen map.resolution, or look for poses far from the rest",
+        .stamp.as_secs_f64()
+    )]
+    MapCells {
+        /// The limit, cells.
+        cells: u64,
+        /// The limit, whole tiles.
+        tiles: usize,
+        /// The stamp of the observation that met it.
+        stamp: Stamp,
+    },
 }
 
 /// Counters of a whole run.
@@ -106,6 +121,8 @@ pub struct Engine {
     correlator: Correlator,
     dynamic: Option<(DynamicParams, bool)>,
     stats: EngineStats,
+    /// `[limits] map_cells`, for the error (the grids hold the budget in tiles).
+    map_cells: u64,
 }
 
 impl Engine {
@@ -128,6 +145,25 @@ impl Engine {
             correlator: Correlator::default(),
             dynamic: None,
             stats: EngineStats::default(),
+            map_cells: u64::MAX,
+        }
+    }
+
+    /// Holds every map to `[limits] map_cells` (see [`LimitsConfig`](crate::config::LimitsConfig)):
+    /// the observation that would need more tiles is refused with
+    /// [`EngineError::MapCells`], after which the maps are incomplete.
+    pub fn set_map_cells_limit(&mut self, limits: &crate::config::LimitsConfig) {
+        self.map_cells = limits.map_cells;
+        for m in self.maps.entries_mut() {
+            m.grid_mut().set_tile_budget(limits.map_tiles());
+        }
+    }
+
+    /// The error for a map past its budget after the observation at `stamp`, if any.
+    fn check_budget(&self, stamp: Stamp) -> Result<(), EngineError> {
+        match self.maps.iter().find(|m| m.grid().over_budget()) {
+            Some(m) => Err(EngineError::MapCells { cells: self.map_cells, tiles: m.grid().tile_count(), stamp }),
+            None => Ok(()),
         }
     }
 
@@ -278,6 +314,7 @@ impl Engine {
         slot.stats.scans += 1;
         slot.stats.maps_fed += fed;
         slot.stats.insert.add(&total);
+        self.check_budget(stamp)?;
         Ok(total)
     }
 
@@ -395,7 +432,9 @@ impl Engine {
         let model = model.limited_to(range_min, range_max);
         model.scan_to_range_data_with(sensor, scan, pose_of_beam, &mut self.scratch, &mut slot.stats.returns);
         let (maps, stats, slot) = (&mut self.maps, &mut self.stats, &mut slot.stats);
-        Ok(apply(maps, stats, slot, SensorKind::Lidar, &self.scratch, &ctx))
+        let s = apply(maps, stats, slot, SensorKind::Lidar, &self.scratch, &ctx);
+        self.check_budget(scan.stamp)?;
+        Ok(s)
     }
 
     /// Inserts range data a sensor model outside the engine produced. Its sensor must be
@@ -418,7 +457,9 @@ impl Engine {
         let ctx = self.context(data.stamp, group);
         let slot = &mut self.sensors[data.sensor.0 as usize];
         let kind = slot.model.kind();
-        Ok(apply(&mut self.maps, &mut self.stats, &mut slot.stats, kind, data, &ctx))
+        let s = apply(&mut self.maps, &mut self.stats, &mut slot.stats, kind, data, &ctx);
+        self.check_budget(data.stamp)?;
+        Ok(s)
     }
 }
 
@@ -475,6 +516,22 @@ mod tests {
         assert_eq!(s[1].scans, 1);
         assert_eq!(s[1].name, "rear");
         assert!(e.insert_scan(SensorId(9), &scan(5), Pose2::IDENTITY).is_err());
+    }
+
+    #[test]
+    fn an_observation_past_the_map_budget_is_an_error_naming_the_limit() {
+        let (mut e, a, _) = engine();
+        // 0.1 m cells: one 64 x 64 tile is 6.4 m; a 1 m beam from the origin touches the
+        // four tiles around it, a 30 m one (max range 10 m: cleared to 10 m) reaches more.
+        e.set_map_cells_limit(&crate::config::LimitsConfig { map_cells: 4 * 4096, ..Default::default() });
+        let short = LaserScan { stamp: Stamp(1), angle_min: 0.0, angle_increment: 0.5, ranges: vec![1.0; 13] };
+        e.insert_scan(a, &short, Pose2::IDENTITY).unwrap();
+        let far = Pose2::new(100.0, 0.0, 0.0);
+        let err = e.insert_scan(a, &scan(2), far).unwrap_err();
+        assert!(matches!(err, EngineError::MapCells { cells: 16384, .. }), "{err:?}");
+        let text = err.to_string();
+        assert!(text.contains("limits.map_cells = 16384") && text.contains("raise limits.map_cells"), "{text}");
+        assert!(e.grid().tile_count() <= 4);
     }
 }
 

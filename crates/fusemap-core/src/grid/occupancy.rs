@@ -301,6 +301,17 @@ impl<L: ExtraLayers> LayeredGrid<L> {
         self.tiles.tile_bytes()
     }
 
+    /// Allocates at most `tiles` tiles (`[limits] map_cells`); see [`TileMap`]'s budget.
+    pub fn set_tile_budget(&mut self, tiles: usize) {
+        self.tiles.set_tile_budget(tiles);
+    }
+
+    /// True once a write needed a tile past the budget: the grid has missed writes and
+    /// must not be exported as a map.
+    pub fn over_budget(&self) -> bool {
+        self.tiles.over_budget()
+    }
+
     /// The bounding box of every cell any ray has reached, `None` before the first.
     pub fn known_box(&self) -> Option<CellBox> {
         self.known

@@ -48,15 +48,33 @@ pub trait Tile {
 
 /// Sparse tiles keyed by [`TileKey`]. Tiles live in a `Vec` and the hash map holds their
 /// index, so iteration order is insertion order and deterministic.
+///
+/// **Budget.** A map can be given a largest number of tiles
+/// ([`set_tile_budget`](Self::set_tile_budget)). Past it, [`get_or_insert`](Self::get_or_insert)
+/// allocates nothing: it hands out one scratch tile that is not part of the map and raises
+/// [`over_budget`](Self::over_budget). The walk inside a tile stays as it is (no fallible
+/// path in the hot loop, one comparison on the cold path that allocates); whoever drives
+/// the insertion checks the flag after each observation and stops the run — the map is no
+/// longer complete once it is raised.
 pub struct TileMap<T> {
     index: HashMap<TileKey, u32, BuildHasherDefault<TileKeyHasher>>,
     keys: Vec<TileKey>,
     tiles: Vec<Box<T>>,
+    budget: usize,
+    scratch: Option<Box<T>>,
+    over_budget: bool,
 }
 
 impl<T: Tile> Default for TileMap<T> {
     fn default() -> Self {
-        Self { index: HashMap::default(), keys: Vec::new(), tiles: Vec::new() }
+        Self {
+            index: HashMap::default(),
+            keys: Vec::new(),
+            tiles: Vec::new(),
+            budget: usize::MAX,
+            scratch: None,
+            over_budget: false,
+        }
     }
 }
 
@@ -82,11 +100,13 @@ impl<T: Tile> TileMap<T> {
         self.index.get(&key).map(|&i| &*self.tiles[i as usize])
     }
 
-    /// The tile at `key`, allocating an empty one if needed.
+    /// The tile at `key`, allocating an empty one if needed; past the budget, the scratch
+    /// tile (see the type docs).
     #[inline]
     pub fn get_or_insert(&mut self, key: TileKey) -> &mut T {
         let i = match self.index.get(&key) {
             Some(&i) => i as usize,
+            None if self.tiles.len() >= self.budget => return self.scratch_tile(),
             None => {
                 let i = self.tiles.len();
                 self.tiles.push(Box::new(T::empty()));
@@ -96,6 +116,27 @@ impl<T: Tile> TileMap<T> {
             }
         };
         &mut self.tiles[i]
+    }
+
+    #[cold]
+    fn scratch_tile(&mut self) -> &mut T {
+        self.over_budget = true;
+        self.scratch.get_or_insert_with(|| Box::new(T::empty()))
+    }
+
+    /// Allocates at most `tiles` tiles from now on (tiles already allocated stay).
+    pub fn set_tile_budget(&mut self, tiles: usize) {
+        self.budget = tiles;
+    }
+
+    /// The largest number of tiles this map allocates.
+    pub fn tile_budget(&self) -> usize {
+        self.budget
+    }
+
+    /// True once a write needed a tile past the budget: the map misses that write.
+    pub fn over_budget(&self) -> bool {
+        self.over_budget
     }
 
     /// The tile holding `cell`, if allocated, and the cell's offset in it.
@@ -141,5 +182,24 @@ mod tests {
         assert_eq!(m.get(far).unwrap().0[0], 8);
         let keys: Vec<_> = m.iter().map(|(k, _)| k).collect();
         assert_eq!(keys, vec![far, TileKey { x: -1, y: 0 }]);
+    }
+
+    #[test]
+    fn past_the_budget_nothing_is_allocated_and_the_map_says_so() {
+        let mut m: TileMap<Counter> = TileMap::new();
+        m.set_tile_budget(2);
+        m.get_or_insert(TileKey { x: 0, y: 0 }).0[0] = 1;
+        m.get_or_insert(TileKey { x: 1, y: 0 }).0[0] = 2;
+        assert!(!m.over_budget());
+        // Tiles already held are still served; a third one is not allocated.
+        m.get_or_insert(TileKey { x: 0, y: 0 }).0[0] += 1;
+        assert!(!m.over_budget());
+        m.get_or_insert(TileKey { x: 2, y: 0 }).0[0] = 9;
+        m.get_or_insert(TileKey { x: 3, y: 0 }).0[0] = 9;
+        assert!(m.over_budget());
+        assert_eq!(m.len(), 2);
+        assert!(m.get(TileKey { x: 2, y: 0 }).is_none());
+        assert_eq!(m.get(TileKey { x: 0, y: 0 }).unwrap().0[0], 2);
+        assert_eq!(m.tile_budget(), 2);
     }
 }

@@ -6,7 +6,7 @@ mod relations;
 mod scores;
 mod semantic;
 
-pub use entropy::{binary_entropy, map_entropy, EntropyReport};
+pub use entropy::{binary_entropy, map_entropy, sparse_entropy, EntropyReport};
 pub use relations::{
     parse_relations, relation_errors, score_relations, Relation, RelationScore, RelationsError, PLANAR_TOLERANCE,
 };

@@ -145,11 +145,25 @@ impl ImagePayloads {
     }
 }
 
-/// What a log reader decodes beyond the small messages it always decodes.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+/// Default of [`ReadOptions::max_decompressed_bytes`]: 512 MiB, `[limits] decompressed_mib`.
+pub const DEFAULT_MAX_DECOMPRESSED_BYTES: u64 = 512 << 20;
+
+/// What a log reader decodes beyond the small messages it always decodes, and how large
+/// one piece of it may grow.
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ReadOptions {
     /// The images whose pixels are decoded.
     pub images: ImagePayloads,
+    /// The most bytes one chunk, message or line may hold once decompressed (ROS 1 bz2 and
+    /// lz4 chunks, MCAP records, rosbag2 zstd messages, CARMEN lines): a decompression bomb
+    /// or a corrupt size is refused at that point, not after the memory is taken.
+    pub max_decompressed_bytes: u64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        Self { images: ImagePayloads::default(), max_decompressed_bytes: DEFAULT_MAX_DECOMPRESSED_BYTES }
+    }
 }
 
 impl ReadOptions {
@@ -159,7 +173,7 @@ impl ReadOptions {
         I: IntoIterator<Item = S>,
         S: Into<String>,
     {
-        Self { images: ImagePayloads::Topics(topics.into_iter().map(Into::into).collect()) }
+        Self { images: ImagePayloads::Topics(topics.into_iter().map(Into::into).collect()), ..Self::default() }
     }
 }
 

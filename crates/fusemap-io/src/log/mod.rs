@@ -24,7 +24,7 @@ pub mod ros2;
 
 pub use image::{
     bytes_per_pixel, check_image_layout, CameraInfoMessage, ImageHeader, ImageMessage, ImagePayloads, ReadOptions,
-    MAX_IMAGE_PIXELS,
+    DEFAULT_MAX_DECOMPRESSED_BYTES, MAX_IMAGE_PIXELS,
 };
 pub use open::{detect, open_log, open_log_with, LogFormat, OpenedLog};
 

@@ -80,7 +80,13 @@ pub fn open_log(path: &Path) -> Result<OpenedLog> {
 pub fn open_log_with(path: &Path, options: &ReadOptions) -> Result<OpenedLog> {
     let format = detect(path)?;
     let reader: Box<dyn LogReader> = match format {
-        LogFormat::Carmen => Box::new(super::carmen::CarmenReader::open(path, Default::default())?),
+        LogFormat::Carmen => {
+            let carmen = super::carmen::CarmenOptions {
+                max_line_bytes: Some(options.max_decompressed_bytes),
+                ..Default::default()
+            };
+            Box::new(super::carmen::CarmenReader::open(path, carmen)?)
+        }
         LogFormat::Ros1Bag => Box::new(super::ros1::BagReader::open_with(path, options.clone())?),
         LogFormat::Mcap | LogFormat::Rosbag2 => Box::new(super::ros2::Ros2Reader::open_with(path, options.clone())?),
     };

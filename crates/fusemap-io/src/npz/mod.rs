@@ -30,6 +30,9 @@ use std::path::Path;
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, ZipArchive, ZipWriter};
 
+mod sparse;
+pub use sparse::write_sparse_map_npz;
+
 /// The `.npy` magic string (format.py `MAGIC_PREFIX`).
 pub const NPY_MAGIC: &[u8; 6] = b"\x93NUMPY";
 
@@ -49,6 +52,8 @@ pub enum NpyData<'a> {
     U8(&'a [u8]),
     /// `int32`, written as `'<i4'`.
     I32(&'a [i32]),
+    /// `int64`, written as `'<i8'`.
+    I64(&'a [i64]),
     /// `int16`, written as `'<i2'`.
     I16(&'a [i16]),
     /// Unicode strings, written as NumPy's fixed-width `'<U{n}'` (UTF-32, little-endian,
@@ -67,6 +72,7 @@ impl NpyData<'_> {
             NpyData::Bool(_) => "|b1".into(),
             NpyData::U8(_) => "|u1".into(),
             NpyData::I32(_) => "<i4".into(),
+            NpyData::I64(_) => "<i8".into(),
             NpyData::I16(_) => "<i2".into(),
             NpyData::Str(_) => format!("<U{}", self.str_width()),
         }
@@ -89,6 +95,7 @@ impl NpyData<'_> {
             NpyData::Bool(d) => d.len(),
             NpyData::U8(d) => d.len(),
             NpyData::I32(d) => d.len(),
+            NpyData::I64(d) => d.len(),
             NpyData::I16(d) => d.len(),
             NpyData::Str(d) => d.len(),
         }
@@ -102,7 +109,7 @@ impl NpyData<'_> {
     fn item_size(&self) -> usize {
         match self {
             NpyData::F32(_) | NpyData::I32(_) => 4,
-            NpyData::F64(_) => 8,
+            NpyData::F64(_) | NpyData::I64(_) => 8,
             NpyData::I16(_) => 2,
             NpyData::Bool(_) | NpyData::U8(_) => 1,
             NpyData::Str(_) => 4 * self.str_width(),
@@ -191,6 +198,7 @@ impl<'a> NpyArray<'a> {
             NpyData::F32(d) => chunks!(d, f32::to_le_bytes),
             NpyData::F64(d) => chunks!(d, f64::to_le_bytes),
             NpyData::I32(d) => chunks!(d, i32::to_le_bytes),
+            NpyData::I64(d) => chunks!(d, i64::to_le_bytes),
             NpyData::I16(d) => chunks!(d, i16::to_le_bytes),
             NpyData::Str(d) => {
                 let width = self.data.str_width();
@@ -387,6 +395,8 @@ pub enum NpyValues {
     U8(Vec<u8>),
     /// `<i4`.
     I32(Vec<i32>),
+    /// `<i8`.
+    I64(Vec<i64>),
     /// `<i2`.
     I16(Vec<i16>),
     /// `<U{n}`, NUL padding removed.
@@ -404,7 +414,7 @@ pub struct NpyOwned {
 
 /// Reads the array `name` (with or without `.npy`) of an `.npz` file.
 ///
-/// Supports what [`NpyArray`] writes: little-endian `f4`, `f8`, `i4`, `i2`, `U{n}`, and
+/// Supports what [`NpyArray`] writes: little-endian `f4`, `f8`, `i4`, `i8`, `i2`, `U{n}`, and
 /// `b1`, `u1`, C order, `.npy` versions 1.0 to 3.0, stored or deflated members (`np.savez` and
 /// `np.savez_compressed`). Anything else is an [`Error::Format`] naming the array.
 pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
@@ -453,7 +463,7 @@ pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
     let str_width = descr.strip_prefix("<U").and_then(|n| n.parse::<usize>().ok());
     let item = match (descr.as_str(), str_width) {
         ("<f4" | "<i4", _) => 4,
-        ("<f8", _) => 8,
+        ("<f8" | "<i8", _) => 8,
         ("<i2", _) => 2,
         ("|b1" | "|u1", _) => 1,
         (_, Some(n)) => n.checked_mul(4).ok_or_else(|| bad(format!("unsupported dtype `{descr}`")))?,
@@ -468,6 +478,9 @@ pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
     let values = match descr.as_str() {
         "<f4" => NpyValues::F32(raw.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),
         "<i4" => NpyValues::I32(raw.chunks_exact(4).map(|c| i32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),
+        "<i8" => NpyValues::I64(
+            raw.chunks_exact(8).map(|c| i64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])).collect(),
+        ),
         "<i2" => NpyValues::I16(raw.chunks_exact(2).map(|c| i16::from_le_bytes([c[0], c[1]])).collect()),
         "<f8" => NpyValues::F64(
             raw.chunks_exact(8).map(|c| f64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])).collect(),

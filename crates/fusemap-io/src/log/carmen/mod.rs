@@ -133,6 +133,11 @@ pub struct CarmenOptions {
     /// `range_max` for every `FLASER`/`RLASER` line, replacing the per-line rule of the
     /// module documentation (for a log whose sensor has another maximum).
     pub flaser_range_max: Option<f32>,
+    /// The longest line read, bytes (default
+    /// [`DEFAULT_MAX_DECOMPRESSED_BYTES`](crate::log::DEFAULT_MAX_DECOMPRESSED_BYTES)): a
+    /// longer one — a gzip that inflates to one endless line — ends the read with an error
+    /// naming the line, before it is held whole.
+    pub max_line_bytes: Option<u64>,
 }
 
 /// The beam angles of a `FLASER`/`RLASER` line with `n` readings, as
@@ -300,13 +305,18 @@ impl<R: BufRead> CarmenReader<R> {
         &self.path
     }
 
-    fn read_line(&mut self) -> std::io::Result<usize> {
+    /// Reads the next line into `self.line`; `Ok(None)` when it is longer than the limit
+    /// (the reader has then read one byte past the limit and stops).
+    fn read_line(&mut self) -> std::io::Result<Option<usize>> {
         self.line.clear();
-        match &mut self.input {
-            Input::Plain(r) => r.read_until(b'\n', &mut self.line),
-            Input::Gzip(r) => r.read_until(b'\n', &mut self.line),
-            Input::GzipAhead(r) => r.read_until(b'\n', &mut self.line),
-        }
+        let limit = self.options.max_line_bytes.unwrap_or(crate::log::DEFAULT_MAX_DECOMPRESSED_BYTES);
+        let take = limit.saturating_add(1);
+        let n = match &mut self.input {
+            Input::Plain(r) => r.take(take).read_until(b'\n', &mut self.line),
+            Input::Gzip(r) => r.take(take).read_until(b'\n', &mut self.line),
+            Input::GzipAhead(r) => r.take(take).read_until(b'\n', &mut self.line),
+        }?;
+        Ok((n as u64 <= limit || self.line.ends_with(b"\n") && n as u64 - 1 <= limit).then_some(n))
     }
 
     fn read_error(&self, e: std::io::Error) -> Error {
@@ -330,8 +340,18 @@ impl<R: BufRead> LogReader for CarmenReader<R> {
     fn next_message(&mut self) -> Option<Result<LogMessage>> {
         while !self.done {
             match self.read_line() {
-                Ok(0) => self.done = true,
-                Ok(_) => {
+                Ok(Some(0)) => self.done = true,
+                Ok(None) => {
+                    self.done = true;
+                    let limit = self.options.max_line_bytes.unwrap_or(crate::log::DEFAULT_MAX_DECOMPRESSED_BYTES);
+                    self.line = Vec::new();
+                    let what = format!(
+                        "longer than the limit of {limit} bytes (limits.decompressed_mib raises it): not a CARMEN \
+                         log line; reading stops here"
+                    );
+                    return Some(Err(Error::format(&self.path, Location::Line(self.line_number + 1), what)));
+                }
+                Ok(Some(_)) => {
                     self.line_number += 1;
                     match parse_line(&self.line, &self.options, &mut self.params) {
                         Parsed::Ignored => {}

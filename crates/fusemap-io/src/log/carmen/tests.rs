@@ -537,3 +537,38 @@ fn truncated_gzip_file_is_a_format_error() {
     assert!(ok > 1000 && lines > 1000, "{ok} messages, {lines} lines");
     assert_eq!(error, format!("{}: gzip stream ends early after line {lines}", cut.display()));
 }
+
+#[test]
+fn a_line_past_the_limit_ends_the_read_naming_it() {
+    let line = flaser_n(181);
+    let n = line.len() as u64 - 1; // without its newline
+    let text = format!("{line}{line}{}\n{line}", "9".repeat(5000));
+    // Gzipped, as the bombs come: the reader must stop at the limit, not inflate the line.
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    gz.write_all(text.as_bytes()).unwrap();
+    let gz = gz.finish().unwrap();
+    for bytes in [text.as_bytes(), &gz[..]] {
+        let read = |limit: u64| {
+            let options = CarmenOptions { max_line_bytes: Some(limit), ..Default::default() };
+            CarmenReader::from_reader("big.log", bytes, options).unwrap().collect::<Vec<_>>()
+        };
+        // Lines up to the limit (newline not counted) read; the 5000-byte one is refused.
+        let got = read(4999);
+        assert_eq!(got.len(), 3);
+        assert!(got[0].is_ok() && got[1].is_ok());
+        match &got[2] {
+            Err(Error::Format { path, location: Location::Line(3), message }) => {
+                assert_eq!(path, Path::new("big.log"));
+                assert!(
+                    message.contains("limit of 4999 bytes") && message.contains("limits.decompressed_mib"),
+                    "{message}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        // At exactly the line's length it is read (and skipped as malformed: not a record).
+        let got = read(5000);
+        assert!(got.iter().all(|m| m.is_ok()) && got.len() == 3, "{got:?}");
+        assert!(read(n).len() == 3 && read(n - 1).len() == 1);
+    }
+}

@@ -164,7 +164,7 @@ impl BagReader<BufReader<File>> {
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let mut reader = Self::from_reader(BufReader::with_capacity(1 << 16, file), path)?;
         reader.decoder.options = options;
-        reader.prefetch = prefetch::Prefetch::spawn(path);
+        reader.prefetch = prefetch::Prefetch::spawn(path, reader.decoder.options.max_decompressed_bytes);
         Ok(reader)
     }
 }
@@ -313,6 +313,15 @@ impl<R: Read> BagReader<R> {
                     (Some(c), Some(s)) => (c, s),
                     _ => return Err(self.error_at(head.offset, "chunk record lacks its `compression` or `size` field")),
                 };
+                let limit = self.decoder.options.max_decompressed_bytes;
+                if u64::from(size) > limit {
+                    // Refused on its word, before a byte is read or inflated.
+                    let what = format!(
+                        "chunk says it holds {size} uncompressed bytes, over the limit of {limit} bytes \
+                         (limits.decompressed_mib raises it)"
+                    );
+                    return Err(self.error_at(head.offset, &what));
+                }
                 self.chunk.next = 0;
                 self.chunk.record_offset = head.offset;
                 self.chunk.data_offset = None;

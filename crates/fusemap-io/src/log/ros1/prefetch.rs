@@ -16,6 +16,10 @@ use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 use std::sync::mpsc::{sync_channel, Receiver};
 
+/// What the walk reads from: a file, or bytes in a test.
+trait ReadSeek: Read + Seek {}
+impl<T: Read + Seek> ReadSeek for T {}
+
 /// The helper thread's side of the bag: chunks it decompressed, by record offset.
 pub(super) struct Prefetch {
     chunks: Receiver<(u64, Vec<u8>)>,
@@ -24,16 +28,19 @@ pub(super) struct Prefetch {
 }
 
 impl Prefetch {
-    /// Starts the helper on a second handle on `path`; `None` if that cannot be had.
-    pub(super) fn spawn(path: &Path) -> Option<Self> {
+    /// Starts the helper on a second handle on `path`; `None` if that cannot be had. It
+    /// leaves chunks that say they inflate past `max_chunk` bytes to the reader, which
+    /// refuses them.
+    pub(super) fn spawn(path: &Path, max_chunk: u64) -> Option<Self> {
         let file = File::open(path).ok()?;
+        let file_len = file.metadata().ok()?.len();
         // One chunk ready and one in the making: at most two decompressed chunks wait.
         let (tx, rx) = sync_channel(1);
         std::thread::Builder::new()
             .name("fusemap-bag-chunks".into())
             .spawn(move || {
                 let mut input = BufReader::with_capacity(1 << 16, file);
-                let _ = walk(&mut input, |offset, data| tx.send((offset, data)).is_ok());
+                let _ = walk(&mut input, file_len, max_chunk, |offset, data| tx.send((offset, data)).is_ok());
             })
             .ok()?;
         Some(Self { chunks: rx, peeked: None, closed: false })
@@ -61,10 +68,17 @@ impl Prefetch {
     }
 }
 
-/// Walks the top-level records and hands every second compressed chunk, decompressed, to
-/// `deliver` (which returns `false` to stop). Stops quietly at the first problem: the
-/// reader meets and reports it itself.
-fn walk(input: &mut BufReader<File>, mut deliver: impl FnMut(u64, Vec<u8>) -> bool) -> Option<()> {
+/// Walks the top-level records of a file of `file_len` bytes and hands every second
+/// compressed chunk, decompressed, to `deliver` (which returns `false` to stop). Stops
+/// quietly at the first problem: the reader meets and reports it itself. A length field
+/// is checked against what is left of the file before anything is allocated for it, so a
+/// corrupt one costs nothing.
+fn walk(
+    input: &mut impl ReadSeek,
+    file_len: u64,
+    max_chunk: u64,
+    mut deliver: impl FnMut(u64, Vec<u8>) -> bool,
+) -> Option<()> {
     let mut magic = [0u8; 13];
     input.read_exact(&mut magic).ok()?;
     if magic != record::MAGIC {
@@ -78,10 +92,16 @@ fn walk(input: &mut BufReader<File>, mut deliver: impl FnMut(u64, Vec<u8>) -> bo
         let mut len = [0u8; 4];
         input.read_exact(&mut len).ok()?;
         let header_len = u32::from_le_bytes(len) as usize;
+        if offset + 4 + header_len as u64 > file_len {
+            return None;
+        }
         header.resize(header_len, 0);
         input.read_exact(&mut header).ok()?;
         input.read_exact(&mut len).ok()?;
         let data_len = u32::from_le_bytes(len);
+        if offset + 8 + header_len as u64 + u64::from(data_len) > file_len {
+            return None;
+        }
         let h = record::parse_header(&header).ok()?;
         let (is_chunk, compression, size) = (h.op == Some(record::OP_CHUNK), h.compression, h.size);
         let ours = match (is_chunk, compression) {
@@ -91,6 +111,9 @@ fn walk(input: &mut BufReader<File>, mut deliver: impl FnMut(u64, Vec<u8>) -> bo
             }
             _ => false,
         };
+        if ours && size.is_some_and(|s| u64::from(s) > max_chunk) {
+            return None;
+        }
         if ours {
             data.resize(data_len as usize, 0);
             input.read_exact(&mut data).ok()?;

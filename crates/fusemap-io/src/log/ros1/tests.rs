@@ -1043,3 +1043,31 @@ fn open_reads_the_intel_bag_exactly_as_a_stream() {
     }
     assert_eq!(n, stream.len());
 }
+
+#[test]
+fn a_chunk_past_the_decompression_limit_is_refused_on_its_word() {
+    for compression in [Compression::None, Compression::Bz2, Compression::Lz4] {
+        let bytes = bag(vec![(compression, standard_records())]);
+        let chunk = 13 + record_len(&bytes, 13);
+        let header_len = u32::from_le_bytes(bytes[chunk..chunk + 4].try_into().unwrap());
+        let size_at = chunk + 4 + header_len as usize - 4;
+        let size = u32::from_le_bytes(bytes[size_at..size_at + 4].try_into().unwrap());
+        let read = |limit: u64| {
+            let mut reader = BagReader::from_reader(&bytes[..], "test.bag").unwrap();
+            reader.set_options(ReadOptions { max_decompressed_bytes: limit, ..Default::default() });
+            std::iter::from_fn(|| reader.next_message()).collect::<Vec<_>>()
+        };
+        // At the limit the chunk reads; one byte under it, the chunk is refused where it
+        // stands, naming its size, the limit and the key.
+        assert!(read(u64::from(size)).iter().all(|m| m.is_ok()), "{compression:?}");
+        let got = read(u64::from(size) - 1);
+        assert_eq!(got.len(), 1, "{compression:?}");
+        let (location, message) = format_error(got.into_iter().next().unwrap().err());
+        assert_eq!(location, Location::Offset(chunk as u64));
+        for part in
+            [format!("{size} uncompressed bytes"), format!("limit of {}", size - 1), "limits.decompressed_mib".into()]
+        {
+            assert!(message.contains(&part), "{compression:?}: `{part}` in {message}");
+        }
+    }
+}

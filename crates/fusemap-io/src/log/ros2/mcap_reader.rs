@@ -15,10 +15,6 @@ use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
-/// Largest MCAP record accepted, so a corrupt length cannot make the reader allocate
-/// without bound. No sensor message fusemap reads comes near it.
-const MAX_RECORD_LEN: usize = 1 << 30;
-
 /// One MCAP file being read.
 pub(crate) struct McapSource {
     path: PathBuf,
@@ -29,20 +25,24 @@ pub(crate) struct McapSource {
     /// Schema id → (name, encoding).
     schemas: HashMap<u16, (String, String)>,
     channels: HashMap<u16, Topic>,
+    /// The largest record or decompressed chunk accepted ([`ReadOptions::max_decompressed_bytes`](crate::log::ReadOptions::max_decompressed_bytes)).
+    max_record: u64,
 }
 
 impl McapSource {
     /// Opens `path`; with `zstd` the whole file is a zstd stream around the MCAP
-    /// (rosbag2's `file` compression, `*.mcap.zstd`).
-    pub(crate) fn open(path: &Path, zstd: bool) -> Result<Self> {
+    /// (rosbag2's `file` compression, `*.mcap.zstd`). A record, or a chunk once
+    /// decompressed, larger than `max_record` bytes is an error when it is met, before it
+    /// is read: a corrupt length or a decompression bomb costs no memory.
+    pub(crate) fn open(path: &Path, zstd: bool, max_record: u64) -> Result<Self> {
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let input: Box<dyn Read + Send> = if zstd {
             Box::new(zstd::stream::read::Decoder::new(file).map_err(|e| Error::io(path, e))?)
         } else {
             Box::new(BufReader::with_capacity(1 << 16, file))
         };
-        let options =
-            LinearReaderOptions::default().with_validate_chunk_crcs(true).with_record_length_limit(MAX_RECORD_LEN);
+        let limit = usize::try_from(max_record).unwrap_or(usize::MAX);
+        let options = LinearReaderOptions::default().with_validate_chunk_crcs(true).with_record_length_limit(limit);
         Ok(Self {
             path: path.to_path_buf(),
             input,
@@ -50,6 +50,7 @@ impl McapSource {
             bytes_read: 0,
             schemas: HashMap::new(),
             channels: HashMap::new(),
+            max_record,
         })
     }
 
@@ -70,7 +71,13 @@ impl McapSource {
                 None => return Ok(false),
                 Some(Ok(event)) => event,
                 Some(Err(e)) => {
-                    let what = error_chain(&e);
+                    let mut what = error_chain(&e);
+                    if matches!(e, mcap::McapError::ChunkTooLarge(_) | mcap::McapError::RecordTooLarge { .. }) {
+                        what += &format!(
+                            ", over the limit of {} bytes (limits.decompressed_mib raises it)",
+                            self.max_record
+                        );
+                    }
                     return Err(self.container_error(&what));
                 }
             };

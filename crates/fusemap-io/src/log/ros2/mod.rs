@@ -367,16 +367,13 @@ pub(crate) enum PendingFile {
 }
 
 impl PendingFile {
-    fn open(&self) -> Result<Box<dyn Source + Send>> {
+    fn open(&self, max_record: u64) -> Result<Box<dyn Source + Send>> {
         Ok(match self {
-            PendingFile::Mcap { path, zstd } => Box::new(mcap_reader::McapSource::open(path, *zstd)?),
+            PendingFile::Mcap { path, zstd } => Box::new(mcap_reader::McapSource::open(path, *zstd, max_record)?),
             PendingFile::Db3 { path } => Box::new(db3::Db3Source::open(path)?),
         })
     }
 }
-
-/// Largest decompressed size of one message in a bag with per-message zstd compression.
-const MAX_MESSAGE_LEN: u64 = 1 << 30;
 
 /// Reads a ROS 2 log (one or more storage files) as [`LogMessage`]s in storage order:
 /// MCAP files in file order, `.db3` files by timestamp, the files of a rosbag2 directory
@@ -406,7 +403,8 @@ impl Ros2Reader {
         Ok(reader)
     }
 
-    /// Decodes the images `options` name in full from now on.
+    /// Decodes the images `options` name in full from now on (the decompression limit
+    /// applies from the next storage file on).
     pub fn set_options(&mut self, options: ReadOptions) {
         self.options = options;
     }
@@ -458,16 +456,17 @@ impl Ros2Reader {
         Self::from_files(bag.files, bag.zstd_messages)
     }
 
-    /// Opens the first file now, so that a missing or unreadable log fails at open.
+    /// Opens the first file now, so that a missing or unreadable log fails at open; it is
+    /// read from a fresh handle, opened with the reader's final options, at the first
+    /// message.
     fn from_files(files: Vec<PendingFile>, zstd_messages: bool) -> Result<Self> {
-        let mut pending: VecDeque<PendingFile> = files.into();
-        let current = match pending.pop_front() {
-            Some(f) => Some(f.open()?),
-            None => None,
-        };
+        let pending: VecDeque<PendingFile> = files.into();
+        if let Some(f) = pending.front() {
+            f.open(ReadOptions::default().max_decompressed_bytes)?;
+        }
         Ok(Self {
             pending,
-            current,
+            current: None,
             zstd_messages,
             index: 0,
             stats: ReadStats::default(),
@@ -483,7 +482,7 @@ impl Ros2Reader {
                 Some(s) => s,
                 None => {
                     let file = self.pending.pop_front()?;
-                    match file.open() {
+                    match file.open(self.options.max_decompressed_bytes) {
                         Ok(s) => self.current.insert(s),
                         Err(e) => {
                             self.finished = true;
@@ -540,10 +539,21 @@ fn decode_raw(
     let mut payload = raw.data;
     if zstd_messages {
         scratch.clear();
-        let decoded =
-            zstd::stream::read::Decoder::new(payload).and_then(|d| d.take(MAX_MESSAGE_LEN).read_to_end(scratch));
+        // One byte past the limit tells a message at the limit from one beyond it, which is
+        // refused there (never cut short and decoded).
+        let limit = options.max_decompressed_bytes;
+        let decoded = zstd::stream::read::Decoder::new(payload)
+            .and_then(|d| d.take(limit.saturating_add(1)).read_to_end(scratch));
         if let Err(e) = decoded {
             return Some(Err(at(format!("{}: the bag says messages are zstd-compressed, but: {e}", topic.type_name))));
+        }
+        if scratch.len() as u64 > limit {
+            scratch.clear();
+            return Some(Err(at(format!(
+                "{}: the zstd-compressed message inflates past the limit of {limit} bytes (limits.decompressed_mib \
+                 raises it)",
+                topic.type_name
+            ))));
         }
         payload = scratch;
     }

@@ -654,3 +654,40 @@ fn unknown_files_are_refused_by_content() {
     assert!(matches!(open_ros2(&dir.path().join("nope.db3")), Err(Error::Io { .. })));
     assert!(open_ros2(dir.path()).is_err());
 }
+
+#[test]
+fn a_message_or_chunk_inflating_past_the_limit_is_refused_where_it_is_met() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = sample_log();
+    let read = |path: &Path, limit: u64| {
+        let options = ReadOptions { max_decompressed_bytes: limit, ..Default::default() };
+        let mut r = Ros2Reader::open_with(path, options).unwrap();
+        read_all(&mut r)
+    };
+    // rosbag2 per-message zstd: the largest message inflates to `n`.
+    let bag = dir.path().join("db3_bag");
+    std::fs::create_dir(&bag).unwrap();
+    write_db3(&bag.join("c_0.db3"), &log, true);
+    std::fs::write(
+        bag.join("metadata.yaml"),
+        "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n  relative_file_paths: [c_0.db3]\n  compression_format: zstd\n  compression_mode: MESSAGE\n",
+    )
+    .unwrap();
+    let largest = log.iter().max_by_key(|m| m.4.len()).unwrap();
+    let n = largest.4.len() as u64;
+    assert!(read(&bag, n).iter().all(|m| m.is_ok()));
+    let got = read(&bag, n - 1);
+    let e = got.iter().find_map(|m| m.as_ref().err()).expect("the message past the limit is an error");
+    let text = e.to_string();
+    let topic = format!("`{}`", largest.0);
+    for part in ["inflates past the limit", &format!("{} bytes", n - 1), "limits.decompressed_mib", &topic] {
+        assert!(text.contains(part), "`{part}` in {text}");
+    }
+    // An MCAP chunk whose records inflate past the limit: refused by its stated size.
+    let path = dir.path().join("zstd.mcap");
+    write_mcap(&path, Some(mcap::Compression::Zstd), &log);
+    assert!(read(&path, 1 << 20).iter().all(|m| m.is_ok()));
+    let got = read(&path, 64);
+    let e = got.iter().find_map(|m| m.as_ref().err()).expect("the chunk past the limit is an error");
+    assert!(e.to_string().contains("over the limit of 64 bytes (limits.decompressed_mib"), "{e}");
+}

@@ -79,7 +79,7 @@ fn read_with(bytes: &[u8], options: ReadOptions) -> Vec<LogMessage> {
 fn images_and_camera_info_decode_in_every_compression() {
     for compression in [Compression::None, Compression::Bz2, Compression::Lz4] {
         let bytes = camera_bag(compression);
-        let all = read_with(&bytes, ReadOptions { images: ImagePayloads::All });
+        let all = read_with(&bytes, ReadOptions { images: ImagePayloads::All, ..Default::default() });
         assert_eq!(all.len(), 4);
         let LogMessage::CameraInfo(c) = &all[0] else { panic!("{:?}", all[0]) };
         assert_eq!((c.width, c.height, c.distortion_model.as_str()), (640, 480, "plumb_bob"));
@@ -109,7 +109,7 @@ fn by_default_images_are_headers_and_only_the_asked_topics_get_pixels() {
     assert!(matches!(&some[1], LogMessage::ImageHeader(_)));
     assert!(matches!(&some[2], LogMessage::Image(i) if i.data.len() == 4));
     // The full image's header is what the header-only pass saw.
-    let all = read_with(&bytes, ReadOptions { images: ImagePayloads::All });
+    let all = read_with(&bytes, ReadOptions { images: ImagePayloads::All, ..Default::default() });
     let LogMessage::Image(full) = &all[1] else { panic!() };
     assert_eq!(&full.header(), h);
 }
@@ -131,7 +131,7 @@ fn bad_images_are_skippable_message_errors_and_reading_goes_on() {
         ),
     ];
     for (payload, needle) in cases {
-        for options in [ReadOptions::default(), ReadOptions { images: ImagePayloads::All }] {
+        for options in [ReadOptions::default(), ReadOptions { images: ImagePayloads::All, ..Default::default() }] {
             let bytes = bag(vec![(
                 Compression::None,
                 vec![

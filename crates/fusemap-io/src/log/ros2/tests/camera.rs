@@ -164,7 +164,9 @@ fn mcap_and_db3_give_pixels_only_for_the_topics_asked_for() {
         );
         let mut r = Ros2Reader::open_with(path, ReadOptions::with_image_topics(["/depth"])).unwrap();
         assert_eq!(kinds(&mut r), ["info 525", "header /labels 8", "/scan", "error", "image /depth 12"]);
-        let mut r = Ros2Reader::open_with(path, ReadOptions { images: crate::log::ImagePayloads::All }).unwrap();
+        let mut r =
+            Ros2Reader::open_with(path, ReadOptions { images: crate::log::ImagePayloads::All, ..Default::default() })
+                .unwrap();
         assert_eq!(kinds(&mut r), ["info 525", "image /labels 8", "/scan", "error", "image /depth 12"]);
         assert!(r.stats().skipped_by_type.is_empty());
     }

@@ -1,0 +1,124 @@
+//! `[limits]`: resource budgets, so that no input — a wrong resolution, a range limit of
+//! 10¹² m, a pose kilometres from the rest — can make a run grow until the allocator
+//! aborts it.
+//!
+//! Each limit is checked before the allocation it guards and, when broken, gives one error
+//! naming the limit, the value met and the key that raises it. The defaults are far above
+//! what a real robot log needs (a 2.7 km² map at 5 cm, a 2.5 km ray at 5 cm), so a
+//! run that meets one has a configuration or a log worth a look.
+//!
+//! * `ray_cells` is checked when the configuration is validated: every lidar's
+//!   `max_range`, every camera's `max_depth_m` and SLAM's `max_range_m` over its cell size
+//!   (a ray's length in cells bounds both its walk and the tiles it can allocate).
+//! * `map_cells` is enforced by the map itself: its tile store refuses to allocate past the
+//!   budget and the engine turns that into an error after the observation that met it
+//!   (see [`TileMap::set_tile_budget`](crate::grid::TileMap::set_tile_budget)).
+//! * `export_cells` is applied by the exporters: past it, a run writes the map's tiles
+//!   sparsely instead of one dense raster of the bounding box of everything it touched.
+//! * `decompressed_mib` is passed to the log readers (`fusemap-io`'s `ReadOptions`): a
+//!   chunk that says or turns out to inflate past it is refused there.
+
+use super::{err, ConfigError};
+use crate::grid::TILE_CELLS;
+use serde::{Deserialize, Serialize};
+
+/// The `[limits]` table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LimitsConfig {
+    /// Cells the map may hold, counted in whole 64 × 64 tiles. A cell costs a little over
+    /// 4 bytes of occupancy (plus 4 per class where a camera wrote semantics): 2³⁰ cells
+    /// is 2.7 km² at 5 cm, about 4.1 GiB.
+    pub map_cells: u64,
+    /// Cells one ray may cross: the longest range of any lidar, camera or SLAM over its
+    /// cell size. 50,000 is 2.5 km at 5 cm, or 500 m at 1 cm.
+    pub ray_cells: u64,
+    /// Cells of a dense raster export (`map.npz`, `map.pgm`, pictures): 10⁸ is a 10,000 ×
+    /// 10,000 raster, 500 m × 500 m at 5 cm. Past it the map is written sparsely (its
+    /// tiles) unless `--crop` names a region that fits.
+    pub export_cells: u64,
+    /// MiB one chunk, message or line of a log may hold once decompressed (ROS 1 bz2/lz4
+    /// chunks, MCAP chunks and records, rosbag2 zstd messages, gzipped CARMEN lines): past
+    /// it the read stops with an error where the bomb or the corrupt size is met.
+    pub decompressed_mib: u64,
+}
+
+impl Default for LimitsConfig {
+    fn default() -> Self {
+        Self { map_cells: 1 << 30, ray_cells: 50_000, export_cells: 100_000_000, decompressed_mib: 512 }
+    }
+}
+
+impl LimitsConfig {
+    /// The number of whole tiles `map_cells` allows (at least one).
+    pub fn map_tiles(&self) -> usize {
+        usize::try_from(self.map_cells.div_ceil(TILE_CELLS as u64)).unwrap_or(usize::MAX).max(1)
+    }
+
+    /// `decompressed_mib` in bytes.
+    pub fn decompressed_bytes(&self) -> u64 {
+        self.decompressed_mib.saturating_mul(1 << 20)
+    }
+
+    /// Checks the values themselves (every limit at least 1).
+    pub(super) fn validate(&self) -> Result<(), ConfigError> {
+        for (key, v) in [
+            ("map_cells", self.map_cells),
+            ("ray_cells", self.ray_cells),
+            ("export_cells", self.export_cells),
+            ("decompressed_mib", self.decompressed_mib),
+        ] {
+            if v == 0 {
+                return Err(err(format!("limits.{key}"), "must be at least 1"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks that a ray of `range_m` metres over cells of `cell_m` metres stays within
+    /// `ray_cells`. `what` names the range's key (`sensor[0].max_range`), `cell_key` the
+    /// cell size's.
+    pub(super) fn check_ray(&self, what: &str, range_m: f64, cell_key: &str, cell_m: f64) -> Result<(), ConfigError> {
+        let cells = range_m / cell_m;
+        if cells.is_finite() && cells <= self.ray_cells as f64 {
+            return Ok(());
+        }
+        Err(err(
+            "limits.ray_cells",
+            format!(
+                "{what} = {range_m} m over {cell_key} = {cell_m} m is {cells:.0} cells per ray, over the limit of {}; \
+                 coarsen {cell_key}, shorten {what}, or raise limits.ray_cells",
+                self.ray_cells
+            ),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rays_within_the_budget_pass_and_longer_ones_name_every_key() {
+        let l = LimitsConfig::default();
+        assert!(l.check_ray("sensor[0].max_range", 10.0, "map.resolution", 0.05).is_ok());
+        assert!(l.check_ray("sensor[0].max_range", 2500.0, "map.resolution", 0.05).is_ok());
+        let e = l.check_ray("sensor[0].max_range", 10.0, "map.resolution", 1e-5).unwrap_err();
+        assert_eq!(e.field, "limits.ray_cells");
+        for part in ["sensor[0].max_range = 10 m", "map.resolution = 0.00001 m", "1000000 cells", "50000"] {
+            assert!(e.message.contains(part), "{part}: {}", e.message);
+        }
+        assert!(l.check_ray("x", f64::INFINITY, "map.resolution", 0.05).is_err());
+        assert!(l.check_ray("x", 1.0, "map.resolution", 0.0).is_err());
+    }
+
+    #[test]
+    fn the_map_budget_is_whole_tiles_and_never_zero() {
+        let l = |map_cells| LimitsConfig { map_cells, ..Default::default() };
+        assert_eq!(l(1).map_tiles(), 1);
+        assert_eq!(l(4096).map_tiles(), 1);
+        assert_eq!(l(4097).map_tiles(), 2);
+        assert_eq!(LimitsConfig::default().map_tiles(), 1 << 18);
+        assert!(l(0).validate().is_err());
+    }
+}
