@@ -159,5 +159,7 @@ fn format_chain(e: &anyhow::Error) -> String {
             s.push_str(&c);
         }
     }
-    s.replace('\n', " ")
+    // One line, and nothing a log wrote into a name (escape sequences, NUL) reaches the
+    // terminal as itself.
+    fusemap_io::text::printable(&s.replace('\n', " ")).into_owned()
 }

@@ -3,6 +3,7 @@
 use fusemap_core::grid::{InsertStats, Raster};
 use fusemap_core::metrics::EntropyReport;
 use fusemap_core::sensor::ReturnCounts;
+use fusemap_io::text::printable;
 use serde::Serialize;
 
 /// The summary of one mapping run.
@@ -89,7 +90,7 @@ impl MapInfo {
 impl Summary {
     /// Prints the summary for a person.
     pub fn print(&self) {
-        println!("source        {} ({})", self.source, self.source_kind);
+        println!("source        {} ({})", printable(&self.source), self.source_kind);
         println!("scans         {}", self.scans);
         let r = &self.returns;
         println!(
@@ -132,7 +133,7 @@ impl Summary {
             );
         }
         for n in &self.notes {
-            println!("note          {n}");
+            println!("note          {}", printable(n));
         }
         println!("wall time     {:.3} s", self.wall_time_s);
     }

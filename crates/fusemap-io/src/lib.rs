@@ -21,6 +21,7 @@ pub mod scanfile;
 pub mod semantic;
 pub mod simulation;
 pub mod slam_picture;
+pub mod text;
 pub mod trajectory;
 pub mod world_file;
 

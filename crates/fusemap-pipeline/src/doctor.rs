@@ -30,6 +30,7 @@ use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SyncConfig};
 use fusemap_core::geometry::quaternion_yaw;
 use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
+use fusemap_io::text::{printable, table_cell};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -96,7 +97,7 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
     let limits = limits(cfg);
     let mut out = String::new();
     let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
-    writeln!(out, "log: {name} ({})", log.format)?;
+    writeln!(out, "log: {} ({})", printable(&name), log.format)?;
     writeln!(out)?;
 
     let mut rows: Vec<(String, &str, StreamTiming)> = Vec::new();
@@ -140,7 +141,8 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
             t.delay.map_or(("-".into(), "-".into(), "-".into()), |d| (ms(d.min_s), ms(d.mean_s), ms(d.max_s)));
         writeln!(
             out,
-            "| {topic} | {kind} | {} | {:.2} | {:.1} | {:.1} | {dmin} | {dmean} | {dmax} | {} | {} | {} |",
+            "| {} | {kind} | {} | {:.2} | {:.1} | {:.1} | {dmin} | {dmean} | {dmax} | {} | {} | {} |",
+            table_cell(topic),
             t.count,
             t.rate_hz,
             t.jitter_s * 1e3,
@@ -156,8 +158,8 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
             writeln!(
                 out,
                 "static transform {} -> {}: translation ({:.3}, {:.3}, {:.3}), yaw {:.2}°",
-                t.parent,
-                t.child,
+                printable(&t.parent),
+                printable(&t.child),
                 t.translation[0],
                 t.translation[1],
                 t.translation[2],
@@ -166,7 +168,7 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
         }
     }
     for (t, n) in &log.stats.skipped_by_type {
-        writeln!(out, "skipped {n} records of type {t}")?;
+        writeln!(out, "skipped {n} records of type {}", printable(t))?;
     }
 
     // How the scans would be posed, as `fusemap map` does it.
@@ -307,12 +309,15 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
     if let Some(s) = &sync {
         writeln!(out)?;
         match &s.track {
-            None => {
-                writeln!(out, "scans on {} are posed by the {}: no time synchronisation needed", s.topic, s.source)?
-            }
+            None => writeln!(
+                out,
+                "scans on {} are posed by the {}: no time synchronisation needed",
+                printable(&s.topic),
+                s.source
+            )?,
             Some(tr) => {
                 let share = |k: &Skipped| 100.0 * (s.scans - k.total()) as f64 / s.scans.max(1) as f64;
-                writeln!(out, "scans on {} with a pose from {}:", s.topic, s.source)?;
+                writeln!(out, "scans on {} with a pose from {}:", printable(&s.topic), s.source)?;
                 writeln!(out, "  interpolate: {:.1} %", share(&tr.interpolate))?;
                 writeln!(out, "  nearest within {:.0} ms: {:.1} %", tr.nearest_tolerance_s * 1e3, share(&tr.nearest))?;
                 let skipped = if tr.configured == SyncMode::Interpolate { &tr.interpolate } else { &tr.nearest };
@@ -359,7 +364,7 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
         writeln!(out, "- no clock faults found")?;
     }
     for f in findings {
-        writeln!(out, "- {f}")?;
+        writeln!(out, "- {}", printable(&f))?;
     }
     Ok(Report { text: out, refusal })
 }
