@@ -39,19 +39,33 @@ pub fn run_simulated(
     let files = output::prepare(out, inputs)?;
     let mut engine = engine_for(plan);
     let ids: Vec<_> = (0..plan.lidars.len() as u16).map(fusemap_core::measurement::SensorId).collect();
+    // Scan i is taken at i / rate: a pose implying an impossible motion from its neighbours
+    // is a glitch (as on a log's pose streams), left out and counted.
+    let stamp = |i: usize| fusemap_core::time::Stamp::from_secs_f64(i as f64 / scanner.rate_hz).unwrap_or_default();
+    let timed: Vec<_> = poses.iter().enumerate().map(|(i, p)| (stamp(i), *p)).collect();
+    let keep = fusemap_core::time::plausible_samples(&timed, &plan.log.motion_limits());
+    let glitches = keep.iter().filter(|k| !**k).count() as u64;
     let pb = progress::bar(poses.len() as u64, "mapping");
     for (i, pose) in poses.iter().enumerate() {
+        if !keep[i] {
+            pb.inc(1);
+            continue;
+        }
         for (k, id) in ids.iter().enumerate() {
             let mount = plan.lidars[k].model.mount();
-            let stamp = fusemap_core::time::Stamp::from_secs_f64(i as f64 / scanner.rate_hz).unwrap_or_default();
-            let scan = fusemap_core::sim::simulate_scan(world, scanner, mount, *pose, stamp);
+            let scan = fusemap_core::sim::simulate_scan(world, scanner, mount, *pose, stamp(i));
             // The engine's refusals (a map past limits.map_cells) name the world file.
             engine.insert_scan(*id, &scan, *pose).map_err(|e| anyhow::anyhow!("{source}: scan {i}: {e}"))?;
         }
         pb.inc(1);
     }
     pb.finish_and_clear();
-    finish(&engine, &files, export, "world", source, started, Vec::new(), None, None)
+    let notes = if glitches > 0 {
+        vec![fusemap_pipeline::track::glitch_note("the world file's trajectory", glitches, &plan.log)]
+    } else {
+        Vec::new()
+    };
+    finish(&engine, &files, export, "world", source, started, notes, None, None)
 }
 
 /// `fusemap map`: a world file (simulated) or a robot log; `crop` exports that region

@@ -161,3 +161,37 @@ fn a_gzipped_log_of_one_endless_line_stops_at_the_decompression_limit() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_world_pose_1e8_m_off_is_a_counted_glitch_and_the_map_is_the_one_without_it() {
+    // The corridor's 40 poses with one replaced by a pose 1e8 m away (the case:
+    // it panicked on a capacity overflow), and the same run without that pose at all.
+    let corridor = std::fs::read_to_string(repo_file("worlds/corridor.toml")).unwrap();
+    let head = &corridor[..corridor.find("[trajectory]").unwrap()];
+    let poses = |glitch: bool| {
+        let list: Vec<String> = (0..40)
+            .filter_map(|i| match (i, glitch) {
+                (17, true) => Some("[1e8, -1e8, 0.0]".to_string()),
+                (17, false) => None,
+                _ => Some(format!("[{:.1}, 0.0, 0.0]", 0.1 * i as f64)),
+            })
+            .collect();
+        format!("{head}[trajectory]\nposes = [{}]\n", list.join(", "))
+    };
+    let dir = temp_dir("limits-world-glitch");
+    let mut maps = Vec::new();
+    for glitch in [true, false] {
+        let world = write_file(&dir, &format!("world-{glitch}.toml"), poses(glitch));
+        let out = dir.join(format!("out-{glitch}"));
+        assert_success(&run(&["map", "--world", s(&world), "--out", s(&out)]));
+        let summary = read_json(&out.join("summary.json"));
+        let notes = summary["notes"].to_string();
+        assert_eq!(notes.contains("1 pose sample(s) rejected as glitches"), glitch, "{notes}");
+        assert_eq!(summary["scans"].as_u64(), Some(39));
+        maps.push(std::fs::read(out.join("map.pgm")).unwrap());
+    }
+    // The scans are simulated at their own index's time, so the glitch run's later scans are
+    // 0.1 s later than the clean run's: the same poses, the same map.
+    assert!(maps[0] == maps[1], "the glitch changed the map");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
