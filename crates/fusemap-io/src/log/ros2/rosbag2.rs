@@ -228,6 +228,7 @@ impl Rosbag2Dir {
         }
         let storage = meta.storage_identifier.to_ascii_lowercase();
         let mut files = Vec::new();
+        let mut seen: Vec<(PathBuf, &str)> = Vec::new();
         for rel in &meta.relative_file_paths {
             // The bag names its files relative to its own directory: an absolute path or a
             // `..` would let a bag someone sent make fusemap open any file.
@@ -240,6 +241,21 @@ impl Rosbag2Dir {
             let path = resolve(dir, rel).ok_or_else(|| {
                 field_error("relative_file_paths", format!("lists `{rel}`, which is not in {}", dir.display()))
             })?;
+            // One file listed twice (or by two spellings) would be read, and mapped, twice.
+            let canonical = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
+            if let Some((_, first)) = seen.iter().find(|(p, _)| *p == canonical) {
+                return Err(field_error(
+                    "relative_file_paths",
+                    format!(
+                        "lists the storage file `{}` twice (as `{}` and `{}`): every message would be read twice; \
+                         remove the repeat",
+                        canonical.display(),
+                        first.escape_debug(),
+                        rel.escape_debug()
+                    ),
+                ));
+            }
+            seen.push((canonical, rel));
             let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
             let compressed = zstd_file || name.ends_with(".zstd");
             let base = name.trim_end_matches(".zstd");
@@ -318,6 +334,25 @@ mod tests {
         let e = Rosbag2Dir::open(&bag).err().expect("refused");
         let text = e.to_string();
         assert!(text.contains("outside the bag directory") && text.contains("metadata.yaml"), "{text}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_storage_file_listed_twice_is_refused() {
+        let dir = crate::testdata::temp_dir("rosbag2-twice");
+        std::fs::write(dir.join("a_0.mcap"), b"x").unwrap();
+        std::fs::write(dir.join("a_1.mcap"), b"x").unwrap();
+        let list = |files: &str| {
+            let meta =
+                format!("rosbag2_bagfile_information:\n  storage_identifier: mcap\n  relative_file_paths: [{files}]\n");
+            std::fs::write(dir.join(METADATA_FILE), meta).unwrap();
+            Rosbag2Dir::open(&dir)
+        };
+        assert_eq!(list("a_0.mcap, a_1.mcap").unwrap().files.len(), 2);
+        for twice in ["a_0.mcap, a_1.mcap, a_0.mcap", "a_0.mcap, ./a_0.mcap"] {
+            let text = list(twice).err().expect("refused").to_string();
+            assert!(text.contains("twice") && text.contains("a_0.mcap") && text.contains("metadata.yaml"), "{text}");
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
