@@ -24,6 +24,9 @@ pub struct Skipped {
     pub pose_glitch: u64,
     /// Arrived later than the merge's reorder window behind the other scans.
     pub late: u64,
+    /// Its beam angles cannot be placed (`ScanMessage::angle_fault`): a zero or non-finite
+    /// `angle_increment`, or a `ranges` count that disagrees with `angle_min … angle_max`.
+    pub bad_angles: u64,
 }
 
 impl Skipped {
@@ -46,6 +49,7 @@ impl Skipped {
             + self.no_pose_on_line
             + self.pose_glitch
             + self.late
+            + self.bad_angles
     }
 
     /// Adds another lidar's counts.
@@ -57,6 +61,7 @@ impl Skipped {
         self.no_pose_on_line += o.no_pose_on_line;
         self.pose_glitch += o.pose_glitch;
         self.late += o.late;
+        self.bad_angles += o.bad_angles;
     }
 }
 

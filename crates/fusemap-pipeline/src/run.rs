@@ -149,6 +149,8 @@ struct Mapped {
     report: LidarReport,
     /// Scan lines whose pose is a glitch (a scan-line track only).
     line_glitches: HashSet<LineKey>,
+    /// Why the first scan refused for its beam angles was refused.
+    bad_angles_example: Option<String>,
 }
 
 /// A bound lidar's frame, its resolved mount and its sensor model.
@@ -313,6 +315,7 @@ pub fn map_with_track(
                 Track::ScanLine => topic.line_glitches(&cfg.motion_limits()),
                 Track::Timed(_) => HashSet::new(),
             },
+            bad_angles_example: None,
         });
     }
 
@@ -455,6 +458,14 @@ pub fn map_with_track(
             };
             notes.push(format!("`{}` stamps go backwards {} times{order}", r.topic, r.timing.regressions));
         }
+        if r.scans_skipped.bad_angles > 0 {
+            notes.push(format!(
+                "{} scans of `{}` refused: their beam angles cannot be placed (first: {})",
+                r.scans_skipped.bad_angles,
+                r.topic,
+                l.bad_angles_example.as_deref().unwrap_or("?")
+            ));
+        }
         if r.scans_skipped.late > 0 {
             notes.push(format!(
                 "{} scans of `{}` arrived more than log.reorder_window_s = {} s behind the others and were dropped",
@@ -463,8 +474,9 @@ pub fn map_with_track(
         }
     }
     let read: u64 = lidars.iter().map(|l| l.report.scans_read).sum();
-    if skipped.total() > 0 {
-        notes.push(format!("{} of {} scans skipped without a pose", skipped.total(), read));
+    let without_pose = skipped.total() - skipped.bad_angles;
+    if without_pose > 0 {
+        notes.push(format!("{without_pose} of {read} scans skipped without a pose"));
     }
     if inv.stats.malformed > 0 {
         notes.push(format!(
@@ -597,6 +609,11 @@ struct Inserter<'a> {
 
 impl Inserter<'_> {
     fn insert(&mut self, l: &mut Mapped, key: Stamp, msg: &ScanMessage) -> Result<(), PipelineError> {
+        if let Some(why) = msg.angle_fault() {
+            l.report.scans_skipped.bad_angles += 1;
+            l.bad_angles_example.get_or_insert(why);
+            return Ok(());
+        }
         // Angles at LaserScan's float32 precision whatever the format, so that the same
         // scan read from CARMEN text or from a ROS message gives the same rays.
         let scan = &mut self.scan;

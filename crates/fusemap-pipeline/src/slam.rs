@@ -191,7 +191,9 @@ pub fn run(
         };
         let deskew = motion_at(n.saturating_sub(1)).is_some();
         hits.clear();
-        hits.extend(scan.scan.ranges.iter().enumerate().filter_map(|(i, &r)| {
+        // A scan whose beams cannot be placed (refused by the mapping pass too) gives no hits.
+        let beams = if scan.angle_fault().is_none() { &scan.scan.ranges[..] } else { &[] };
+        hits.extend(beams.iter().enumerate().filter_map(|(i, &r)| {
             let r = r as f64;
             (r.is_finite() && r >= lo && r < hi).then(|| {
                 let a = mount.beam_angle_in_base(a0 + i as f64 * inc);

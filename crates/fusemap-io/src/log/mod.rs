@@ -45,6 +45,9 @@ pub struct ScanMessage {
     pub receive_stamp: Option<Stamp>,
     /// The scan; `scan.stamp` is the header stamp (acquisition of the first beam).
     pub scan: LaserScan,
+    /// The angle of the last beam as the message states it (ROS `angle_max`), radians;
+    /// NaN when the format states none (CARMEN, whose angles follow from the count).
+    pub angle_max: f32,
     /// Seconds between beams (0 when unknown).
     pub time_increment: f32,
     /// Seconds between scans (0 when unknown).
@@ -62,6 +65,36 @@ pub struct ScanMessage {
     /// For CARMEN `ROBOTLASER1`: the laser pose on the line (`world_from_laser`), from
     /// which the mount follows.
     pub laser_pose: Option<Pose2>,
+}
+
+impl ScanMessage {
+    /// Why the scan's beams cannot be placed, if they cannot: an `angle_increment` that is
+    /// zero or not finite puts every beam on one bearing, a non-finite `angle_min` puts
+    /// them nowhere, and a `ranges` count that disagrees with the stated
+    /// `angle_min … angle_max` (by more than one beam and 1 %) would spread them over
+    /// another field of view — a driver bug, or a message cut or padded. Such a scan is
+    /// refused and counted, never drawn.
+    pub fn angle_fault(&self) -> Option<String> {
+        let (a0, inc, n) = (self.scan.angle_min, self.scan.angle_increment, self.scan.ranges.len());
+        if !a0.is_finite() {
+            return Some(format!("angle_min is {a0}"));
+        }
+        if !(inc.is_finite() && inc != 0.0) {
+            return Some(format!("angle_increment is {inc}: every beam would lie on one bearing"));
+        }
+        let a1 = f64::from(self.angle_max);
+        if a1.is_nan() || n == 0 {
+            return None;
+        }
+        let expected = (a1 - a0) / inc + 1.0;
+        let tolerance = 1.0 + 0.01 * expected.abs();
+        if !(expected.is_finite() && (n as f64 - expected).abs() <= tolerance) {
+            return Some(format!(
+                "{n} ranges, but angle_min {a0:.4} to angle_max {a1:.4} rad by {inc:.6} rad is {expected:.1} beams"
+            ));
+        }
+        None
+    }
 }
 
 /// Robot odometry (`nav_msgs/Odometry`, CARMEN `ODOM`): `odom_from_base` at a stamp.
@@ -395,6 +428,45 @@ mod tests {
     }
 
     #[test]
+    fn beam_angles_that_cannot_be_placed_are_named() {
+        let scan = |angle_min: f64, angle_increment: f64, angle_max: f32, n: usize| ScanMessage {
+            topic: "/scan".into(),
+            frame_id: "laser".into(),
+            receive_stamp: None,
+            scan: LaserScan { stamp: Stamp(1), angle_min, angle_increment, ranges: vec![1.0; n] },
+            angle_max,
+            time_increment: 0.0,
+            scan_time: 0.0,
+            range_min: 0.0,
+            range_max: 10.0,
+            pose: None,
+            odom_pose: None,
+            laser_pose: None,
+        };
+        let inc = std::f64::consts::PI / 720.0;
+        let half = std::f32::consts::FRAC_PI_2;
+        let a0 = std::f64::consts::FRAC_PI_2;
+        // ±90° at 0.25° is 721 beams; a driver's rounding of one beam either way is kept.
+        for n in [720, 721, 722] {
+            assert_eq!(scan(-a0, inc, half, n).angle_fault(), None, "{n}");
+        }
+        // CARMEN states no angle_max: the count decides the angles.
+        assert_eq!(scan(-a0, inc, f32::NAN, 181).angle_fault(), None);
+        // A negative increment sweeping clockwise is a real layout.
+        assert_eq!(scan(a0, -inc, -half, 721).angle_fault(), None);
+        for (bad, what) in [
+            (scan(-1.57, 0.0, half, 721), "angle_increment is 0"),
+            (scan(-1.57, f64::NAN, half, 721), "angle_increment is NaN"),
+            (scan(f64::INFINITY, inc, half, 721), "angle_min is inf"),
+            (scan(-a0, inc, half, 1442), "1442 ranges"),
+            (scan(-a0, inc, half, 360), "is 721.0 beams"),
+        ] {
+            let why = bad.angle_fault().expect(what);
+            assert!(why.contains(what), "{what}: {why}");
+        }
+    }
+
+    #[test]
     fn topic_and_stamps_of_every_kind() {
         let receive = Some(Stamp(99));
         let messages = [
@@ -403,6 +475,7 @@ mod tests {
                 frame_id: "laser".into(),
                 receive_stamp: receive,
                 scan: LaserScan { stamp: Stamp(1), angle_min: 0.0, angle_increment: 0.1, ranges: vec![] },
+                angle_max: f32::NAN,
                 time_increment: 0.0,
                 scan_time: 0.0,
                 range_min: 0.0,

@@ -119,7 +119,7 @@ fn header(c: &mut Cursor<'_>) -> Result<(Stamp, String), Malformed> {
 fn scan(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<ScanMessage, Malformed> {
     let (stamp, frame_id) = header(c)?;
     let angle_min = c.f32("angle_min")?;
-    let _angle_max = c.f32("angle_max")?;
+    let angle_max = c.f32("angle_max")?;
     let angle_increment = c.f32("angle_increment")?;
     let time_increment = c.f32("time_increment")?;
     let scan_time = c.f32("scan_time")?;
@@ -132,6 +132,7 @@ fn scan(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result
         frame_id,
         receive_stamp,
         scan: LaserScan { stamp, angle_min: f64::from(angle_min), angle_increment: f64::from(angle_increment), ranges },
+        angle_max,
         time_increment,
         scan_time,
         range_min,

@@ -342,6 +342,7 @@ fn standard_messages() -> Vec<LogMessage> {
             frame_id: "laser".into(),
             receive_stamp: Some(receive),
             scan: LaserScan { stamp, angle_min: -1.0, angle_increment: 0.5, ranges },
+            angle_max: 1.0,
             time_increment: 0.001,
             scan_time: 0.1,
             range_min: 0.1,

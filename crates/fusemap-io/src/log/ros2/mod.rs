@@ -178,6 +178,7 @@ pub fn decode_known_with(
                     angle_increment: f64::from(m.angle_increment),
                     ranges: m.ranges,
                 },
+                angle_max: m.angle_max,
                 time_increment: m.time_increment,
                 scan_time: m.scan_time,
                 range_min: m.range_min,

@@ -236,6 +236,7 @@ fn expect(log_time: Stamp, topic: &str, m: &OutMessage) -> Option<LogMessage> {
                 angle_increment: f64::from(s.angle_increment),
                 ranges: s.ranges.clone(),
             },
+            angle_max: s.angle_max,
             time_increment: s.time_increment,
             scan_time: s.scan_time,
             range_min: s.range_min,
