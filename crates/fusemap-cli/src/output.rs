@@ -1,5 +1,8 @@
 //! Writing a run's outputs: `map.npz`, `map.pgm` + `map.yaml`, `map.png`, `summary.json`.
-//! Every file is written atomically (temp file + rename) and never over an input.
+//! They are one set ([`OutputSet`]): written into a staging directory inside the output
+//! directory while the run holds its lock, moved into place together when all are
+//! written, `summary.json` last with each file's size and SHA-256. A failing run leaves
+//! the previous set as it was; no output is ever written over an input.
 
 use crate::export::{view_of, ExportOptions, MapView};
 use crate::summary::{CellsUpdated, MapInfo, Summary};
@@ -12,10 +15,10 @@ use fusemap_core::measurement::SensorId;
 use fusemap_core::metrics::{map_entropy, sparse_entropy};
 use fusemap_core::sensor::ReturnCounts;
 use fusemap_core::time::Stamp;
-use fusemap_io::atomic::{ensure_not_input, write_atomic};
+use fusemap_io::atomic::ensure_not_input;
 use fusemap_io::npz::NpzLayers;
+use fusemap_io::output_set::OutputSet;
 use fusemap_io::semantic::{ClassInfo, SemanticRaster};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -61,6 +64,21 @@ impl OutputFiles {
         }
     }
 
+    /// The file names of a run's set, for removing an earlier run's files this run does
+    /// not write.
+    pub const NAMES: [&'static str; 10] = [
+        "map.npz",
+        "map.yaml",
+        "map.pgm",
+        "map.png",
+        "summary.json",
+        "trajectory.tum",
+        "semantic.yaml",
+        "semantic.png",
+        "dynamic.png",
+        "slam.png",
+    ];
+
     fn all(&self) -> [&PathBuf; 10] {
         [
             &self.npz,
@@ -77,14 +95,23 @@ impl OutputFiles {
     }
 }
 
-/// Creates `dir` and checks that no output would overwrite one of `inputs`.
-pub fn prepare(dir: &Path, inputs: &[PathBuf]) -> Result<OutputFiles> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
-    let files = OutputFiles::in_dir(dir);
-    for f in files.all() {
+/// A run's outputs: the paths its writers use (inside the set's staging directory) and
+/// the set that moves them into the output directory at the end.
+pub struct Outputs {
+    /// Where each file is written until the commit.
+    pub files: OutputFiles,
+    set: OutputSet,
+}
+
+/// Checks that no output would overwrite one of `inputs`, creates `dir`, takes its lock
+/// (a second run into it is refused while this one lives) and opens the set.
+pub fn prepare(dir: &Path, inputs: &[PathBuf]) -> Result<Outputs> {
+    for f in OutputFiles::in_dir(dir).all() {
         ensure_not_input(f, inputs)?;
     }
-    Ok(files)
+    let set =
+        OutputSet::begin(dir).with_context(|| format!("cannot write into the output directory {}", dir.display()))?;
+    Ok(Outputs { files: OutputFiles::in_dir(set.staging()), set })
 }
 
 /// The semantic and dynamic layers of a run with a camera, over the occupancy raster's
@@ -132,52 +159,25 @@ pub fn layers_of(engine: &Engine, grid: &FusionGrid, raster: &Raster) -> Option<
     Some(Layers { semantic, dynamic })
 }
 
-/// Writes the map files of `view`, the trajectory (when there is one) and the summary.
+/// Writes the map files of `view` and the trajectory (when there is one) into the set,
+/// then commits it with the summary, which lists them.
 pub fn write(
-    files: &OutputFiles,
+    outputs: Outputs,
     view: &MapView,
     layers: Option<&Layers>,
-    summary: &Summary,
+    summary: &mut Summary,
     trajectory: Option<&[(Stamp, Pose2)]>,
 ) -> Result<()> {
+    let Outputs { files, set } = outputs;
     if let Some(t) = trajectory {
         fusemap_io::trajectory::write_tum(&files.trajectory, t)?;
     }
-    // Files of an earlier run into the same directory that this run does not write are
-    // removed first: a run never leaves files beside its summary that look like its own.
     let graph = summary.log.as_ref().and_then(pose_graph_of);
-    let dense = match view {
-        MapView::Dense(r) => Some(r),
-        _ => None,
-    };
-    let mut stale: Vec<&PathBuf> = Vec::new();
-    if trajectory.is_none() {
-        stale.push(&files.trajectory);
-    }
-    match view {
-        MapView::Empty => stale.extend([&files.npz, &files.yaml, &files.pgm, &files.png]),
-        MapView::Sparse { .. } => stale.extend([&files.yaml, &files.pgm]),
-        MapView::Dense(_) => {}
-    }
-    if dense.is_none() || layers.is_none() {
-        stale.extend([&files.semantic, &files.semantic_png, &files.dynamic]);
-    }
-    if dense.is_none() || graph.is_none() {
-        stale.push(&files.slam);
-    }
-    for f in stale {
-        match std::fs::remove_file(f) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(e).with_context(|| format!("cannot remove the earlier run's {}", f.display()))
-            }
-            _ => {}
-        }
-    }
     if let MapView::Sparse { tiles, overview, .. } = view {
         fusemap_io::npz::write_sparse_map_npz(&files.npz, tiles)?;
         fusemap_io::picture::write_map_png(&files.png, overview)?;
     }
-    if let Some(r) = dense {
+    if let MapView::Dense(r) = view {
         match layers {
             Some(l) => {
                 let with = NpzLayers { semantic: Some(&l.semantic), dynamic: Some(&l.dynamic) };
@@ -193,8 +193,13 @@ pub fn write(
             fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, &trajectory, &closures)?;
         }
     }
-    let json = serde_json::to_vec_pretty(summary)?;
-    write_atomic(&files.summary, |w| w.write_all(&json))?;
+    // Files of an earlier run that this run does not write are removed at the commit: a
+    // run never leaves files beside its summary that look like its own.
+    let summary_path = set.dir().join("summary.json");
+    set.commit(&OutputFiles::NAMES, "summary.json", |list| {
+        summary.files = list.to_vec();
+        serde_json::to_vec_pretty(&*summary).map_err(|e| fusemap_io::Error::io(&summary_path, std::io::Error::other(e)))
+    })?;
     Ok(())
 }
 
@@ -234,7 +239,7 @@ fn pose_graph_of(log: &serde_json::Value) -> Option<GraphPicture> {
 #[allow(clippy::too_many_arguments)]
 pub fn finish(
     engine: &Engine,
-    files: &OutputFiles,
+    outputs: Outputs,
     export: &ExportOptions,
     source_kind: &str,
     source: &str,
@@ -291,6 +296,7 @@ pub fn finish(
         wall_time_s: 0.0,
         notes,
         log,
+        files: Vec::new(),
     };
     if matches!(view, MapView::Empty) {
         summary.notes.push("no cell was observed: only summary.json was written".into());
@@ -299,7 +305,7 @@ pub fn finish(
         summary.notes.push("the semantic and dynamic layers are written only with a dense map (--crop)".into());
     }
     summary.wall_time_s = started.elapsed().as_secs_f64();
-    write(files, &view, layers.as_ref(), &summary, trajectory)?;
+    write(outputs, &view, layers.as_ref(), &mut summary, trajectory)?;
     summary.wall_time_s = started.elapsed().as_secs_f64();
     Ok(summary)
 }

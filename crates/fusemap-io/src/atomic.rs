@@ -72,7 +72,7 @@ pub fn write_atomic<T>(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> 
 
 /// `fsync` of a directory makes a rename in it durable. Not every platform or file
 /// system supports it, and the data is already safe, so failures are ignored.
-fn sync_dir(dir: &Path) {
+pub(crate) fn sync_dir(dir: &Path) {
     #[cfg(unix)]
     if let Ok(d) = File::open(dir) {
         let _ = d.sync_all();

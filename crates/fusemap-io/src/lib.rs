@@ -14,6 +14,7 @@ pub mod input_file;
 pub mod log;
 pub mod map_server;
 pub mod npz;
+pub mod output_set;
 pub mod picture;
 pub mod read_ahead;
 pub mod relations;

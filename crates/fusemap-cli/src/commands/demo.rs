@@ -87,7 +87,7 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     let source = format!("built-in production line, simulated to {}", sim.bag.dir.display());
     let summary = finish(
         &run.engine,
-        &files,
+        files,
         &ExportOptions { crop: None, export_cells: plan.limits.export_cells },
         "rosbag2 (simulated production line)",
         &source,

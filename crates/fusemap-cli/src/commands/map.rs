@@ -65,7 +65,7 @@ pub fn run_simulated(
     } else {
         Vec::new()
     };
-    finish(&engine, &files, export, "world", source, started, notes, None, None)
+    finish(&engine, files, export, "world", source, started, notes, None, None)
 }
 
 /// `fusemap map`: a world file (simulated) or a robot log; `crop` exports that region
@@ -130,7 +130,7 @@ fn run_log(plan: &Plan, export: &ExportOptions, path: &Path, out: &Path, inputs:
     let value = serde_json::to_value(&run.report)?;
     finish(
         &run.engine,
-        &files,
+        files,
         export,
         &run.format.to_string(),
         &path.display().to_string(),

@@ -6,6 +6,7 @@ mod demo;
 mod doctor;
 mod formats;
 mod limits;
+mod output_set;
 mod real_logs;
 mod relations;
 mod scenario_demo;
