@@ -364,9 +364,15 @@ pub fn write_map_npz_with(path: &Path, raster: &Raster, layers: &NpzLayers<'_>) 
         arrays.push(("dynamic", NpyArray::new(&shape, NpyData::F32(&dynamic))));
     }
 
-    let mut all = Vec::new();
+    // The checks above guarantee the sizes; this keeps the writer panic-free regardless.
+    write_arrays(path, arrays)
+}
+
+/// Writes `arrays` as an `.npz` at `path`, atomically; an array whose shape did not match
+/// its data (`None`) is an error naming it, and nothing is written.
+fn write_arrays(path: &Path, arrays: Vec<(&str, Option<NpyArray<'_>>)>) -> Result<()> {
+    let mut all = Vec::with_capacity(arrays.len());
     for (name, array) in arrays {
-        // The checks above guarantee the sizes; this keeps the writer panic-free regardless.
         let array = array.ok_or_else(|| {
             Error::format(path, Location::Field(name.into()), "array size does not match the map's shape")
         })?;

@@ -1,8 +1,7 @@
 //! The sparse `.npz`: a map too large for one dense raster (past `[limits] export_cells`),
 //! written as it is stored, tile by tile.
 
-use super::{NpyArray, NpyData, NpzWriter};
-use crate::atomic::write_atomic;
+use super::{NpyArray, NpyData};
 use crate::{Error, Location, Result};
 use fusemap_core::grid::{SparseTiles, TILE_CELLS, TILE_SIZE};
 use std::path::Path;
@@ -36,26 +35,14 @@ pub fn write_sparse_map_npz(path: &Path, tiles: &SparseTiles) -> Result<()> {
     let tile_size = [TILE_SIZE as i32];
     let resolution = [tiles.resolution];
     let origin = [tiles.origin.x, tiles.origin.y];
-    let arrays = [
+    let arrays = vec![
         ("tile_keys", NpyArray::new(&[n, 2], NpyData::I64(&keys))),
         ("tile_log_odds", NpyArray::new(&[n, TILE_SIZE, TILE_SIZE], NpyData::F32(&tiles.log_odds))),
         ("tile_size", NpyArray::new(&[], NpyData::I32(&tile_size))),
         ("resolution", NpyArray::new(&[], NpyData::F64(&resolution))),
         ("origin", NpyArray::new(&[2], NpyData::F64(&origin))),
     ];
-    let mut all = Vec::with_capacity(arrays.len());
-    for (name, array) in arrays {
-        let array = array.ok_or_else(|| Error::format(path, Location::Field(name.into()), "array size mismatch"))?;
-        all.push((name, array));
-    }
-    write_atomic(path, |w| {
-        let mut npz = NpzWriter::new(w);
-        for (name, array) in &all {
-            npz.add(name, array)?;
-        }
-        npz.finish()?;
-        Ok(())
-    })
+    super::write_arrays(path, arrays)
 }
 
 #[cfg(test)]
