@@ -30,6 +30,7 @@ pub mod extrinsics;
 pub mod merge;
 pub mod pose_sensors_report;
 pub mod recording;
+pub mod repeats;
 pub mod report;
 pub mod run;
 pub mod scenario;

@@ -27,6 +27,8 @@ pub struct Skipped {
     /// Its beam angles cannot be placed (`ScanMessage::angle_fault`): a zero or non-finite
     /// `angle_increment`, or a `ranges` count that disagrees with `angle_min … angle_max`.
     pub bad_angles: u64,
+    /// The same scan again (same stamp and ranges as the one before it): inserted once.
+    pub repeated: u64,
 }
 
 impl Skipped {
@@ -50,6 +52,7 @@ impl Skipped {
             + self.pose_glitch
             + self.late
             + self.bad_angles
+            + self.repeated
     }
 
     /// Adds another lidar's counts.
@@ -62,6 +65,7 @@ impl Skipped {
         self.pose_glitch += o.pose_glitch;
         self.late += o.late;
         self.bad_angles += o.bad_angles;
+        self.repeated += o.repeated;
     }
 }
 

@@ -151,6 +151,8 @@ struct Mapped {
     line_glitches: HashSet<LineKey>,
     /// Why the first scan refused for its beam angles was refused.
     bad_angles_example: Option<String>,
+    /// The scan before, to insert a repeated message once.
+    repeats: crate::repeats::RepeatFilter,
 }
 
 /// A bound lidar's frame, its resolved mount and its sensor model.
@@ -316,6 +318,7 @@ pub fn map_with_track(
                 Track::Timed(_) => HashSet::new(),
             },
             bad_angles_example: None,
+            repeats: Default::default(),
         });
     }
 
@@ -466,6 +469,12 @@ pub fn map_with_track(
                 l.bad_angles_example.as_deref().unwrap_or("?")
             ));
         }
+        if r.scans_skipped.repeated > 0 {
+            notes.push(format!(
+                "{} scans of `{}` repeat the scan before them (same stamp, same ranges): each was inserted once",
+                r.scans_skipped.repeated, r.topic
+            ));
+        }
         if r.scans_skipped.late > 0 {
             notes.push(format!(
                 "{} scans of `{}` arrived more than log.reorder_window_s = {} s behind the others and were dropped",
@@ -474,7 +483,7 @@ pub fn map_with_track(
         }
     }
     let read: u64 = lidars.iter().map(|l| l.report.scans_read).sum();
-    let without_pose = skipped.total() - skipped.bad_angles;
+    let without_pose = skipped.total() - skipped.bad_angles - skipped.repeated;
     if without_pose > 0 {
         notes.push(format!("{without_pose} of {read} scans skipped without a pose"));
     }
@@ -609,6 +618,10 @@ struct Inserter<'a> {
 
 impl Inserter<'_> {
     fn insert(&mut self, l: &mut Mapped, key: Stamp, msg: &ScanMessage) -> Result<(), PipelineError> {
+        if l.repeats.is_repeat(msg) {
+            l.report.scans_skipped.repeated += 1;
+            return Ok(());
+        }
         if let Some(why) = msg.angle_fault() {
             l.report.scans_skipped.bad_angles += 1;
             l.bad_angles_example.get_or_insert(why);

@@ -158,8 +158,13 @@ pub fn run(
     // order; CARMEN IPC stamps go backwards now and then).
     let mut merge: OrderedMerge<ScanMessage> = OrderedMerge::new(crate::offset_ns(cfg.reorder_window_s));
     let stream = merge.add_stream(b.topic.clone());
+    let mut repeats = crate::repeats::RepeatFilter::default();
     let mut feed = |t: Stamp, scan: ScanMessage| {
         progress(Progress::Advance(1));
+        // A repeated message is one scan, as in the mapping pass.
+        if repeats.is_repeat(&scan) {
+            return;
+        }
         let pose = match &chosen.track {
             Track::ScanLine => {
                 scan.pose.filter(|p| p.is_finite() && !line_glitches.contains(&line_key(scan.scan.stamp, *p)))

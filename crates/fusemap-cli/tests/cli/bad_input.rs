@@ -300,6 +300,15 @@ fn log_directory_that_is_not_a_rosbag2() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// FLASER line `i` of a robot driving along a 4 m corridor at 5 cm a line, 10 Hz, every
+/// beam at 2 m; its pose `dx` metres off in x (a glitch), its raw odometry `odom_y` off in y
+/// (0: a raw log, the pose on the line its odometry).
+fn corridor_line(i: usize, dx: f64, odom_y: f64) -> String {
+    let ranges = vec!["2.0"; 180].join(" ");
+    let (x, t) = (0.05 * i as f64, 1.0 + 0.1 * i as f64);
+    format!("FLASER 180 {ranges} {:.2} 0 0 {x:.2} {odom_y} 0 {t:.3} host {t:.3}", x + dx)
+}
+
 /// A CARMEN log of 20 good FLASER lines (a robot driving along a 4 m corridor, every
 /// beam at 2 m) with one line of too few fields (line 6) and one with a NaN pose (line
 /// 11): both are skipped and counted, the rest is mapped.
@@ -307,12 +316,7 @@ fn log_directory_that_is_not_a_rosbag2() {
 fn log_malformed_carmen_lines_are_skipped_and_counted() {
     let dir = temp_dir("log-carmen-malformed");
     let ranges = vec!["2.0"; 180].join(" ");
-    let mut lines: Vec<String> = (0..20)
-        .map(|i| {
-            let (x, t) = (0.05 * i as f64, 1.0 + 0.1 * i as f64);
-            format!("FLASER 180 {ranges} {x:.2} 0 0 {x:.2} 0 0 {t:.3} host {t:.3}")
-        })
-        .collect();
+    let mut lines: Vec<String> = (0..20).map(|i| corridor_line(i, 0.0, 0.0)).collect();
     lines.insert(5, "FLASER 180 1 2 3 0 0 0 0 0 0 1 h 1".into());
     lines.insert(10, format!("FLASER 180 {ranges} nan 0 0 0 0 0 2.05 host 2.05"));
     let log = write_file(&dir, "corridor.log", lines.join("\n") + "\n");
@@ -348,11 +352,7 @@ fn log_malformed_carmen_lines_are_skipped_and_counted() {
 #[test]
 fn log_carmen_pose_glitch_is_rejected_and_the_map_is_not_stretched() {
     let dir = temp_dir("log-carmen-glitch");
-    let ranges = vec!["2.0"; 180].join(" ");
-    let line = |i: usize, dx: f64| {
-        let (x, t) = (0.05 * i as f64, 1.0 + 0.1 * i as f64);
-        format!("FLASER 180 {ranges} {:.2} 0 0 {:.2} 0.5 0 {t:.3} host {t:.3}", x + dx, x)
-    };
+    let line = |i: usize, dx: f64| corridor_line(i, dx, 0.5);
     let glitched: Vec<String> = (0..40).map(|i| line(i, if i == 12 { 1000.0 } else { 0.0 })).collect();
     let without: Vec<String> = (0..40).filter(|&i| i != 12).map(|i| line(i, 0.0)).collect();
     let mut maps = Vec::new();
@@ -507,13 +507,7 @@ fn a_run_with_no_map_fails_and_leaves_no_stale_map() {
 #[test]
 fn log_strings_are_escaped_before_they_reach_the_terminal() {
     let dir = temp_dir("log-escapes");
-    let ranges = vec!["2.0"; 180].join(" ");
-    let mut lines: Vec<String> = (0..20)
-        .map(|i| {
-            let (x, t) = (0.05 * i as f64, 1.0 + 0.1 * i as f64);
-            format!("FLASER 180 {ranges} {x:.2} 0 0 {x:.2} 0 0 {t:.3} host {t:.3}")
-        })
-        .collect();
+    let mut lines: Vec<String> = (0..20).map(|i| corridor_line(i, 0.0, 0.0)).collect();
     // Three readings, the second a token with a terminal title, a clear-screen and a NUL.
     lines.insert(5, "FLASER 3 1.0 \u{1b}]0;pwned\u{7}\u{1b}[2J\0 2.0 0 0 0 0 0 0 1.45 host 1.45".to_string());
     let log = write_file(&dir, "escapes.log", lines.join("\n") + "\n");
@@ -532,5 +526,34 @@ fn log_strings_are_escaped_before_they_reach_the_terminal() {
     let odd = write_file(&dir, "bad\u{1b}[2Jname.log", "\0\0\0\0");
     let line = one_line_error(&run(&["map", "--out", path_str(&out), path_str(&odd)]));
     assert!(!line.contains('\u{1b}') && line.contains("bad\\u{1b}[2Jname.log"), "{line:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A scan line written twice is one observation: inserted once and counted, and the map is
+/// the map of the log without the repeat, byte for byte.
+#[test]
+fn log_repeated_scans_are_inserted_once() {
+    let dir = temp_dir("log-repeats");
+    let line = |i: usize| corridor_line(i, 0.0, 0.0);
+    let once: Vec<String> = (0..30).map(line).collect();
+    let mut twice = once.clone();
+    twice.insert(11, line(10));
+    twice.insert(21, line(19));
+    let mut maps = Vec::new();
+    for (name, lines) in [("once", &once), ("twice", &twice)] {
+        let log = write_file(&dir, &format!("{name}.log"), lines.join("\n") + "\n");
+        let out = dir.join(name);
+        let o = run(&["map", "--out", path_str(&out), path_str(&log)]);
+        assert_success(&o);
+        let s = read_json(&out.join("summary.json"));
+        let repeated = s["log"]["lidars"][0]["scans_skipped"]["repeated"].as_u64();
+        assert_eq!(repeated, Some(if name == "twice" { 2 } else { 0 }), "{}", s["log"]["lidars"][0]);
+        assert_eq!(s["scans"], 30);
+        if name == "twice" {
+            assert!(stdout(&o).contains("2 scans of `FLASER` repeat the scan before them"), "{}", stdout(&o));
+        }
+        maps.push(std::fs::read(out.join("map.pgm")).unwrap());
+    }
+    assert!(maps[0] == maps[1], "the repeats changed the map");
     std::fs::remove_dir_all(&dir).unwrap();
 }
