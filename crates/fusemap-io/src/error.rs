@@ -61,6 +61,18 @@ pub enum Error {
         /// What is wrong, in plain words.
         message: String,
     },
+    /// The file ends before its container does (a recording cut short: a bag whose
+    /// last record or index is missing, an MCAP without its end, a gzip stream that stops):
+    /// everything the reader returned before it is sound.
+    #[error("{}{location}: {message}", path.display())]
+    Truncated {
+        /// The file.
+        path: PathBuf,
+        /// Where the file ends.
+        location: Location,
+        /// What was cut off, in plain words.
+        message: String,
+    },
     /// Refusing to overwrite one of the run's inputs.
     #[error("{}: refusing to overwrite an input file", path.display())]
     WouldOverwriteInput {
@@ -78,6 +90,17 @@ impl Error {
     /// A format error at `location` in `path`.
     pub fn format(path: &Path, location: Location, message: impl Into<String>) -> Self {
         Error::Format { path: path.to_path_buf(), location, message: message.into() }
+    }
+
+    /// The file `path` ends at `location` inside its container (see [`Error::Truncated`]).
+    pub fn truncated(path: &Path, location: Location, message: impl Into<String>) -> Self {
+        Error::Truncated { path: path.to_path_buf(), location, message: message.into() }
+    }
+
+    /// True for [`Error::Truncated`]: the log ends early, and what was read before it can
+    /// be used as the log.
+    pub fn is_truncation(&self) -> bool {
+        matches!(self, Error::Truncated { .. })
     }
 
     /// True when the error concerns one message of a log and a caller that wants the
@@ -103,6 +126,8 @@ impl Error {
     ///   in strict mode, where the user asked for a malformed line to stop the read (the
     ///   lenient mode already skips and counts those lines in
     ///   [`crate::log::ReadStats::malformed`]).
+    /// - [`Error::Truncated`]: the file ends; a caller may use what came before
+    ///   ([`Error::is_truncation`]), but there is nothing after it to read.
     /// - [`Error::WouldOverwriteInput`]: never to be worked around.
     pub fn is_skippable(&self) -> bool {
         matches!(self, Error::Format { location: Location::Message { .. }, .. })
@@ -135,5 +160,8 @@ mod tests {
         let os = Error::io(Path::new("run.bag"), std::io::Error::other("disk on fire"));
         assert!(!os.is_skippable());
         assert!(!Error::WouldOverwriteInput { path: "map.pgm".into() }.is_skippable());
+        let cut = Error::truncated(Path::new("run.bag"), Location::Offset(4096), "the file ends");
+        assert!(!cut.is_skippable() && cut.is_truncation() && !at(Location::File).is_truncation());
+        assert_eq!(cut.to_string(), "run.bag: at byte 4096: the file ends");
     }
 }

@@ -242,6 +242,9 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
     crate::pose_sensors_report::gnss_quality(&log, &mut out, &mut findings)?;
     crate::pose_sensors_report::odometry_vs_gyro(&log, &mut out, &mut findings)?;
 
+    if let Some(cut) = &log.truncated {
+        findings.push(format!("the log is cut short (`fusemap map` maps it up to the cut): {cut}"));
+    }
     if log.stats.malformed > 0 {
         // The same words as `fusemap map`'s note: the reader skipped these records.
         findings.push(format!(

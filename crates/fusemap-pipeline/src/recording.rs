@@ -185,6 +185,9 @@ pub struct Inventory {
     /// The most bytes one chunk, message or line may inflate to, for every pass over the
     /// file (`[limits] decompressed_mib`).
     pub max_decompressed_bytes: u64,
+    /// Where the file ends early, when it does (the reader's words): the log is what came
+    /// before, and the later passes stop there too.
+    pub truncated: Option<String>,
     /// Its format.
     pub format: LogFormat,
     /// Scan topics.
@@ -269,11 +272,23 @@ impl Inventory {
             tf_dynamic: Vec::new(),
             stats: ReadStats::default(),
             read_s: 0.0,
+            truncated: None,
         };
         let mut undecodable = ReadStats::default();
         let mut tf = Vec::new();
+        let mut read = 0u64;
         while let Some(m) = next(reader.as_mut(), &mut undecodable) {
-            match m? {
+            // A recording cut short is the recording up to the cut: it is used as the log,
+            // and the cut reported. A file that ends before one message is no log.
+            let m = match m {
+                Err(e) if e.is_truncation() && read > 0 => {
+                    inv.truncated = Some(e.to_string());
+                    break;
+                }
+                m => m?,
+            };
+            read += 1;
+            match m {
                 LogMessage::Scan(s) => {
                     let t = inv.scans.entry(s.topic.clone()).or_default();
                     t.stamps.push(s.scan.stamp);
@@ -434,7 +449,12 @@ pub fn for_each_range_message(
     let mut reader = opened.reader;
     let mut ignored = ReadStats::default();
     while let Some(m) = next(reader.as_mut(), &mut ignored) {
-        match m? {
+        // The first pass met the same cut and reported it: the log ends here.
+        let m = match m {
+            Err(e) if e.is_truncation() => break,
+            m => m?,
+        };
+        match m {
             LogMessage::Scan(s) if scan_topics.contains(&s.topic) => f(RangeMessage::Scan(s))?,
             LogMessage::Image(i) if image_topics.contains(&i.topic) => f(RangeMessage::Image(i))?,
             _ => {}

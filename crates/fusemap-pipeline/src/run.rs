@@ -487,6 +487,9 @@ pub fn map_with_track(
     if without_pose > 0 {
         notes.push(format!("{without_pose} of {read} scans skipped without a pose"));
     }
+    if let Some(cut) = &inv.truncated {
+        notes.push(format!("the log is cut short, and was mapped up to the cut: {cut}"));
+    }
     if inv.stats.malformed > 0 {
         notes.push(format!(
             "{} malformed records skipped; first: {}",

@@ -280,13 +280,20 @@ fn log_truncated_ros1_bag() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A gzipped CARMEN log cut short maps the lines before the cut, and says where it ends.
 #[test]
-fn log_truncated_gzip_carmen() {
+fn log_truncated_gzip_carmen_maps_the_lines_before_the_cut() {
     let dir = temp_dir("log-gz-cut");
     let Some(log) = dataset_head("intel/intel-corrected.log.gz", 50_000, &dir, "cut.log.gz") else {
         return;
     };
-    log_errors(&log, &["gzip stream ends early after line"]);
+    let out = dir.join("out");
+    let o = run(&["map", "--out", path_str(&out), path_str(&log)]);
+    assert_success(&o);
+    let s = read_json(&out.join("summary.json"));
+    assert!(s["scans"].as_u64().unwrap() > 10, "{}", s["scans"]);
+    let notes = s["notes"].to_string();
+    assert!(notes.contains("cut short") && notes.contains("gzip stream ends early after line"), "{notes}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -555,5 +562,30 @@ fn log_repeated_scans_are_inserted_once() {
         maps.push(std::fs::read(out.join("map.pgm")).unwrap());
     }
     assert!(maps[0] == maps[1], "the repeats changed the map");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A recording cut short (a ROS 1 bag without its end and index, an MCAP without its
+/// end) maps the part before the cut and says where it stopped; the doctor says so too.
+#[test]
+fn log_cut_short_maps_its_intact_part() {
+    let Some(fixtures) = crate::formats::intel_fixtures() else { return };
+    let dir = temp_dir("log-cut-short");
+    for name in ["ros1.bag", "bare.mcap"] {
+        let whole = std::fs::read(fixtures.join(name)).unwrap();
+        let cut = write_file(&dir, &format!("cut-{name}"), &whole[..whole.len() * 3 / 5]);
+        let (full_out, cut_out) = (dir.join(format!("{name}-whole")), dir.join(format!("{name}-cut")));
+        assert_success(&run(&["map", "--out", path_str(&full_out), path_str(&fixtures.join(name))]));
+        let o = run(&["map", "--out", path_str(&cut_out), path_str(&cut)]);
+        assert_success(&o);
+        let (full, part) = (read_json(&full_out.join("summary.json")), read_json(&cut_out.join("summary.json")));
+        let (n_full, n_part) = (full["scans"].as_u64().unwrap(), part["scans"].as_u64().unwrap());
+        assert!(n_part > n_full / 3 && n_part < n_full, "{name}: {n_part} of {n_full} scans");
+        let notes = part["notes"].to_string();
+        assert!(notes.contains("cut short") && notes.contains("truncated"), "{name}: {notes}");
+        let doctor = run(&["doctor", path_str(&cut)]);
+        assert!(doctor.status.success(), "{name}: {}", crate::util::stderr(&doctor));
+        assert!(stdout(&doctor).contains("the log is cut short"), "{name}: {}", stdout(&doctor));
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

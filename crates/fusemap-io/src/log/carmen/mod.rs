@@ -326,7 +326,7 @@ impl<R: BufRead> CarmenReader<R> {
         let after = self.line_number;
         match e.kind() {
             ErrorKind::UnexpectedEof => {
-                Error::format(&self.path, Location::File, format!("gzip stream ends early after line {after}"))
+                Error::truncated(&self.path, Location::File, format!("gzip stream ends early after line {after}"))
             }
             ErrorKind::InvalidInput | ErrorKind::InvalidData => {
                 Error::format(&self.path, Location::File, format!("gzip stream is corrupt after line {after}: {e}"))

@@ -305,7 +305,7 @@ fn gzip_is_recognised_by_content() {
     let mut items: Vec<_> = r.by_ref().collect();
     let last = items.pop().unwrap().unwrap_err();
     assert!(items.iter().all(|i| i.is_ok()));
-    let Error::Format { path, location: Location::File, message } = &last else { panic!("{last:?}") };
+    let Error::Truncated { path, location: Location::File, message } = &last else { panic!("{last:?}") };
     assert_eq!(path, Path::new("x.log.gz"));
     assert!(message.starts_with("gzip stream ends early after line"), "{message}");
     assert!(r.next().is_none());

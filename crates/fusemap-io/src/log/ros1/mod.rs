@@ -211,6 +211,11 @@ impl<R: Read> BagReader<R> {
         Error::format(&self.decoder.path, Location::Offset(offset), message)
     }
 
+    /// The file ends at `offset`, inside the record that starts there or before its index.
+    fn truncated_at(&self, offset: u64, message: impl Into<String>) -> Error {
+        Error::truncated(&self.decoder.path, Location::Offset(offset), message)
+    }
+
     /// The magic line and the bag header record.
     fn read_preamble(&mut self) -> Result<()> {
         let mut magic = [0u8; record::MAGIC.len()];
@@ -252,15 +257,14 @@ impl<R: Read> BagReader<R> {
             0 => return Ok(None),
             4 => {}
             n => {
-                return Err(
-                    self.error_at(offset, format!("truncated record: the file ends {n} bytes into its header length"))
-                )
+                return Err(self
+                    .truncated_at(offset, format!("truncated record: the file ends {n} bytes into its header length")))
             }
         }
         let header_len = u32::from_le_bytes(len);
         let got = read_into(&mut self.input, header_len, &mut self.header_buf).map_err(|e| self.io(e))?;
         if got < header_len as usize {
-            return Err(self.error_at(
+            return Err(self.truncated_at(
                 offset,
                 format!(
                     "truncated record: its header claims {header_len} bytes but the file \
@@ -270,7 +274,7 @@ impl<R: Read> BagReader<R> {
         }
         let n = read_full(&mut self.input, &mut len).map_err(|e| self.io(e))?;
         if n < 4 {
-            return Err(self.error_at(offset, "truncated record: the file ends in its data length"));
+            return Err(self.truncated_at(offset, "truncated record: the file ends in its data length"));
         }
         let data_len = u32::from_le_bytes(len);
         let data_offset = offset + 4 + u64::from(header_len) + 4;
@@ -289,7 +293,7 @@ impl<R: Read> BagReader<R> {
     }
 
     fn truncated_data(&self, head: &Head, got: u64) -> Error {
-        self.error_at(
+        self.truncated_at(
             head.offset,
             format!("truncated record: its data claims {} bytes but the file ends after {got}", head.data_len),
         )
@@ -389,14 +393,14 @@ impl<R: Read> BagReader<R> {
     fn at_end(&self) -> Result<Step> {
         if self.index_pos != 0 {
             if self.pos < self.index_pos {
-                return Err(self.error_at(
+                return Err(self.truncated_at(
                     self.pos,
                     format!("the file ends before its index section at byte {}: it is truncated", self.index_pos),
                 ));
             }
             if let Some(count) = self.chunk_count {
                 if self.chunk_infos < u64::from(count) {
-                    return Err(self.error_at(
+                    return Err(self.truncated_at(
                         self.pos,
                         format!(
                             "the file ends after {} of the {count} chunk info records its \

@@ -443,7 +443,7 @@ fn read_bytes(bytes: &[u8]) -> (Vec<LogMessage>, Option<Error>, ReadStats) {
 /// The location and message of a format error.
 fn format_error(e: Option<Error>) -> (Location, String) {
     match e {
-        Some(Error::Format { path, location, message }) => {
+        Some(Error::Format { path, location, message } | Error::Truncated { path, location, message }) => {
             assert_eq!(path, Path::new("test.bag"));
             (location, message)
         }
@@ -586,6 +586,7 @@ fn truncated_record_error_names_the_record() {
     let bytes = bag(vec![(Compression::None, standard_records())]);
     let cut = bytes.len() - 3;
     let (_, error, _) = read_bytes(&bytes[..cut]);
+    assert!(error.as_ref().is_some_and(Error::is_truncation), "{error:?}");
     let (_, message) = format_error(error);
     assert!(message.starts_with("truncated record: its data claims"), "{message}");
 }

@@ -70,6 +70,16 @@ impl McapSource {
             let event = match self.reader.next_event() {
                 None => return Ok(false),
                 Some(Ok(event)) => event,
+                Some(Err(mcap::McapError::UnexpectedEof)) => {
+                    return Err(Error::truncated(
+                        &self.path,
+                        Location::File,
+                        format!(
+                            "MCAP: the file ends after {} bytes, inside a record: it is truncated",
+                            self.bytes_read
+                        ),
+                    ));
+                }
                 Some(Err(e)) => {
                     let mut what = error_chain(&e);
                     if matches!(e, mcap::McapError::ChunkTooLarge(_) | mcap::McapError::RecordTooLarge { .. }) {
