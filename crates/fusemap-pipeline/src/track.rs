@@ -16,7 +16,9 @@ use fusemap_core::config::{LogConfig, PoseSource, SensorKind};
 use fusemap_core::frames::{FrameTree, LookupError};
 use fusemap_core::geometry::{Mount3, Pose2};
 use fusemap_core::time::{plausible_samples, NoPose, PoseBuffer, PoseTrack, PushOutcome, Stamp, SyncMode};
+use fusemap_io::log::Transform;
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// Counters of the pose track.
 #[derive(Debug, Default, Clone, Serialize)]
@@ -169,6 +171,36 @@ pub fn buffer_of(cfg: &LogConfig, samples: Vec<(Stamp, Pose2)>, counts: &mut Tra
     buffer
 }
 
+/// The dynamic transforms of `all` without the glitches of the edges whose child is on
+/// `chain` (each edge judged as its own pose stream, in x, y and yaw), and how many were
+/// left out.
+fn without_edge_glitches(all: &[Transform], chain: &[String], cfg: &LogConfig) -> (Vec<Transform>, u64) {
+    let strip = |f: &str| f.strip_prefix('/').unwrap_or(f).to_string();
+    let mut edges: BTreeMap<(String, String), Vec<usize>> = BTreeMap::new();
+    for (i, t) in all.iter().enumerate() {
+        let child = strip(&t.child);
+        if chain.contains(&child) {
+            edges.entry((strip(&t.parent), child)).or_default().push(i);
+        }
+    }
+    let mut drop = vec![false; all.len()];
+    for indices in edges.values() {
+        let samples: Vec<(Stamp, Pose2)> = indices
+            .iter()
+            .map(|&i| {
+                let m = Mount3::from_translation_quaternion(all[i].translation, all[i].rotation);
+                (all[i].stamp, Pose2::new(m.x, m.y, m.yaw))
+            })
+            .collect();
+        for (&i, keep) in indices.iter().zip(plausible_samples(&samples, &cfg.motion_limits())) {
+            drop[i] = !keep;
+        }
+    }
+    let glitches = drop.iter().filter(|d| **d).count() as u64;
+    let kept = all.iter().zip(&drop).filter(|(_, d)| !**d).map(|(t, _)| t.clone()).collect();
+    (kept, glitches)
+}
+
 /// The note a run prints when `source` had pose glitches.
 pub fn glitch_note(source: &str, glitches: u64, cfg: &LogConfig) -> String {
     format!(
@@ -301,10 +333,17 @@ pub fn choose(
             let single_edge = root.is_some() && root == parent && !tf_samples.is_empty();
             if let (Some(root), false) = (root, single_edge) {
                 // Several edges above the base, or a static one under a dynamic one: compose
-                // the chain at each stamp where one of its dynamic edges has a sample.
+                // the chain at each stamp where one of its dynamic edges has a sample. Each
+                // dynamic edge of the chain is a pose stream of its own: its glitches are
+                // left out before the tree is built again from what remains.
+                let (kept, glitches) = without_edge_glitches(&inv.tf_dynamic, &chain, cfg);
+                counts.glitches = glitches;
+                let tree =
+                    if glitches > 0 { crate::extrinsics::frame_tree(cfg, &inv.tf_static, &kept).0 } else { tree };
                 let stamps = chain_stamps;
                 counts.samples = stamps.len() as u64;
                 let name = format!("TF `{root} → … → {base}`");
+                let notes = glitch_notes(&name, &counts, cfg);
                 let track = TfTrack { tree, root, base, stamps: stamps.clone() };
                 counts.used = track.samples().len() as u64;
                 if counts.used == 0 {
@@ -318,7 +357,7 @@ pub fn choose(
                     receive: vec![None; stamps.len()],
                     stamps,
                     estimator: None,
-                    notes: Vec::new(),
+                    notes,
                     slam: None,
                 });
             }

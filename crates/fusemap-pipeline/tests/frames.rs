@@ -25,6 +25,11 @@ fn tf(stamp: fusemap_core::time::Stamp, parent: &str, child: &str, x: f64, y: f6
 /// odometry message, plus `map → odom` (10 m east, turned 90°) at 10 Hz when `localiser`,
 /// plus a static `base_footprint → base_link` when BASE is `/base_footprint`.
 fn bag_with_tf(tag: &str, base: &str, localiser: bool) -> std::path::PathBuf {
+    bag_with_tf_glitch(tag, base, localiser, None)
+}
+
+/// [`bag_with_tf`], with the `odom → BASE` sample number `glitch` a kilometre off.
+fn bag_with_tf_glitch(tag: &str, base: &str, localiser: bool, glitch: Option<usize>) -> std::path::PathBuf {
     let mut s = Scenario::default();
     s.robot.duration_s = 20.0;
     let rec = simulate(&s).unwrap();
@@ -42,7 +47,9 @@ fn bag_with_tf(tag: &str, base: &str, localiser: bool) -> std::path::PathBuf {
                 // odom → base_link from the odometry, and a localiser's map → odom at 10 Hz:
                 // 10 m east, turned 90°.
                 let yaw = fusemap_core::geometry::quaternion_yaw(o.orientation);
-                w.write(o.stamp, "/tf", &tf(o.stamp, "odom", base, o.position[0], o.position[1], yaw)).unwrap();
+                let off = if glitch == Some(n_odom) { 1000.0 } else { 0.0 };
+                let odom_tf = tf(o.stamp, "odom", base, o.position[0] + off, o.position[1], yaw);
+                w.write(o.stamp, "/tf", &odom_tf).unwrap();
                 if n_odom == 0 && base != "base_link" {
                     let mut t = tf(o.stamp, base, "base_link", 0.0, 0.0, 0.0);
                     if let OutMessage::Tf { is_static, .. } = &mut t {
@@ -90,4 +97,34 @@ fn a_static_edge_under_the_dynamic_one_and_a_leading_slash_are_followed() {
     assert!(run.report.pose_source.contains("over TF `odom → … → base_link`"), "{}", run.report.pose_source);
     assert!(run.report.scans_used > 190, "{}", run.report.scans_used);
     assert!(run.trajectory.len() > 900, "{}", run.trajectory.len());
+}
+
+/// One `odom → base_link` sample a kilometre off under a localiser's `map → odom`: the
+/// glitch is left out of the chain and counted, and the track is the one without it.
+#[test]
+fn a_glitch_on_one_edge_of_a_chain_is_left_out() {
+    let mut cfg = Config::default();
+    cfg.log.pose_source = PoseSource::Tf;
+    cfg.slam.mode = fusemap_core::config::SlamMode::Off;
+    let plan = cfg.validate().unwrap();
+    let clean = map_log(&plan, &bag_with_tf("tf-chain-clean", "base_link", true), &mut |_| {}).unwrap();
+    let glitched =
+        map_log(&plan, &bag_with_tf_glitch("tf-chain-glitch", "base_link", true, Some(300)), &mut |_| {}).unwrap();
+    assert_eq!(glitched.report.pose_track.glitches, 1, "{:?}", glitched.report.pose_track);
+    assert_eq!(clean.report.pose_track.glitches, 0);
+    assert!(glitched.notes.iter().any(|n| n.contains("1 pose sample(s) rejected as glitches")), "{:?}", glitched.notes);
+    assert_eq!(glitched.report.scans_used, clean.report.scans_used);
+    // Where the glitch was, the chain interpolates its neighbours (50 Hz odometry): the
+    // track stays within a centimetre of the clean one everywhere.
+    assert_eq!(glitched.trajectory.len(), clean.trajectory.len());
+    let worst = clean
+        .trajectory
+        .iter()
+        .zip(&glitched.trajectory)
+        .map(|((ta, a), (tb, b))| {
+            assert_eq!(ta, tb);
+            (a.x - b.x).hypot(a.y - b.y)
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 0.01, "the track moved by {worst} m");
 }
