@@ -268,7 +268,8 @@ pub fn finish(
             (MapInfo::new(Some(r), grid.geometry().resolution(), grid.tile_count()), Some(map_entropy(r)))
         }
         MapView::Sparse { tiles, area, .. } => {
-            let cells = area.width() as u64 * area.height() as u64;
+            // Saturating: two sites 1e9 m apart make a box of more than 2^64 cells.
+            let cells = (area.width() as u64).saturating_mul(area.height() as u64);
             let info = MapInfo {
                 resolution: grid.geometry().resolution(),
                 origin: [grid.geometry().cell_corner(area.min).x, grid.geometry().cell_corner(area.min).y],

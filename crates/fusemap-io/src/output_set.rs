@@ -130,6 +130,13 @@ impl OutputSet {
             let (bytes, sha256) = digest(&path).map_err(|e| Error::io(&path, e))?;
             files.push(OutputFile { name: name.clone(), bytes, sha256 });
         }
+        // The old summary goes first: should the commit stop half-way (a rename refused, the
+        // process killed), the directory holds no summary that claims a complete set.
+        let old_summary = self.dir.join(summary_name);
+        match std::fs::remove_file(&old_summary) {
+            Err(e) if e.kind() != io::ErrorKind::NotFound => return Err(Error::io(&old_summary, e)),
+            _ => sync_dir(&self.dir),
+        }
         // Every file is whole on disk (each was fsynced by its writer); now the names.
         for name in &names {
             let to = self.dir.join(name);

@@ -71,7 +71,9 @@ pub fn plausible_samples(samples: &[(Stamp, Pose2)], limits: &MotionLimits) -> V
             pending = Run::default();
             pending.push(samples, i);
         }
-        if pending.items.len() >= RUN {
+        // A run becomes real only once it spans two stamps: samples of one stamp were never
+        // judged against each other, and three of them agreeing proves nothing.
+        if pending.items.len() >= RUN && pending.before_last.is_some() {
             if main.items.len() < RUN {
                 reject(&main);
             }
@@ -200,6 +202,17 @@ mod tests {
         s[41].1.x += 500.0;
         s[60].1.y -= 500.0;
         assert_eq!(rejected(&plausible_samples(&s, &LIMITS)), vec![41, 60]);
+    }
+
+    #[test]
+    fn glitches_sharing_one_stamp_do_not_make_a_run() {
+        // Three far samples at one stamp, off the drive and off each other.
+        let mut s = drive(60);
+        let t = s[30].0;
+        for x in [1e3, -3e3, 5e6] {
+            s.push((t, Pose2::new(x, 0.0, 0.0)));
+        }
+        assert_eq!(rejected(&plausible_samples(&s, &LIMITS)), vec![60, 61, 62]);
     }
 
     proptest! {

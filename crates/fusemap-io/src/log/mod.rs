@@ -75,7 +75,10 @@ impl ScanMessage {
     /// another field of view — a driver bug, or a message cut or padded. Such a scan is
     /// refused and counted, never drawn.
     pub fn angle_fault(&self) -> Option<String> {
-        let (a0, inc, n) = (self.scan.angle_min, self.scan.angle_increment, self.scan.ranges.len());
+        // At LaserScan's f32 precision, as the map pass places the beams: a CARMEN
+        // resolution of 1e-50 is 0 there, and 1e39 infinite.
+        let (a0, inc) = (self.scan.angle_min as f32 as f64, self.scan.angle_increment as f32 as f64);
+        let n = self.scan.ranges.len();
         if !a0.is_finite() {
             return Some(format!("angle_min is {a0}"));
         }
@@ -457,6 +460,8 @@ mod tests {
         for (bad, what) in [
             (scan(-1.57, 0.0, half, 721), "angle_increment is 0"),
             (scan(-1.57, f64::NAN, half, 721), "angle_increment is NaN"),
+            (scan(-1.57, 1e-50, f32::NAN, 721), "angle_increment is 0"),
+            (scan(-1.57, 1e39, f32::NAN, 721), "angle_increment is inf"),
             (scan(f64::INFINITY, inc, half, 721), "angle_min is inf"),
             (scan(-a0, inc, half, 1442), "1442 ranges"),
             (scan(-a0, inc, half, 360), "is 721.0 beams"),

@@ -317,6 +317,15 @@ impl<R: Read> BagReader<R> {
                     (Some(c), Some(s)) => (c, s),
                     _ => return Err(self.error_at(head.offset, "chunk record lacks its `compression` or `size` field")),
                 };
+                // Chunks lie before the index section the bag header points at: one that claims
+                // to reach past it has a corrupt length, which is damage, not a cut file.
+                if self.index_pos != 0 && head.data_offset + u64::from(head.data_len) > self.index_pos {
+                    let what = format!(
+                        "chunk claims {} bytes of data, reaching past the index section at byte {}: its length is corrupt",
+                        head.data_len, self.index_pos
+                    );
+                    return Err(self.error_at(head.offset, what));
+                }
                 let limit = self.decoder.options.max_decompressed_bytes;
                 if u64::from(size) > limit {
                     // Refused on its word, before a byte is read or inflated.

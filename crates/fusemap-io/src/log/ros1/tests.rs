@@ -1073,3 +1073,19 @@ fn a_chunk_past_the_decompression_limit_is_refused_on_its_word() {
         }
     }
 }
+
+#[test]
+fn a_chunk_length_reaching_past_the_index_is_damage_not_a_cut() {
+    let mut bytes = bag(vec![(Compression::None, standard_records()), (Compression::None, standard_records())]);
+    let chunk = 13 + record_len(&bytes, 13);
+    let header_len = u32::from_le_bytes(bytes[chunk..chunk + 4].try_into().unwrap()) as usize;
+    let data_len_at = chunk + 4 + header_len;
+    let data_len = u32::from_le_bytes(bytes[data_len_at..data_len_at + 4].try_into().unwrap());
+    bytes[data_len_at..data_len_at + 4].copy_from_slice(&(data_len + (1 << 24)).to_le_bytes());
+    let (_, error, _) = read_bytes(&bytes);
+    let error = error.expect("an error");
+    assert!(!error.is_truncation(), "{error}");
+    let (location, message) = format_error(Some(error));
+    assert_eq!(location, Location::Offset(chunk as u64));
+    assert!(message.contains("reaching past the index section"), "{message}");
+}

@@ -504,6 +504,19 @@ impl Ros2Reader {
                 }
                 Some(Err(e)) => {
                     self.finished = true;
+                    // A storage file cut short with more listed after it is a damaged bag,
+                    // not a recording that stopped: the later files must not go unread.
+                    let e = match e {
+                        Error::Truncated { path, location, message } if !self.pending.is_empty() => Error::format(
+                            &path,
+                            location,
+                            format!(
+                                "{message}, and the bag lists {} more storage file(s) after it",
+                                self.pending.len()
+                            ),
+                        ),
+                        e => e,
+                    };
                     return Some(Err(e));
                 }
                 Some(Ok(())) => {}
