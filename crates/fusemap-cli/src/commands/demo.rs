@@ -59,7 +59,7 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     let sim_dir = out.join("sim");
     let sim = fusemap_io::simulation::write_simulation(&rec, &sim_dir, plan.geometry.resolution(), true)
         .with_context(|| format!("writing the simulation to {}", sim_dir.display()))?;
-    let inv = Inventory::read(&sim.bag.dir)?;
+    let inv = Inventory::read_with(&sim.bag.dir, plan.limits.decompressed_bytes())?;
     let (bound, chosen, track_s) = fusemap_pipeline::run::prepare(&plan, &inv)?;
     let run = fusemap_pipeline::map_with_track(
         &plan,

@@ -27,6 +27,19 @@ pub(crate) struct McapSource {
     channels: HashMap<u16, Topic>,
     /// The largest record or decompressed chunk accepted ([`ReadOptions::max_decompressed_bytes`](crate::log::ReadOptions::max_decompressed_bytes)).
     max_record: u64,
+    /// The file ends with MCAP's closing magic: it was written to its end, so running out
+    /// of bytes inside a record means a corrupt length, not a recording cut short.
+    complete: bool,
+}
+
+/// True when the file at `file` (not compressed as a whole) ends with the closing magic.
+fn ends_with_magic(file: &mut File) -> bool {
+    use std::io::{Seek, SeekFrom};
+    let magic = super::MCAP_MAGIC;
+    let mut tail = [0u8; 8];
+    let found = file.seek(SeekFrom::End(-(magic.len() as i64))).is_ok() && file.read_exact(&mut tail).is_ok();
+    let rewound = file.seek(SeekFrom::Start(0)).is_ok();
+    found && rewound && tail == *magic
 }
 
 impl McapSource {
@@ -35,7 +48,8 @@ impl McapSource {
     /// decompressed, larger than `max_record` bytes is an error when it is met, before it
     /// is read: a corrupt length or a decompression bomb costs no memory.
     pub(crate) fn open(path: &Path, zstd: bool, max_record: u64) -> Result<Self> {
-        let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        let mut file = File::open(path).map_err(|e| Error::io(path, e))?;
+        let complete = !zstd && ends_with_magic(&mut file);
         let input: Box<dyn Read + Send> = if zstd {
             Box::new(zstd::stream::read::Decoder::new(file).map_err(|e| Error::io(path, e))?)
         } else {
@@ -51,6 +65,7 @@ impl McapSource {
             schemas: HashMap::new(),
             channels: HashMap::new(),
             max_record,
+            complete,
         })
     }
 
@@ -70,6 +85,14 @@ impl McapSource {
             let event = match self.reader.next_event() {
                 None => return Ok(false),
                 Some(Ok(event)) => event,
+                Some(Err(mcap::McapError::UnexpectedEof)) if self.complete => {
+                    let what = format!(
+                        "a record's length reaches past the end of the file after {} bytes, although the file ends \
+                         with MCAP's closing magic: the length is corrupt",
+                        self.bytes_read
+                    );
+                    return Err(self.container_error(&what));
+                }
                 Some(Err(mcap::McapError::UnexpectedEof)) => {
                     return Err(Error::truncated(
                         &self.path,

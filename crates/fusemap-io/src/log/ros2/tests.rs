@@ -697,3 +697,25 @@ fn a_message_or_chunk_inflating_past_the_limit_is_refused_where_it_is_met() {
     let e = got.iter().find_map(|m| m.as_ref().err()).expect("the chunk past the limit is an error");
     assert!(e.to_string().contains("over the limit of 64 bytes (limits.decompressed_mib"), "{e}");
 }
+
+#[test]
+fn a_corrupt_length_in_a_whole_mcap_is_damage_not_a_cut() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("full.mcap");
+    write_mcap(&path, None, &sample_log());
+    let mut bytes = std::fs::read(&path).unwrap();
+    // The Header record follows the 8-byte magic: opcode, then its u64 length. Make it
+    // claim the whole file, so the reader runs out of bytes inside it.
+    let len = bytes.len() as u64;
+    bytes[9..17].copy_from_slice(&len.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let mut r = open_ros2(&path).unwrap();
+    let last = read_all(r.as_mut()).pop().unwrap().unwrap_err();
+    assert!(!last.is_truncation(), "{last}");
+    assert!(last.to_string().contains("the length is corrupt"), "{last}");
+    // The same file cut short (no closing magic) is a cut.
+    std::fs::write(&path, &bytes[..bytes.len() - 40]).unwrap();
+    let mut r = open_ros2(&path).unwrap();
+    let last = read_all(r.as_mut()).pop().unwrap().unwrap_err();
+    assert!(last.is_truncation(), "{last}");
+}
