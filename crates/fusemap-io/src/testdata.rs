@@ -96,3 +96,28 @@ pub fn tiny_scanfile_bytes() -> Vec<u8> {
     }
     b
 }
+
+/// A ROS-style scan message on `/scan` (frame `laser`, range limits 0–10 m, no poses),
+/// for tests of what is done with scans.
+pub fn scan_message(
+    stamp: fusemap_core::time::Stamp,
+    angle_min: f64,
+    angle_increment: f64,
+    angle_max: f32,
+    ranges: Vec<f32>,
+) -> crate::log::ScanMessage {
+    crate::log::ScanMessage {
+        topic: "/scan".into(),
+        frame_id: "laser".into(),
+        receive_stamp: None,
+        scan: fusemap_core::sensor::LaserScan { stamp, angle_min, angle_increment, ranges },
+        angle_max,
+        time_increment: 0.0,
+        scan_time: 0.0,
+        range_min: 0.0,
+        range_max: 10.0,
+        pose: None,
+        odom_pose: None,
+        laser_pose: None,
+    }
+}

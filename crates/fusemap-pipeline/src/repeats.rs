@@ -42,23 +42,9 @@ impl RepeatFilter {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fusemap_core::sensor::LaserScan;
 
     fn scan(t: i64, ranges: &[f32]) -> ScanMessage {
-        ScanMessage {
-            topic: "/scan".into(),
-            frame_id: "laser".into(),
-            receive_stamp: None,
-            scan: LaserScan { stamp: Stamp(t), angle_min: 0.0, angle_increment: 0.1, ranges: ranges.to_vec() },
-            angle_max: f32::NAN,
-            time_increment: 0.0,
-            scan_time: 0.0,
-            range_min: 0.0,
-            range_max: 10.0,
-            pose: None,
-            odom_pose: None,
-            laser_pose: None,
-        }
+        fusemap_io::testdata::scan_message(Stamp(t), 0.0, 0.1, f32::NAN, ranges.to_vec())
     }
 
     #[test]

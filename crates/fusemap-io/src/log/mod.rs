@@ -432,19 +432,8 @@ mod tests {
 
     #[test]
     fn beam_angles_that_cannot_be_placed_are_named() {
-        let scan = |angle_min: f64, angle_increment: f64, angle_max: f32, n: usize| ScanMessage {
-            topic: "/scan".into(),
-            frame_id: "laser".into(),
-            receive_stamp: None,
-            scan: LaserScan { stamp: Stamp(1), angle_min, angle_increment, ranges: vec![1.0; n] },
-            angle_max,
-            time_increment: 0.0,
-            scan_time: 0.0,
-            range_min: 0.0,
-            range_max: 10.0,
-            pose: None,
-            odom_pose: None,
-            laser_pose: None,
+        let scan = |angle_min: f64, angle_increment: f64, angle_max: f32, n: usize| {
+            crate::testdata::scan_message(Stamp(1), angle_min, angle_increment, angle_max, vec![1.0; n])
         };
         let inc = std::f64::consts::PI / 720.0;
         let half = std::f32::consts::FRAC_PI_2;
@@ -476,18 +465,8 @@ mod tests {
         let receive = Some(Stamp(99));
         let messages = [
             LogMessage::Scan(ScanMessage {
-                topic: "/scan".into(),
-                frame_id: "laser".into(),
                 receive_stamp: receive,
-                scan: LaserScan { stamp: Stamp(1), angle_min: 0.0, angle_increment: 0.1, ranges: vec![] },
-                angle_max: f32::NAN,
-                time_increment: 0.0,
-                scan_time: 0.0,
-                range_min: 0.0,
-                range_max: 10.0,
-                pose: None,
-                odom_pose: None,
-                laser_pose: None,
+                ..crate::testdata::scan_message(Stamp(1), 0.0, 0.1, f32::NAN, vec![])
             }),
             LogMessage::Odometry(OdomMessage {
                 topic: "/odom".into(),
