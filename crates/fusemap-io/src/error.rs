@@ -73,6 +73,20 @@ pub enum Error {
         /// What was cut off, in plain words.
         message: String,
     },
+    /// A `[limits]` budget is broken at `location` (a message or chunk that inflates past
+    /// `limits.decompressed_mib`, say): reading on would take memory the user did not
+    /// allow, so the run ends here, naming the limit and the key that raises it. Never
+    /// skippable: a limit that silently dropped data would hide that the budget is too
+    /// small for the log.
+    #[error("{}{location}: {message}", path.display())]
+    Limit {
+        /// The file.
+        path: PathBuf,
+        /// Where the budget was reached.
+        location: Location,
+        /// Which limit, the value met, and the key that raises it.
+        message: String,
+    },
     /// Refusing to overwrite one of the run's inputs.
     #[error("{}: refusing to overwrite an input file", path.display())]
     WouldOverwriteInput {
@@ -95,6 +109,11 @@ impl Error {
     /// The file `path` ends at `location` inside its container (see [`Error::Truncated`]).
     pub fn truncated(path: &Path, location: Location, message: impl Into<String>) -> Self {
         Error::Truncated { path: path.to_path_buf(), location, message: message.into() }
+    }
+
+    /// A broken budget at `location` in `path` (see [`Error::Limit`]).
+    pub fn limit(path: &Path, location: Location, message: impl Into<String>) -> Self {
+        Error::Limit { path: path.to_path_buf(), location, message: message.into() }
     }
 
     /// True for [`Error::Truncated`]: the log ends early, and what was read before it can
@@ -160,6 +179,8 @@ mod tests {
         let os = Error::io(Path::new("run.bag"), std::io::Error::other("disk on fire"));
         assert!(!os.is_skippable());
         assert!(!Error::WouldOverwriteInput { path: "map.pgm".into() }.is_skippable());
+        let limit = Error::limit(Path::new("run.bag"), Location::Message { index: 3, topic: "/scan".into() }, "big");
+        assert!(!limit.is_skippable());
         let cut = Error::truncated(Path::new("run.bag"), Location::Offset(4096), "the file ends");
         assert!(!cut.is_skippable() && cut.is_truncation() && !at(Location::File).is_truncation());
         assert_eq!(cut.to_string(), "run.bag: at byte 4096: the file ends");

@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod atomic;
+pub mod bounded;
 pub mod camera;
 pub mod comparison;
 pub mod config_file;

@@ -66,6 +66,7 @@
 //! [`Error::Format`], for the whole file, after which the reader returns `None`.
 
 use super::{LogMessage, LogReader, OdomMessage, ReadStats, ScanMessage};
+use crate::bounded::read_until_bounded;
 use crate::{Error, Location, Result};
 use flate2::bufread::MultiGzDecoder;
 use fusemap_core::geometry::Pose2;
@@ -313,11 +314,10 @@ impl<R: BufRead> CarmenReader<R> {
     fn read_line(&mut self) -> std::io::Result<Option<usize>> {
         self.line.clear();
         let limit = self.options.max_line_bytes.unwrap_or(crate::log::DEFAULT_MAX_DECOMPRESSED_BYTES);
-        let take = limit.saturating_add(1);
         let n = match &mut self.input {
-            Input::Plain(r) => r.take(take).read_until(b'\n', &mut self.line),
-            Input::Gzip(r) => r.take(take).read_until(b'\n', &mut self.line),
-            Input::GzipAhead(r) => r.take(take).read_until(b'\n', &mut self.line),
+            Input::Plain(r) => read_until_bounded(r, b'\n', limit, &mut self.line),
+            Input::Gzip(r) => read_until_bounded(r, b'\n', limit, &mut self.line),
+            Input::GzipAhead(r) => read_until_bounded(r, b'\n', limit, &mut self.line),
         }?;
         Ok((n as u64 <= limit || self.line.ends_with(b"\n") && n as u64 - 1 <= limit).then_some(n))
     }

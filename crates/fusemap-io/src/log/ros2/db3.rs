@@ -53,11 +53,14 @@ pub(crate) struct Db3Source {
     /// The running statement's deadline, nanoseconds after `started`.
     deadline: Arc<AtomicU64>,
     started: Instant,
+    /// The most bytes one message's `data` may hold (`limits.decompressed_mib`).
+    max_message: u64,
 }
 
 impl Db3Source {
-    /// Opens `path` read-only and reads its topics and message order.
-    pub(crate) fn open(path: &Path) -> Result<Self> {
+    /// Opens `path` read-only and reads its topics and message order; a message whose
+    /// `data` holds more than `max_message` bytes is refused when it is reached.
+    pub(crate) fn open(path: &Path, max_message: u64) -> Result<Self> {
         // SQLite would create a missing file; report it as the OS would.
         std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
         let sql_error = |what: &str, e: rusqlite::Error| {
@@ -136,7 +139,7 @@ impl Db3Source {
             rows.collect::<rusqlite::Result<Vec<i64>>>().map_err(|e| sql_error("reading table `messages`", e))?
         };
 
-        Ok(Self { path: path.to_path_buf(), conn, topics, order, next: 0, deadline, started })
+        Ok(Self { path: path.to_path_buf(), conn, topics, order, next: 0, deadline, started, max_message })
     }
 
     /// Fetches row `id` and hands it to `visit`, its payload borrowed from SQLite.
@@ -145,30 +148,50 @@ impl Db3Source {
         let path = &self.path;
         let at = |topic: String, message: String| Error::format(path, Location::Message { index, topic }, message);
         let topics = &self.topics;
-        // Ok(Err(topic_id)): the row names a topic `topics` does not list.
-        let row = self.conn.prepare_cached("SELECT topic_id, timestamp, data FROM messages WHERE id = ?1").and_then(
-            |mut stmt| {
-                stmt.query_row([id], |row| {
-                    let topic_id = row.get::<_, i64>(0)?;
-                    let timestamp = row.get::<_, i64>(1)?;
-                    let data = match row.get_ref(2)? {
-                        rusqlite::types::ValueRef::Blob(b) => b,
-                        rusqlite::types::ValueRef::Null => &[],
-                        other => {
-                            return Err(rusqlite::Error::FromSqlConversionFailure(
-                                2,
-                                other.data_type(),
-                                "the `data` column is not a blob".into(),
-                            ))
-                        }
-                    };
-                    let Some(topic) = topics.get(&topic_id) else { return Ok(Err(topic_id)) };
-                    visit(RawMessage { path, topic, log_time: Stamp(timestamp), data });
-                    Ok(Ok(()))
-                })
-                .optional()
-            },
-        );
+        let max = i64::try_from(self.max_message).unwrap_or(i64::MAX);
+        // Ok(Err(topic_id)): the row names a topic `topics` does not list. The payload is
+        // fetched only when `length(data)` (which SQLite answers from the record header,
+        // without reading the blob) is within the limit.
+        let sql = "SELECT topic_id, timestamp, length(data), CASE WHEN length(data) <= ?2 THEN data END \
+                   FROM messages WHERE id = ?1";
+        let mut too_long = None;
+        let row = self.conn.prepare_cached(sql).and_then(|mut stmt| {
+            stmt.query_row([id, max], |row| {
+                let topic_id = row.get::<_, i64>(0)?;
+                let timestamp = row.get::<_, i64>(1)?;
+                let length = row.get::<_, Option<i64>>(2)?.unwrap_or(0);
+                if length > max {
+                    too_long = Some((topics.get(&topic_id).map(|t| t.name.clone()), length));
+                    return Ok(Ok(()));
+                }
+                let data = match row.get_ref(3)? {
+                    rusqlite::types::ValueRef::Blob(b) => b,
+                    rusqlite::types::ValueRef::Null => &[],
+                    other => {
+                        return Err(rusqlite::Error::FromSqlConversionFailure(
+                            3,
+                            other.data_type(),
+                            "the `data` column is not a blob".into(),
+                        ))
+                    }
+                };
+                let Some(topic) = topics.get(&topic_id) else { return Ok(Err(topic_id)) };
+                visit(RawMessage { path, topic, log_time: Stamp(timestamp), data });
+                Ok(Ok(()))
+            })
+            .optional()
+        });
+        if let Some((topic, length)) = too_long {
+            return Err(Error::limit(
+                path,
+                Location::Message { index, topic: topic.unwrap_or_else(|| format!("(row id {id})")) },
+                format!(
+                    "row id {id} of table `messages` holds {length} bytes, over the limit of {} bytes \
+                     (limits.decompressed_mib raises it)",
+                    self.max_message
+                ),
+            ));
+        }
         match row {
             Ok(Some(Ok(()))) => Ok(()),
             Ok(Some(Err(topic_id))) => Err(at(

@@ -371,7 +371,7 @@ impl PendingFile {
     fn open(&self, max_record: u64) -> Result<Box<dyn Source + Send>> {
         Ok(match self {
             PendingFile::Mcap { path, zstd } => Box::new(mcap_reader::McapSource::open(path, *zstd, max_record)?),
-            PendingFile::Db3 { path } => Box::new(db3::Db3Source::open(path)?),
+            PendingFile::Db3 { path } => Box::new(db3::Db3Source::open(path, max_record)?),
         })
     }
 }
@@ -557,17 +557,27 @@ fn decode_raw(
         // refused there (never cut short and decoded).
         let limit = options.max_decompressed_bytes;
         let decoded = zstd::stream::read::Decoder::new(payload)
-            .and_then(|d| d.take(limit.saturating_add(1)).read_to_end(scratch));
-        if let Err(e) = decoded {
-            return Some(Err(at(format!("{}: the bag says messages are zstd-compressed, but: {e}", topic.type_name))));
-        }
-        if scratch.len() as u64 > limit {
-            scratch.clear();
-            return Some(Err(at(format!(
-                "{}: the zstd-compressed message inflates past the limit of {limit} bytes (limits.decompressed_mib \
-                 raises it)",
-                topic.type_name
-            ))));
+            .and_then(|d| crate::bounded::read_to_end_bounded(d, limit, scratch));
+        match decoded {
+            Err(e) => {
+                return Some(Err(at(format!(
+                    "{}: the bag says messages are zstd-compressed, but: {e}",
+                    topic.type_name
+                ))))
+            }
+            Ok(crate::bounded::Bounded::OverLimit) => {
+                scratch.clear();
+                return Some(Err(Error::limit(
+                    raw.path,
+                    Location::Message { index, topic: topic.name.clone() },
+                    format!(
+                        "{}: the zstd-compressed message inflates past the limit of {limit} bytes \
+                         (limits.decompressed_mib raises it)",
+                        topic.type_name
+                    ),
+                )));
+            }
+            Ok(crate::bounded::Bounded::Complete) => {}
         }
         payload = scratch;
     }

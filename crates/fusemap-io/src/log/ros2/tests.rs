@@ -689,6 +689,20 @@ fn a_message_or_chunk_inflating_past_the_limit_is_refused_where_it_is_met() {
     for part in ["inflates past the limit", &format!("{} bytes", n - 1), "limits.decompressed_mib", &topic] {
         assert!(text.contains(part), "`{part}` in {text}");
     }
+    assert!(!e.is_skippable(), "a broken budget ends the run: {e}");
+    // A plain `.db3` message past the limit: refused by `length(data)`, before SQLite
+    // hands over the blob.
+    let plain = dir.path().join("plain.db3");
+    write_db3(&plain, &log, false);
+    assert!(read(&plain, n).iter().all(|m| m.is_ok()));
+    let got = read(&plain, n - 1);
+    let e = got.iter().find_map(|m| m.as_ref().err()).expect("the message past the limit is an error");
+    assert!(matches!(e, Error::Limit { .. }), "{e}");
+    let parts =
+        [format!("holds {n} bytes"), format!("limit of {} bytes", n - 1), "limits.decompressed_mib".into(), topic];
+    for part in parts {
+        assert!(e.to_string().contains(&part), "`{part}` in {e}");
+    }
     // An MCAP chunk whose records inflate past the limit: refused by its stated size.
     let path = dir.path().join("zstd.mcap");
     write_mcap(&path, Some(mcap::Compression::Zstd), &log);
