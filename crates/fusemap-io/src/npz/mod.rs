@@ -23,6 +23,7 @@ use crate::atomic::{check_raster, write_atomic};
 use crate::semantic::SemanticRaster;
 use crate::{Error, Location, Result};
 use fusemap_core::grid::{CellRaster, Raster};
+use sink::QuietAfterError;
 use std::collections::HashSet;
 use std::fs::File;
 use std::io::{self, BufReader, Read, Seek, Write};
@@ -30,6 +31,7 @@ use std::path::Path;
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, ZipArchive, ZipWriter};
 
+mod sink;
 mod sparse;
 pub use sparse::write_sparse_map_npz;
 
@@ -221,14 +223,14 @@ impl<'a> NpyArray<'a> {
 /// Writes `.npz` archives the way `numpy.savez` does: each array is a stored (not
 /// compressed) member `<name>.npy`.
 pub struct NpzWriter<W: Write + Seek> {
-    zip: ZipWriter<W>,
+    zip: ZipWriter<QuietAfterError<W>>,
     names: HashSet<String>,
 }
 
 impl<W: Write + Seek> NpzWriter<W> {
     /// An archive written to `inner`.
     pub fn new(inner: W) -> Self {
-        Self { zip: ZipWriter::new(inner), names: HashSet::new() }
+        Self { zip: ZipWriter::new(QuietAfterError::new(inner)), names: HashSet::new() }
     }
 
     /// Adds `array` as `<name>.npy`. Names must be unique, non-empty and without `/`
@@ -252,7 +254,7 @@ impl<W: Write + Seek> NpzWriter<W> {
 
     /// Writes the central directory and returns the inner writer.
     pub fn finish(self) -> io::Result<W> {
-        Ok(self.zip.finish()?)
+        Ok(self.zip.finish()?.inner)
     }
 }
 
