@@ -122,9 +122,11 @@ fn run_log(plan: &Plan, export: &ExportOptions, path: &Path, out: &Path, inputs:
     let started = Instant::now();
     let files = output::prepare(out, inputs)?;
     // fusemap-io errors already name the file (and the line or message): no context.
-    // The engine's refusals (a map past limits.map_cells) do not know the file: named here.
+    // The engine's refusals (a map past limits.map_cells) and the pipeline's (a log with
+    // no scans, a lidar topic the log lacks) do not know the file: named here.
     let run = fusemap_pipeline::map_log(plan, path, &mut progress::reporter()).map_err(|e| match e {
         fusemap_pipeline::PipelineError::Engine(e) => anyhow::anyhow!("{}: {e}", path.display()),
+        fusemap_pipeline::PipelineError::Refused(e) => anyhow::anyhow!("{}: {e}", path.display()),
         other => other.into(),
     })?;
     let value = serde_json::to_value(&run.report)?;
