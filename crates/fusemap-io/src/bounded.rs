@@ -23,32 +23,21 @@ pub enum Bounded {
 /// Appends `reader`'s bytes to `buf` (cleared first) until its end or until it holds
 /// `limit + 1` bytes, whichever comes first. Memory is reserved fallibly: a failed
 /// reservation is an [`io::ErrorKind::OutOfMemory`] error, never an abort.
-pub fn read_to_end_bounded(reader: impl Read, limit: u64, buf: &mut Vec<u8>) -> io::Result<Bounded> {
+pub fn read_to_end_bounded(mut reader: impl Read, limit: u64, buf: &mut Vec<u8>) -> io::Result<Bounded> {
     buf.clear();
     let cap = usize::try_from(limit.saturating_add(1)).unwrap_or(usize::MAX);
-    let mut reader = reader.take(cap as u64);
-    loop {
+    while buf.len() < cap {
+        let room = cap - buf.len();
         if buf.len() == buf.capacity() {
-            let grow = buf.capacity().clamp(STEP.min(cap), STEP * 64).min(cap - buf.len());
-            if grow == 0 {
-                break;
-            }
+            let grow = buf.capacity().clamp(STEP.min(room), STEP * 64).min(room);
             buf.try_reserve_exact(grow).map_err(|e| io::Error::new(io::ErrorKind::OutOfMemory, e))?;
         }
-        let len = buf.len();
-        let spare = buf.capacity() - len;
-        buf.resize(len + spare, 0);
-        match reader.read(&mut buf[len..]) {
-            Ok(0) => {
-                buf.truncate(len);
-                break;
-            }
-            Ok(n) => buf.truncate(len + n),
-            Err(e) if e.kind() == io::ErrorKind::Interrupted => buf.truncate(len),
-            Err(e) => {
-                buf.truncate(len);
-                return Err(e);
-            }
+        // Exactly the spare capacity: `read_to_end` fills it without zeroing it first and,
+        // meeting the `take`'s end, never grows the buffer itself.
+        let want = (buf.capacity() - buf.len()).min(room);
+        let n = (&mut reader).take(want as u64).read_to_end(buf)?;
+        if n < want {
+            break; // the stream's end
         }
     }
     Ok(if buf.len() as u64 > limit { Bounded::OverLimit } else { Bounded::Complete })

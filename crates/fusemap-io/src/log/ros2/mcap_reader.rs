@@ -128,6 +128,15 @@ impl McapSource {
                     self.bytes_read += n as u64;
                 }
                 LinearReadEvent::Record { opcode, data } => {
+                    // Only schemas, channels and messages matter here; the others (indexes,
+                    // statistics, attachments, metadata) are not parsed at all.
+                    if !matches!(opcode, SCHEMA | CHANNEL | MESSAGE) {
+                        continue;
+                    }
+                    if let Err(what) = lengths_fit(opcode, data) {
+                        let what = format!("record with opcode {opcode:#04x}: {what}");
+                        return Err(self.container_error(&what));
+                    }
                     let record = match mcap::parse_record(opcode, data) {
                         Ok(r) => r,
                         Err(e) => {
@@ -169,6 +178,60 @@ impl McapSource {
 }
 
 /// A message error naming the message's topic (or its channel when undeclared).
+/// MCAP opcodes of the records this reader parses.
+const SCHEMA: u8 = 0x03;
+const CHANNEL: u8 = 0x04;
+const MESSAGE: u8 = 0x05;
+
+/// Checks that every length-prefixed field of a Schema or Channel record (its strings,
+/// its schema data, its metadata map and the strings inside it) fits in the record, before
+/// the `mcap` crate parses it: that parser reserves memory by a field's stated length
+/// first, so one corrupt length (found by fuzzing: a metadata string claiming 3.5 GB)
+/// would cost that much memory, or abort the process under a memory limit.
+fn lengths_fit(opcode: u8, data: &[u8]) -> std::result::Result<(), String> {
+    /// Skips a field of `n` fixed bytes, or a u32-length-prefixed one (`n = None`).
+    fn skip(data: &[u8], at: &mut usize, fixed: Option<usize>, what: &str) -> std::result::Result<usize, String> {
+        let len = match fixed {
+            Some(n) => n,
+            None => {
+                let bytes = data.get(*at..*at + 4).ok_or_else(|| format!("{what}: its length is cut off"))?;
+                *at += 4;
+                u32::from_le_bytes(bytes.try_into().expect("4 bytes")) as usize
+            }
+        };
+        let left = data.len() - *at;
+        if len > left {
+            return Err(format!("{what} claims {len} bytes, but only {left} are left in the record"));
+        }
+        *at += len;
+        Ok(len)
+    }
+    let mut at = 0;
+    match opcode {
+        SCHEMA => {
+            skip(data, &mut at, Some(2), "the schema id")?;
+            skip(data, &mut at, None, "the schema name")?;
+            skip(data, &mut at, None, "the schema encoding")?;
+            skip(data, &mut at, None, "the schema data")?;
+        }
+        CHANNEL => {
+            skip(data, &mut at, Some(4), "the channel and schema ids")?;
+            skip(data, &mut at, None, "the topic")?;
+            skip(data, &mut at, None, "the message encoding")?;
+            let map_start = at + 4;
+            let map_len = skip(data, &mut at, None, "the metadata map")?;
+            let map = &data[map_start..map_start + map_len];
+            let mut in_map = 0;
+            while in_map < map.len() {
+                skip(map, &mut in_map, None, "a metadata key")?;
+                skip(map, &mut in_map, None, "a metadata value")?;
+            }
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
 fn message_error(path: &Path, channels: &HashMap<u16, Topic>, index: u64, channel: u16, message: String) -> Error {
     let topic = match channels.get(&channel) {
         Some(t) => t.name.clone(),
@@ -184,5 +247,45 @@ impl Source for McapSource {
             Ok(false) => None,
             Err(e) => Some(Err(e)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn string(s: &str) -> Vec<u8> {
+        let mut v = (s.len() as u32).to_le_bytes().to_vec();
+        v.extend_from_slice(s.as_bytes());
+        v
+    }
+
+    fn channel(metadata: &[u8]) -> Vec<u8> {
+        let mut v = vec![1, 0, 1, 0];
+        v.extend(string("/scan"));
+        v.extend(string("cdr"));
+        v.extend((metadata.len() as u32).to_le_bytes());
+        v.extend_from_slice(metadata);
+        v
+    }
+
+    #[test]
+    fn fields_within_the_record_pass_and_a_length_past_it_is_named() {
+        let pair = [string("key"), string("value")].concat();
+        assert_eq!(lengths_fit(CHANNEL, &channel(&pair)), Ok(()));
+        assert_eq!(lengths_fit(CHANNEL, &channel(&[])), Ok(()));
+        // A metadata value claiming 3.5 GB (the fuzzer's find) is refused before parsing.
+        let mut lying = pair.clone();
+        lying[7..11].copy_from_slice(&0xd1aa_1f80u32.to_le_bytes());
+        let e = lengths_fit(CHANNEL, &channel(&lying)).unwrap_err();
+        assert!(e.contains("a metadata value claims 3517587328 bytes"), "{e}");
+        // A topic reaching past the record, and a record cut inside a length.
+        let mut c = channel(&pair);
+        c[4..8].copy_from_slice(&1000u32.to_le_bytes());
+        assert!(lengths_fit(CHANNEL, &c).unwrap_err().contains("the topic claims 1000 bytes"));
+        assert!(lengths_fit(CHANNEL, &channel(&pair)[..6]).unwrap_err().contains("cut off"));
+        let schema = [vec![1, 0], string("sensor_msgs/msg/LaserScan"), string("ros2msg"), string("...")].concat();
+        assert_eq!(lengths_fit(SCHEMA, &schema), Ok(()));
+        assert!(lengths_fit(SCHEMA, &schema[..schema.len() - 1]).unwrap_err().contains("the schema data claims"));
     }
 }
