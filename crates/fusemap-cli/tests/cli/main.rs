@@ -2,6 +2,7 @@
 //! per area, so it links once.
 
 mod bad_input;
+mod corpus;
 mod demo;
 mod doctor;
 mod formats;
