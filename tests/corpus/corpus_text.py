@@ -270,6 +270,12 @@ def world_cases() -> None:
         poses = [f"[{far}, 0.0, 0.0]" if i == 17 else f"[{0.1 * i:.1f}, 0.0, 0.0]" for i in range(40)]
         world_case(f"world/one-pose-{what}-off", f"{head}[trajectory]\nposes = [{', '.join(poses)}]\n", "map",
                    notes=["1 pose sample(s) rejected as glitches"])
+    for key, value in {"world_poses": 10, "world_beams": 100}.items():
+        d = case(f"world/over-limits-{key}",
+                 ["map", "--config", "{case}/limits.toml", "--world", "{case}/world.toml", "--out", "{case}/out"],
+                 "error", names=["{case}/world.toml", f"limits.{key}"])
+        (d / "limits.toml").write_text(f"[limits]\n{key} = {value}\n")
+        (d / "world.toml").write_text(corridor)
     d = case("world/fifo", ["map", "--world", "{case}/pipe", "--out", "{case}/out"], "error",
              names=["{case}/pipe", "FIFO"])
     os.mkfifo(d / "pipe")

@@ -32,17 +32,11 @@
 
 use crate::config_file::{field_error, read_text, toml_error};
 use crate::Result;
+use fusemap_core::config::LimitsConfig;
 use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::sim::{ScannerSpec, Segment, World};
 use serde::Deserialize;
 use std::path::Path;
-
-/// The most poses a trajectory may have: ten million scans is days of driving at 10 Hz,
-/// and a larger `count` is far more likely a typo than a plan.
-pub const MAX_POSES: u64 = 10_000_000;
-
-/// The most beams a simulated scan may have (real 2D lidars have a few thousand).
-pub const MAX_BEAMS: usize = 1_000_000;
 
 /// A loaded, validated world file.
 #[derive(Clone, Debug, PartialEq)]
@@ -86,17 +80,28 @@ struct RawTrajectory {
 /// [`Error::Format`](crate::Error::Format) for anything
 /// wrong inside it (see the module documentation).
 pub fn load_world(path: &Path) -> Result<WorldFile> {
-    let text = read_text(path)?;
-    parse_world_str(&text, path)
+    load_world_with(path, &LimitsConfig::default())
 }
 
-/// Parses and validates world-file `text`; `path` is only used in error messages.
+/// [`load_world`] within `limits` (`world_poses`, `world_beams`).
+pub fn load_world_with(path: &Path, limits: &LimitsConfig) -> Result<WorldFile> {
+    let text = read_text(path)?;
+    parse_world_str_with(&text, path, limits)
+}
+
+/// Parses and validates world-file `text` within the default limits; `path` is only used
+/// in error messages.
 pub fn parse_world_str(text: &str, path: &Path) -> Result<WorldFile> {
+    parse_world_str_with(text, path, &LimitsConfig::default())
+}
+
+/// [`parse_world_str`] within `limits` (`world_poses`, `world_beams`).
+pub fn parse_world_str_with(text: &str, path: &Path, limits: &LimitsConfig) -> Result<WorldFile> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let raw: RawWorld = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
     let bad = |field: &str, message: String| field_error(path, text, field, message);
 
-    let scanner = check_scanner(&raw.scanner).map_err(|(f, m)| bad(&format!("scanner.{f}"), m))?;
+    let scanner = check_scanner(&raw.scanner, limits.world_beams).map_err(|(f, m)| bad(&format!("scanner.{f}"), m))?;
 
     if raw.wall.is_empty() {
         return Err(bad("wall", "the world needs at least one [[wall]] table".into()));
@@ -114,14 +119,15 @@ pub fn parse_world_str(text: &str, path: &Path) -> Result<WorldFile> {
         segments.push(Segment { a, b });
     }
 
-    let poses = trajectory(&raw.trajectory).map_err(|(f, m)| bad(&format!("trajectory{f}"), m))?;
+    let poses = trajectory(&raw.trajectory, limits.world_poses).map_err(|(f, m)| bad(&format!("trajectory{f}"), m))?;
     Ok(WorldFile { world: World { segments }, scanner, poses })
 }
 
 /// Checks a scanner; errors are (field name, message).
-fn check_scanner(s: &ScannerSpec) -> std::result::Result<ScannerSpec, (&'static str, String)> {
-    if s.beams == 0 || s.beams > MAX_BEAMS {
-        return Err(("beams", format!("must be between 1 and {MAX_BEAMS}, got {}", s.beams)));
+fn check_scanner(s: &ScannerSpec, max_beams: u64) -> std::result::Result<ScannerSpec, (&'static str, String)> {
+    if s.beams == 0 || s.beams as u64 > max_beams {
+        let why = format!("must be between 1 and {max_beams} (limits.world_beams raises it), got {}", s.beams);
+        return Err(("beams", why));
     }
     for (name, v) in [("angle_min", s.angle_min), ("angle_max", s.angle_max)] {
         if !v.is_finite() {
@@ -165,7 +171,7 @@ fn pose(v: &[f64]) -> std::result::Result<Pose2, String> {
 }
 
 /// The trajectory's poses; errors are (field suffix such as `.count`, message).
-fn trajectory(t: &RawTrajectory) -> std::result::Result<Vec<Pose2>, (String, String)> {
+fn trajectory(t: &RawTrajectory, max_poses: u64) -> std::result::Result<Vec<Pose2>, (String, String)> {
     let line_keys = t.start.is_some() || t.step.is_some() || t.count.is_some();
     match (&t.poses, line_keys) {
         (Some(_), true) => Err((String::new(), "give either `poses` or `start`, `step` and `count`, not both".into())),
@@ -176,8 +182,9 @@ fn trajectory(t: &RawTrajectory) -> std::result::Result<Vec<Pose2>, (String, Str
             if list.is_empty() {
                 return Err((".poses".into(), "the trajectory needs at least one pose".into()));
             }
-            if list.len() as u64 > MAX_POSES {
-                return Err((".poses".into(), format!("more than {MAX_POSES} poses")));
+            if list.len() as u64 > max_poses {
+                let why = format!("{} poses, more than {max_poses} (limits.world_poses raises it)", list.len());
+                return Err((".poses".into(), why));
             }
             list.iter().enumerate().map(|(i, p)| pose(p).map_err(|m| (format!(".poses[{i}]"), m))).collect()
         }
@@ -188,8 +195,9 @@ fn trajectory(t: &RawTrajectory) -> std::result::Result<Vec<Pose2>, (String, Str
             let start = pose(t.start.as_deref().ok_or_else(|| need("start"))?).map_err(|m| (".start".into(), m))?;
             let step = pose(t.step.as_deref().ok_or_else(|| need("step"))?).map_err(|m| (".step".into(), m))?;
             let count = t.count.ok_or_else(|| need("count"))?;
-            if count == 0 || count > MAX_POSES {
-                return Err((".count".into(), format!("must be between 1 and {MAX_POSES}, got {count}")));
+            if count == 0 || count > max_poses {
+                let why = format!("must be between 1 and {max_poses} (limits.world_poses raises it), got {count}");
+                return Err((".count".into(), why));
             }
             (0..count)
                 .map(|i| {
@@ -241,6 +249,21 @@ poses = [[0.0, 0.0, 0.0], [0.5, 0.0, 0.1]]
 
     fn parse(text: &str) -> Result<WorldFile> {
         parse_world_str(text, Path::new("w.toml"))
+    }
+
+    #[test]
+    fn poses_and_beams_past_the_limits_name_the_key_that_raises_them() {
+        let limits = LimitsConfig { world_poses: 1, world_beams: 2, ..Default::default() };
+        let e = parse_world_str_with(GOOD, Path::new("w.toml"), &limits).unwrap_err().to_string();
+        assert!(e.contains("scanner.beams") && e.contains("limits.world_beams") && e.contains("got 3"), "{e}");
+        let limits = LimitsConfig { world_poses: 1, ..Default::default() };
+        let e = parse_world_str_with(GOOD, Path::new("w.toml"), &limits).unwrap_err().to_string();
+        assert!(e.contains("trajectory.poses") && e.contains("2 poses, more than 1 (limits.world_poses"), "{e}");
+        let line = GOOD
+            .replace("poses = [[0.0, 0.0, 0.0], [0.5, 0.0, 0.1]]", "start = [0, 0, 0]\nstep = [1, 0, 0]\ncount = 5");
+        let e = parse_world_str_with(&line, Path::new("w.toml"), &limits).unwrap_err().to_string();
+        assert!(e.contains("trajectory.count") && e.contains("limits.world_poses") && e.contains("got 5"), "{e}");
+        assert!(parse_world_str_with(GOOD, Path::new("w.toml"), &LimitsConfig::default()).is_ok());
     }
 
     fn loc(text: &str) -> (Location, String) {

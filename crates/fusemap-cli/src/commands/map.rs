@@ -90,7 +90,7 @@ pub fn map(
     let summary = match (world, log) {
         (Some(w), None) => {
             inputs.push(w.to_path_buf());
-            let wf = fusemap_io::world_file::load_world(w)?;
+            let wf = fusemap_io::world_file::load_world_with(w, &plan.limits)?;
             run_simulated(&plan, &export, &wf.world, &wf.scanner, wf.poses, out, &w.display().to_string(), &inputs)?
         }
         (None, Some(l)) => {

@@ -17,6 +17,8 @@
 //!   sparsely instead of one dense raster of the bounding box of everything it touched.
 //! * `decompressed_mib` is passed to the log readers (`fusemap-io`'s `ReadOptions`): a
 //!   chunk that says or turns out to inflate past it is refused there.
+//! * `world_poses` and `world_beams` are checked by the world-file loader before it builds
+//!   the trajectory or a scan.
 
 use super::{err, ConfigError};
 use crate::grid::TILE_CELLS;
@@ -41,11 +43,23 @@ pub struct LimitsConfig {
     /// chunks, MCAP chunks and records, rosbag2 zstd messages, gzipped CARMEN lines): past
     /// it the read stops with an error where the bomb or the corrupt size is met.
     pub decompressed_mib: u64,
+    /// Poses (scans) a simulated world file's trajectory may have: 10⁷ is more than ten
+    /// days of driving at 10 Hz; a larger `count` is far more likely a typo than a plan.
+    pub world_poses: u64,
+    /// Beams of a world file's simulated scanner (real 2D lidars have a few thousand).
+    pub world_beams: u64,
 }
 
 impl Default for LimitsConfig {
     fn default() -> Self {
-        Self { map_cells: 1 << 30, ray_cells: 50_000, export_cells: 100_000_000, decompressed_mib: 512 }
+        Self {
+            map_cells: 1 << 30,
+            ray_cells: 50_000,
+            export_cells: 100_000_000,
+            decompressed_mib: 512,
+            world_poses: 10_000_000,
+            world_beams: 1_000_000,
+        }
     }
 }
 
@@ -67,6 +81,8 @@ impl LimitsConfig {
             ("ray_cells", self.ray_cells),
             ("export_cells", self.export_cells),
             ("decompressed_mib", self.decompressed_mib),
+            ("world_poses", self.world_poses),
+            ("world_beams", self.world_beams),
         ] {
             if v == 0 {
                 return Err(err(format!("limits.{key}"), "must be at least 1"));
