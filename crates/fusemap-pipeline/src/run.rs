@@ -9,23 +9,24 @@
 //! clock faults are reported, and the usable part of the log is still mapped.
 
 use crate::camera::{build_camera, MappedCamera};
-use crate::extrinsics::{frame_tree, lidar_mount_from_log, resolve, ExtrinsicsReport};
+use crate::extrinsics::frame_tree;
+use crate::lidar_frames::lidar_setup;
+use crate::lidar_frames::other_frames;
 use crate::merge::{OrderedMerge, Pushed};
 use crate::recording::{for_each_range_message, line_key, Inventory, LineKey, RangeMessage};
 use crate::report::{LidarReport, LogReport, Skipped};
-use crate::sensors::{bind, Bound, BoundLidar};
+use crate::sensors::{bind, Bound};
 use crate::track::{choose, count_reordered, ChosenTrack, Track};
 use crate::PipelineError;
 use fusemap_core::config::{default_camera, LogConfig, Plan, PlannedCamera, SensorKind, SyncConfig};
-use fusemap_core::frames::FrameTree;
 use fusemap_core::fusion::{Correlation, Engine, MapSet};
-use fusemap_core::geometry::{PlanarMount, Pose2};
+use fusemap_core::geometry::Pose2;
 use fusemap_core::grid::FusionGrid;
 use fusemap_core::measurement::{ObservationId, SensorId};
-use fusemap_core::sensor::{LaserScan, LidarModel};
+use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
 use fusemap_io::log::{LogFormat, ScanMessage};
-use std::collections::{BTreeMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 use std::time::Instant;
 
@@ -153,31 +154,8 @@ struct Mapped {
     bad_angles_example: Option<String>,
     /// The scan before, to insert a repeated message once.
     repeats: crate::repeats::RepeatFilter,
-}
-
-/// A bound lidar's frame, its resolved mount and its sensor model.
-pub(crate) fn lidar_setup(
-    b: &BoundLidar,
-    inv: &Inventory,
-    tree: &FrameTree,
-    cfg: &LogConfig,
-    notes: &mut Vec<String>,
-) -> Result<(String, ExtrinsicsReport, LidarModel), PipelineError> {
-    let topic = &inv.scans[&b.topic];
-    let frame = b.lidar.frame.clone().or_else(|| topic.frame().map(str::to_string)).unwrap_or_default();
-    let log_mount = lidar_mount_from_log(tree, &cfg.base_frame, &frame, topic);
-    let config_mount = b.lidar.mount_given.then_some(b.lidar.mount);
-    let ext: ExtrinsicsReport = resolve(&frame, cfg, config_mount, log_mount, notes)?;
-    let planar: PlanarMount = ext
-        .base_from_sensor
-        .to_planar(b.lidar.max_tilt)
-        .map_err(|e| PipelineError::Refused(format!("mount of lidar `{}` ({}): {e}", b.lidar.name, ext.source)))?;
-    let mut params = *b.lidar.model.params();
-    if !b.lidar.explicit {
-        // Defaults suited to a typical indoor 2D lidar rather than the document's 10 m corridor.
-        params.max_range = 40.0;
-    }
-    Ok((frame, ext, LidarModel::new(params, planar)))
+    /// The sensors of the topic's other frame ids, each with its own mount.
+    by_frame: HashMap<String, SensorId>,
 }
 
 /// Binds the sensors and builds the pose track from the pose sensors alone.
@@ -279,16 +257,16 @@ pub fn map_with_track(
         let topic = &inv.scans[&b.topic];
         let (frame, ext, model) = lidar_setup(b, inv, &tree, cfg, &mut notes)?;
         let id = engine.add_lidar(b.lidar.name.clone(), model);
+        let by_frame = other_frames(b, &frame, inv, &tree, cfg, &mut notes)
+            .into_iter()
+            .map(|(f, (_, model))| {
+                let sensor = engine.add_lidar(format!("{}@{f}", b.lidar.name), model);
+                (f, sensor)
+            })
+            .collect();
         let mut other_frames = topic.frames.clone();
         other_frames.remove(&frame);
         other_frames.remove("");
-        if !other_frames.is_empty() {
-            notes.push(format!(
-                "`{}` carries several frame ids ({} besides `{frame}`): every scan is mapped with the mount of `{frame}`",
-                b.topic,
-                other_frames.keys().map(String::as_str).collect::<Vec<_>>().join(", ")
-            ));
-        }
         let stream = merge.add_stream(b.topic.clone());
         let timing = StreamTiming::analyze(&topic.stamps, &topic.receive, limits(cfg));
         let scans_reordered = match chosen.track {
@@ -319,6 +297,7 @@ pub fn map_with_track(
             },
             bad_angles_example: None,
             repeats: Default::default(),
+            by_frame,
         });
     }
 
@@ -637,6 +616,8 @@ impl Inserter<'_> {
         scan.angle_increment = msg.scan.angle_increment as f32 as f64;
         scan.ranges.clone_from(&msg.scan.ranges);
         let stamp = msg.scan.stamp;
+        // The sensor of the scan's own frame (its own mount), else the lidar's.
+        let sensor = l.by_frame.get(msg.frame_id.as_str()).copied().unwrap_or(l.id);
         let id = ObservationId(self.next_id);
         self.next_id += 1;
         match self.track {
@@ -651,7 +632,7 @@ impl Inserter<'_> {
                 }
                 // Line poses do not depend on the stamp: applied in file order.
                 scan.stamp = self.last.map_or(stamp, |last| last.max(stamp));
-                self.engine.insert_scan_observed(l.id, id, scan, msg.range_min, msg.range_max, |_| pose)?;
+                self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;
                 self.line_trajectory.push((scan.stamp, pose));
                 self.last = Some(scan.stamp);
             }
@@ -671,12 +652,12 @@ impl Inserter<'_> {
                 let end = Stamp(t.0.saturating_add((ti * (n - 1) as f64 * 1e9) as i64));
                 if can_deskew && track.pose_at(end, SyncMode::Interpolate).is_ok() {
                     l.report.scans_deskewed += 1;
-                    self.engine.insert_scan_observed(l.id, id, scan, msg.range_min, msg.range_max, |i| {
+                    self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |i| {
                         let tb = Stamp(t.0.saturating_add((ti * i as f64 * 1e9) as i64));
                         track.pose_at(tb, SyncMode::Interpolate).unwrap_or(pose)
                     })?;
                 } else {
-                    self.engine.insert_scan_observed(l.id, id, scan, msg.range_min, msg.range_max, |_| pose)?;
+                    self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;
                 }
                 self.last = Some(t);
             }

@@ -11,19 +11,21 @@
 //! lines (raw CARMEN), the optimised scan poses are the track.
 
 use crate::extrinsics::frame_tree;
+use crate::lidar_frames::lidar_setup;
 use crate::merge::{OrderedMerge, Pushed};
 use crate::recording::{for_each_range_message, line_key, Inventory, RangeMessage};
-use crate::run::{lidar_setup, sync_mode, Progress};
+use crate::run::{sync_mode, Progress};
 use crate::sensors::Bound;
 use crate::track::{ChosenTrack, TfTrack, Track, TrackCounts};
 use crate::PipelineError;
 use fusemap_core::config::{Plan, PoseSource, SlamMode};
-use fusemap_core::geometry::{Point2, Pose2};
+use fusemap_core::geometry::{PlanarMount, Point2, Pose2};
 use fusemap_core::slam::pose_graph::EdgeKind;
 use fusemap_core::slam::{CorrectedTrack, ScanInput, Slam, SlamReport, SlamResult};
 use fusemap_core::time::{PoseBuffer, Stamp, SyncMode};
 use fusemap_io::log::ScanMessage;
 use serde::Serialize;
+use std::collections::HashMap;
 use std::time::Instant;
 
 /// A pose-graph node as the run report shows it.
@@ -133,8 +135,15 @@ pub fn run(
     let b = &bound.lidars[0];
     let (tree, _) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
     let mut scratch = Vec::new();
-    let (_, _, model) = lidar_setup(b, inv, &tree, cfg, &mut scratch)?;
+    let (frame, _, model) = lidar_setup(b, inv, &tree, cfg, &mut scratch)?;
     let mount = *model.mount();
+    // Scans of the topic's other frame ids are placed from their own mounts, as the
+    // mapping pass places them.
+    let mounts: HashMap<String, PlanarMount> =
+        crate::lidar_frames::other_frames(b, &frame, inv, &tree, cfg, &mut scratch)
+            .into_iter()
+            .map(|(f, (_, m))| (f, *m.mount()))
+            .collect();
     let params = *model.params();
     let offset = crate::offset_ns(b.lidar.time_offset_s);
     let stamps = &inv.scans[&b.topic].stamps;
@@ -177,6 +186,7 @@ pub fn run(
         let lo = params.min_range.max(scan.range_min as f64);
         let hi = params.max_range.min(scan.range_max as f64);
         let (a0, inc) = (scan.scan.angle_min as f32 as f64, scan.scan.angle_increment as f32 as f64);
+        let mount = mounts.get(scan.frame_id.as_str()).unwrap_or(&mount);
         let origin = mount.origin_in_base();
         // De-skew as the mapping pass does: each beam placed with the track's motion from
         // the scan's stamp to the beam's own time, so the matcher sees the scan as it would
