@@ -212,6 +212,13 @@ pub fn bytes_per_pixel(encoding: &str) -> Option<u64> {
 /// 32-bit fields cannot overflow. The error says what is wrong, in the message's terms.
 pub fn check_image_layout(width: u32, height: u32, encoding: &str, step: u32, data_len: u64) -> Result<(), String> {
     let pixels = u64::from(width) * u64::from(height);
+    // 0 × 0 is an empty image; 0 × 10⁹ is no image either, but a decoder walking its rows
+    // would take a billion steps for nothing (found by fuzzing the camera decoding).
+    if (width == 0) != (height == 0) {
+        return Err(format!(
+            "declares {width} × {height} pixels: an image with rows but no columns, or columns but no rows"
+        ));
+    }
     if pixels > MAX_IMAGE_PIXELS {
         return Err(format!(
             "declares {width} × {height} = {pixels} pixels, more than the {MAX_IMAGE_PIXELS} an image may have"
@@ -265,6 +272,8 @@ mod tests {
         // Padded rows and data longer than needed are fine.
         assert!(check_image_layout(3, 2, "mono16", 8, 20).is_ok());
         assert!(check_image_layout(0, 0, "mono8", 0, 0).is_ok());
+        assert!(check_image_layout(0, 1_124_073_476, "16UC1", 0, 0).unwrap_err().contains("rows but no columns"));
+        assert!(check_image_layout(640, 0, "mono8", 640, 0).is_err());
         let e = check_image_layout(4, 2, "mono8", 4, 7).unwrap_err();
         assert!(e.contains("= 8 bytes") && e.contains("holds 7"), "{e}");
         let e = check_image_layout(4, 2, "mono16", 7, 100).unwrap_err();
