@@ -27,6 +27,7 @@ pub mod camera;
 pub mod doctor;
 pub mod estimation;
 pub mod extrinsics;
+mod insert;
 mod lidar_frames;
 pub mod merge;
 pub mod pose_sensors_report;

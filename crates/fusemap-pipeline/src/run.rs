@@ -10,10 +10,11 @@
 
 use crate::camera::{build_camera, MappedCamera};
 use crate::extrinsics::frame_tree;
+use crate::insert::{release, Inserter, Mapped};
 use crate::lidar_frames::lidar_setup;
 use crate::lidar_frames::other_frames;
 use crate::merge::{OrderedMerge, Pushed};
-use crate::recording::{for_each_range_message, line_key, Inventory, LineKey, RangeMessage};
+use crate::recording::{for_each_range_message, Inventory, RangeMessage};
 use crate::report::{LidarReport, LogReport, Skipped};
 use crate::sensors::{bind, Bound};
 use crate::track::{choose, count_reordered, ChosenTrack, Track};
@@ -22,11 +23,11 @@ use fusemap_core::config::{default_camera, LogConfig, Plan, PlannedCamera, Senso
 use fusemap_core::fusion::{Correlation, Engine, MapSet};
 use fusemap_core::geometry::Pose2;
 use fusemap_core::grid::FusionGrid;
-use fusemap_core::measurement::{ObservationId, SensorId};
+use fusemap_core::measurement::SensorId;
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
-use fusemap_io::log::{LogFormat, ScanMessage};
-use std::collections::{BTreeMap, HashMap, HashSet};
+use fusemap_io::log::LogFormat;
+use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
 use std::time::Instant;
 
@@ -140,22 +141,6 @@ fn planned_cameras(plan: &Plan, inv: &Inventory, notes: &mut Vec<String>) -> Res
         c.topic, c.depth_topic, c.info_topic
     ));
     Ok(vec![c])
-}
-
-/// One lidar as the second pass uses it.
-struct Mapped {
-    id: SensorId,
-    offset_ns: i64,
-    stream: usize,
-    report: LidarReport,
-    /// Scan lines whose pose is a glitch (a scan-line track only).
-    line_glitches: HashSet<LineKey>,
-    /// Why the first scan refused for its beam angles was refused.
-    bad_angles_example: Option<String>,
-    /// The scan before, to insert a repeated message once.
-    repeats: crate::repeats::RepeatFilter,
-    /// The sensors of the topic's other frame ids, each with its own mount.
-    by_frame: HashMap<String, SensorId>,
 }
 
 /// Binds the sensors and builds the pose track from the pose sensors alone.
@@ -552,117 +537,4 @@ pub fn map_with_track(
     };
     notes.extend(chosen.notes.iter().cloned());
     Ok(MapRun { engine, format: inv.format, report, trajectory, notes })
-}
-
-/// Inserts one released message: a lidar's scan, or a camera's image (a frame when it
-/// completes a label + depth pair).
-fn release(
-    inserter: &mut Inserter<'_>,
-    lidars: &mut [Mapped],
-    cameras: &mut [MappedCamera],
-    stream: usize,
-    key: Stamp,
-    msg: RangeMessage,
-) -> Result<(), PipelineError> {
-    match msg {
-        RangeMessage::Scan(scan) => {
-            let l = lidars.iter_mut().find(|l| l.stream == stream).expect("a scan stream is a lidar's");
-            inserter.insert(l, key, &scan)
-        }
-        RangeMessage::Image(image) => {
-            let c = cameras
-                .iter_mut()
-                .find(|c| c.label_stream == stream || c.depth_stream == stream)
-                .expect("an image stream is a camera's");
-            if let Some(frame) = c.take(stream, key, image) {
-                let id = ObservationId(inserter.next_id);
-                inserter.next_id += 1;
-                c.insert(inserter.engine, inserter.track, inserter.mode, id, &frame)?;
-            }
-            Ok(())
-        }
-    }
-}
-
-/// Inserts released scans with their poses.
-struct Inserter<'a> {
-    engine: &'a mut Engine,
-    track: &'a Track,
-    mode: SyncMode,
-    deskew: bool,
-    scan: LaserScan,
-    last: Option<Stamp>,
-    line_trajectory: Vec<(Stamp, Pose2)>,
-    /// The next observation id: one per scan released by the merge, so that every insert
-    /// is named (evidence of one instant from several sensors will share one).
-    next_id: u64,
-}
-
-impl Inserter<'_> {
-    fn insert(&mut self, l: &mut Mapped, key: Stamp, msg: &ScanMessage) -> Result<(), PipelineError> {
-        if l.repeats.is_repeat(msg) {
-            l.report.scans_skipped.repeated += 1;
-            return Ok(());
-        }
-        if let Some(why) = msg.angle_fault() {
-            l.report.scans_skipped.bad_angles += 1;
-            l.bad_angles_example.get_or_insert(why);
-            return Ok(());
-        }
-        // Angles at LaserScan's float32 precision whatever the format, so that the same
-        // scan read from CARMEN text or from a ROS message gives the same rays.
-        let scan = &mut self.scan;
-        scan.angle_min = msg.scan.angle_min as f32 as f64;
-        scan.angle_increment = msg.scan.angle_increment as f32 as f64;
-        scan.ranges.clone_from(&msg.scan.ranges);
-        let stamp = msg.scan.stamp;
-        // The sensor of the scan's own frame (its own mount), else the lidar's.
-        let sensor = l.by_frame.get(msg.frame_id.as_str()).copied().unwrap_or(l.id);
-        let id = ObservationId(self.next_id);
-        self.next_id += 1;
-        match self.track {
-            Track::ScanLine => {
-                let Some(pose) = msg.pose.filter(|p| p.is_finite()) else {
-                    l.report.scans_skipped.no_pose_on_line += 1;
-                    return Ok(());
-                };
-                if l.line_glitches.contains(&line_key(stamp, pose)) {
-                    l.report.scans_skipped.pose_glitch += 1;
-                    return Ok(());
-                }
-                // Line poses do not depend on the stamp: applied in file order.
-                scan.stamp = self.last.map_or(stamp, |last| last.max(stamp));
-                self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;
-                self.line_trajectory.push((scan.stamp, pose));
-                self.last = Some(scan.stamp);
-            }
-            Track::Timed(track) => {
-                let t = key;
-                let pose = match track.pose_at(t, self.mode) {
-                    Ok(p) => p,
-                    Err(why) => {
-                        l.report.scans_skipped.count(why);
-                        return Ok(());
-                    }
-                };
-                scan.stamp = t;
-                let n = scan.ranges.len();
-                let ti = msg.time_increment as f64;
-                let can_deskew = self.deskew && self.mode == SyncMode::Interpolate && ti > 0.0 && n > 1;
-                let end = Stamp(t.0.saturating_add((ti * (n - 1) as f64 * 1e9) as i64));
-                if can_deskew && track.pose_at(end, SyncMode::Interpolate).is_ok() {
-                    l.report.scans_deskewed += 1;
-                    self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |i| {
-                        let tb = Stamp(t.0.saturating_add((ti * i as f64 * 1e9) as i64));
-                        track.pose_at(tb, SyncMode::Interpolate).unwrap_or(pose)
-                    })?;
-                } else {
-                    self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;
-                }
-                self.last = Some(t);
-            }
-        }
-        l.report.scans_used += 1;
-        Ok(())
-    }
 }
