@@ -4,7 +4,7 @@
 //! what is small: the pose sensors' samples (odometry, IMU, GNSS, poses, transforms), which
 //! the estimator and its smoother need over the whole log, and for each scan topic its
 //! stamps and frame ids (for the timing report and the choice of topics) — not the scans.
-//! The second pass ([`for_each_scan`]) streams the range sensors' messages of the chosen
+//! The second pass ([`for_each_range_message`]) streams the range sensors' messages of the chosen
 //! topics to the mapper through the time-ordered merge. Peak memory is the pose streams
 //! plus one merge window of scans, whatever the number of scans.
 
@@ -415,21 +415,6 @@ pub enum RangeMessage {
     Scan(ScanMessage),
     /// A label or depth image.
     Image(ImageMessage),
-}
-
-/// The second pass: calls `f` with every scan of `topics`, in log order, and returns the
-/// seconds spent reading. Errors of the container end the pass; undecodable messages were
-/// already counted by the first pass and are skipped.
-pub fn for_each_scan(
-    path: &Path,
-    topics: &[String],
-    mut f: impl FnMut(ScanMessage) -> Result<(), crate::PipelineError>,
-) -> Result<f64, crate::PipelineError> {
-    let limit = fusemap_io::log::DEFAULT_MAX_DECOMPRESSED_BYTES;
-    for_each_range_message(path, limit, topics, &[], |m| match m {
-        RangeMessage::Scan(s) => f(s),
-        RangeMessage::Image(_) => Ok(()),
-    })
 }
 
 /// The second pass over scans of `scan_topics` and images of `image_topics` (with their
