@@ -85,6 +85,12 @@ pub(crate) fn other_frames(
     let mut out = BTreeMap::new();
     let mut kept_main = Vec::new();
     for f in others {
+        // Without a transform of its own the frame has no mount to use: `resolve` would
+        // fall back to identity, which is a guess; the main frame's mount is the better one.
+        if lidar_mount_from_log(tree, &cfg.base_frame, f, topic).is_none() {
+            kept_main.push(format!("`{}` (no transform from `{}`)", printable(f), printable(&cfg.base_frame)));
+            continue;
+        }
         let mut scratch = Vec::new();
         match frame_model(b, f, inv, tree, cfg, &mut scratch) {
             Ok(m) => {

@@ -179,13 +179,15 @@ impl ScanFilters {
             return Err(("speckle.window", format!("must be within [1, {MAX_WINDOW}] beams, got {}", p.window)));
         }
         let a = &self.angular_bounds;
-        // The key at fault when one is not finite, so that the error points at its line.
-        let key = match (a.lower_deg.is_finite(), a.upper_deg.is_finite()) {
-            (false, _) => "angular_bounds.lower_deg",
-            (true, false) => "angular_bounds.upper_deg",
-            (true, true) => "angular_bounds",
-        };
         if !(a.lower_deg.is_finite() && a.upper_deg.is_finite()) || a.lower_deg > a.upper_deg {
+            // The key at fault when one is not finite, so that the error points at its line.
+            let key = if !a.lower_deg.is_finite() {
+                "angular_bounds.lower_deg"
+            } else if !a.upper_deg.is_finite() {
+                "angular_bounds.upper_deg"
+            } else {
+                "angular_bounds"
+            };
             return Err((key, format!("needs finite lower_deg <= upper_deg, got {} / {}", a.lower_deg, a.upper_deg)));
         }
         let b = &self.self_box;
