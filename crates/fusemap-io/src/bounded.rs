@@ -43,6 +43,15 @@ pub fn read_to_end_bounded(mut reader: impl Read, limit: u64, buf: &mut Vec<u8>)
     Ok(if buf.len() as u64 > limit { Bounded::OverLimit } else { Bounded::Complete })
 }
 
+/// An empty `Vec` with room for `n` elements, or the allocator's refusal: for a count read
+/// from a file (a sequence length, an image's rows, a header's size), where
+/// `Vec::with_capacity` would abort the process instead of giving an error.
+pub fn vec_with_capacity<T>(n: usize) -> Result<Vec<T>, std::collections::TryReserveError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)?;
+    Ok(v)
+}
+
 /// Grows `buf` to hold `more` bytes past its length, at most to `max_len` bytes in all:
 /// doubling (so appends stay amortised O(1)) but never past `max_len`, fallibly.
 fn reserve(buf: &mut Vec<u8>, more: usize, max_len: usize) -> io::Result<()> {

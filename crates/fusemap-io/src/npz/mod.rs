@@ -481,8 +481,16 @@ pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
     if bytes as u64 > entry.size() {
         return Err(bad(format!("shape {shape:?} needs {bytes} bytes but the member holds {}", entry.size())));
     }
-    let mut raw = vec![0u8; bytes];
-    entry.read_exact(&mut raw).map_err(|e| bad(format!("truncated data: {e}")))?;
+    // The member's stated size may lie: read what it holds, growing fallibly, and compare.
+    let mut raw = Vec::new();
+    crate::bounded::read_to_end_bounded((&mut entry).take(bytes as u64), bytes as u64, &mut raw)
+        .map_err(|e| bad(format!("reading the data: {e}")))?;
+    if raw.len() != bytes {
+        return Err(bad(format!(
+            "truncated data: shape {shape:?} needs {bytes} bytes, the member holds {}",
+            raw.len()
+        )));
+    }
     let values = match descr.as_str() {
         "<f4" => NpyValues::F32(raw.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),
         "<i4" => NpyValues::I32(raw.chunks_exact(4).map(|c| i32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),

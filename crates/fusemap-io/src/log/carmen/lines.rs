@@ -122,7 +122,8 @@ impl<'a> Fields<'a> {
 
     /// `n` range readings as f32 (NaN and inf kept), with the largest finite one.
     fn ranges(&mut self, n: usize) -> Result<(Vec<f32>, f32), String> {
-        let mut ranges = Vec::with_capacity(n);
+        let mut ranges =
+            crate::bounded::vec_with_capacity(n).map_err(|e| format!("no memory for {n} range readings ({e})"))?;
         let mut largest = f32::NEG_INFINITY;
         for _ in 0..n {
             let token = self.next("a range reading")?;

@@ -166,7 +166,8 @@ fn odometry(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Re
 
 fn tf(c: &mut Cursor<'_>, topic: &str, receive_stamp: Option<Stamp>) -> Result<TfMessage, Malformed> {
     let n = c.array_len(MIN_TRANSFORM_SIZE, "transforms")?;
-    let mut transforms = Vec::with_capacity(n);
+    let mut transforms =
+        crate::bounded::vec_with_capacity(n).map_err(|e| Malformed(format!("no memory for {n} transforms ({e})")))?;
     for i in 0..n {
         let t = transform(c).map_err(|e| e.context(format_args!("transforms[{i}]")))?;
         transforms.push(t);

@@ -95,6 +95,8 @@ fn walk(
         if offset + 4 + header_len as u64 > file_len {
             return None;
         }
+        header.clear();
+        header.try_reserve_exact(header_len).ok()?;
         header.resize(header_len, 0);
         input.read_exact(&mut header).ok()?;
         input.read_exact(&mut len).ok()?;
@@ -115,6 +117,8 @@ fn walk(
             return None;
         }
         if ours {
+            data.clear();
+            data.try_reserve_exact(data_len as usize).ok()?;
             data.resize(data_len as usize, 0);
             input.read_exact(&mut data).ok()?;
             let mut out = Vec::new();

@@ -6,8 +6,8 @@
 //! record is. Chunks hold connection and message-data records, optionally compressed.
 
 use super::cursor::{Cursor, Malformed};
+use crate::bounded::read_to_end_bounded;
 use fusemap_core::time::Stamp;
-use std::io::Read;
 
 /// The first line of every bag this reader accepts.
 pub(super) const MAGIC: &[u8] = b"#ROSBAG V2.0\n";
@@ -135,19 +135,16 @@ pub(super) fn read_inner<'a>(c: &mut Cursor<'a>) -> Result<InnerRecord<'a>, Malf
     Ok(InnerRecord { header, data })
 }
 
-/// How much to reserve ahead for a chunk's uncompressed data: its declared size, but no
-/// more than this, so a lying header cannot make the reader allocate gigabytes up front.
-const MAX_RESERVE: usize = 64 << 20;
-
 /// Decompresses a chunk's data into `out` (cleared first), checking that it comes to
-/// exactly `size` bytes. `compression` is known to be `bz2` or `lz4`.
+/// exactly `size` bytes. `compression` is known to be `bz2` or `lz4`. The buffer grows
+/// with what the stream yields, by fallible reservations, never past `size + 1` bytes
+/// ([`read_to_end_bounded`]): a lying header costs no memory up front, and a chunk that
+/// inflates past its stated size is refused there.
 pub(super) fn decompress(compression: &[u8], input: &[u8], size: u32, out: &mut Vec<u8>) -> Result<(), Malformed> {
-    out.clear();
-    out.reserve((size as usize).min(MAX_RESERVE));
-    let limit = u64::from(size) + 1;
+    let limit = u64::from(size);
     let (name, result) = match compression {
-        b"bz2" => ("bz2", bzip2::read::BzDecoder::new(input).take(limit).read_to_end(out)),
-        b"lz4" => ("lz4", lz4_flex::frame::FrameDecoder::new(input).take(limit).read_to_end(out)),
+        b"bz2" => ("bz2", read_to_end_bounded(bzip2::read::BzDecoder::new(input), limit, out)),
+        b"lz4" => ("lz4", read_to_end_bounded(lz4_flex::frame::FrameDecoder::new(input), limit, out)),
         other => return Err(unsupported_compression(other)),
     };
     if let Err(e) = result {

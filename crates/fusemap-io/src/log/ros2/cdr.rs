@@ -300,17 +300,26 @@ impl<'a> CdrReader<'a> {
         }
     }
 
+    /// An empty `Vec` for the `n` elements of `field` (a count already checked against the
+    /// bytes left), reserved fallibly: an allocator that refuses is an error, not an abort.
+    fn room_for<T>(&self, field: &str, n: usize) -> Result<Vec<T>, CdrError> {
+        crate::bounded::vec_with_capacity(n)
+            .map_err(|e| self.invalid(field, format!("no memory for its {n} elements ({e})")))
+    }
+
     /// A `float32[]` sequence, bit for bit.
     pub fn f32_seq(&mut self, field: &str) -> Result<Vec<f32>, CdrError> {
         let n = self.sequence_len(field, 4)?;
+        let mut out = self.room_for(field, n)?;
         let bytes = self.take(field, 4, n * 4)?;
-        Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
+        out.extend(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])));
+        Ok(out)
     }
 
     /// A `float64[]` sequence (the count, then elements aligned to 8).
     pub fn f64_seq(&mut self, field: &str) -> Result<Vec<f64>, CdrError> {
         let n = self.sequence_len(field, 8)?;
-        let mut out = Vec::with_capacity(n);
+        let mut out = self.room_for(field, n)?;
         if n > 0 {
             let bytes = self.take(field, 8, n * 8)?;
             for b in bytes.chunks_exact(8) {
@@ -361,7 +370,7 @@ impl<'a> CdrReader<'a> {
         mut read: impl FnMut(&mut Self) -> Result<T, CdrError>,
     ) -> Result<Vec<T>, CdrError> {
         let n = self.sequence_len(field, min_element_size)?;
-        let mut out = Vec::with_capacity(n);
+        let mut out = self.room_for(field, n)?;
         self.path.push(PathPart::Field(field));
         for i in 0..n {
             self.path.push(PathPart::Index(i));
