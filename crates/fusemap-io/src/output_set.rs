@@ -81,11 +81,12 @@ impl OutputSet {
             Err(TryLockError::Error(e)) => return Err(Error::io(&lock_path, e)),
         }
         // Holding the lock, every staging directory here is a dead run's.
-        if let Ok(entries) = std::fs::read_dir(dir) {
-            for e in entries.flatten() {
-                if e.file_name().to_string_lossy().starts_with(STAGING_PREFIX) {
-                    let _ = std::fs::remove_dir_all(e.path());
-                }
+        // A leftover that cannot be removed is only wasted space, not a wrong set: the
+        // commit moves this run's own staging directory's files, never a dead run's.
+        for e in std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))? {
+            let e = e.map_err(|e| Error::io(dir, e))?;
+            if e.file_name().to_string_lossy().starts_with(STAGING_PREFIX) {
+                let _ = std::fs::remove_dir_all(e.path());
             }
         }
         let staging = dir.join(format!("{STAGING_PREFIX}{}", std::process::id()));
@@ -117,12 +118,14 @@ impl OutputSet {
         summary_name: &str,
         summary: impl FnOnce(&[OutputFile]) -> Result<Vec<u8>>,
     ) -> Result<Vec<OutputFile>> {
-        let mut names: Vec<String> = std::fs::read_dir(&self.staging)
-            .map_err(|e| Error::io(&self.staging, e))?
-            .filter_map(|e| e.ok())
-            .map(|e| e.file_name().to_string_lossy().into_owned())
-            .filter(|n| !n.starts_with('.'))
-            .collect();
+        // An entry that cannot be read is an error, not a file quietly left out of the set.
+        let mut names = Vec::new();
+        for e in std::fs::read_dir(&self.staging).map_err(|e| Error::io(&self.staging, e))? {
+            let name = e.map_err(|e| Error::io(&self.staging, e))?.file_name().to_string_lossy().into_owned();
+            if !name.starts_with('.') {
+                names.push(name);
+            }
+        }
         names.sort();
         let mut files = Vec::with_capacity(names.len());
         for name in &names {
