@@ -30,6 +30,7 @@ import fcntl
 import json
 import os
 import resource
+import shutil
 import signal
 import subprocess
 import sys
@@ -134,7 +135,18 @@ def crashed(r: Run) -> str | None:
 
 
 def check_case(fusemap: str, corpus: Path, c: dict) -> tuple[list[str], list[Run]]:
+    """Checks one case. An output directory the case's runs create is removed afterwards,
+    so that running the corpus again starts each case from what the generator wrote."""
     d = corpus / c["dir"]
+    made_out = not (d / "out").exists()
+    try:
+        return check_case_in(fusemap, d, c)
+    finally:
+        if made_out and (d / "out").is_dir():
+            shutil.rmtree(d / "out", ignore_errors=True)
+
+
+def check_case_in(fusemap: str, d: Path, c: dict) -> tuple[list[str], list[Run]]:
     sub = lambda s: s.replace("{case}", str(d))  # noqa: E731
     args = [sub(a) for a in c["args"]]
     problems: list[str] = []
