@@ -32,9 +32,10 @@ def ros_messages(lines: list[str], tmp: Path):
     return messages, ros.first_stamp(messages)
 
 
-def write_ros1(out: Path, messages, static_stamp: int, compression, mutate=None) -> None:
+def write_ros1(out: Path, messages, static_stamp: int, compression, mutate=None, raw=()) -> None:
     """A ROS 1 bag of `messages`; `mutate(topic, n, message dict)`, when given, returns
-    the dicts to write in place of the n-th message of `topic` (none drops it)."""
+    the dicts to write in place of the n-th message of `topic` (none drops it). `raw`:
+    (topic, type, log time, serialized bytes) written first, each on its own connection."""
     writer = ros.Rosbag1Writer(out)
     if compression is not None:
         writer.set_compression(compression)
@@ -42,6 +43,9 @@ def write_ros1(out: Path, messages, static_stamp: int, compression, mutate=None)
     try:
         conns = {t: writer.add_connection(t, ty, typestore=ros.ROS1_TYPESTORE, callerid="/corpus")
                  for t, ty in ros.TOPICS.items()}
+        for topic, ty, t, data in raw:
+            conn = writer.add_connection(topic, ty, typestore=ros.ROS1_TYPESTORE, callerid="/corpus")
+            writer.write(conn, t, data)
         seq = dict.fromkeys(ros.TOPICS, 0)
         for m in messages:
             ty = ros.TOPICS[m.topic]
@@ -199,6 +203,20 @@ def ros1_message_cases(tmp: Path, messages, static: int) -> None:
             pose = d["pose"]["pose"]["position"] if t == "/odom" else d["transforms"][0]["transform"]["translation"]
             pose["x"] += 1e8
         return [d]
+
+    # Found by fuzzing the camera decoding: a 0 x 1,124,073,476 image made the depth decoder
+    # walk a billion empty rows. Now a malformed message, counted, and the scans map.
+    def ros1_image(width: int, height: int, encoding: bytes, step: int, data: bytes) -> bytes:
+        frame = b"camera"
+        head = struct.pack("<III", 0, 1000, 0) + struct.pack("<I", len(frame)) + frame
+        return (head + struct.pack("<II", height, width) + struct.pack("<I", len(encoding)) + encoding
+                + struct.pack("<BI", 0, step) + struct.pack("<I", len(data)) + data)
+
+    p = tmp / "image-zero-by-billion.bag"
+    image = ros1_image(0, 1_124_073_476, b"16UC1", 0, b"")
+    write_ros1(p, messages, static, None, raw=[("/camera/depth", "sensor_msgs/msg/Image", static, image)])
+    log_case("ros1/image-0-by-1124073476", "room.bag", p.read_bytes(), "map",
+             summary={"scans": 40, "log.malformed_records": 1})
 
     p = tmp / "odom-jump.bag"
     write_ros1(p, messages, static, None, odom_jump)

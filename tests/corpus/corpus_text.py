@@ -125,6 +125,14 @@ def carmen_cases() -> None:
     (d / "limits.toml").write_text("[limits]\ndecompressed_mib = 1\n")
     (d / "long.log").write_bytes(text(base[:10]) + b"FLASER " + b"1.0 " * 300_000 + b"\n")
 
+    # Limits from the config: a scan over `beams_per_scan` (the lines before it map, but the
+    # read stops there with the key named).
+    d = case("carmen/scan-over-beam-limit",
+             ["map", "--config", "{case}/limits.toml", "--out", "{case}/out", "{case}/wide.log"],
+             "error", names=["{case}/wide.log", ":14:", "181 beams", "limits.beams_per_scan"])
+    (d / "limits.toml").write_text("[limits]\nbeams_per_scan = 180\n")
+    (d / "wide.log").write_bytes(text(base[:13]) + text([base[13].replace("FLASER 180 ", "FLASER 181 3.0 ", 1)]))
+
     # A lidar of 10,000 beams is fine.
     wide = " ".join(["3.0"] * 10000)
     log_case("carmen/ten-thousand-beams", "wide.log",
@@ -270,7 +278,7 @@ def world_cases() -> None:
         poses = [f"[{far}, 0.0, 0.0]" if i == 17 else f"[{0.1 * i:.1f}, 0.0, 0.0]" for i in range(40)]
         world_case(f"world/one-pose-{what}-off", f"{head}[trajectory]\nposes = [{', '.join(poses)}]\n", "map",
                    notes=["1 pose sample(s) rejected as glitches"])
-    for key, value in {"world_poses": 10, "world_beams": 100}.items():
+    for key, value in {"world_poses": 10, "beams_per_scan": 100}.items():
         d = case(f"world/over-limits-{key}",
                  ["map", "--config", "{case}/limits.toml", "--world", "{case}/world.toml", "--out", "{case}/out"],
                  "error", names=["{case}/world.toml", f"limits.{key}"])

@@ -83,7 +83,7 @@ pub fn load_world(path: &Path) -> Result<WorldFile> {
     load_world_with(path, &LimitsConfig::default())
 }
 
-/// [`load_world`] within `limits` (`world_poses`, `world_beams`).
+/// [`load_world`] within `limits` (`world_poses`, `beams_per_scan`).
 pub fn load_world_with(path: &Path, limits: &LimitsConfig) -> Result<WorldFile> {
     let text = read_text(path)?;
     parse_world_str_with(&text, path, limits)
@@ -95,13 +95,14 @@ pub fn parse_world_str(text: &str, path: &Path) -> Result<WorldFile> {
     parse_world_str_with(text, path, &LimitsConfig::default())
 }
 
-/// [`parse_world_str`] within `limits` (`world_poses`, `world_beams`).
+/// [`parse_world_str`] within `limits` (`world_poses`, `beams_per_scan`).
 pub fn parse_world_str_with(text: &str, path: &Path, limits: &LimitsConfig) -> Result<WorldFile> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let raw: RawWorld = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
     let bad = |field: &str, message: String| field_error(path, text, field, message);
 
-    let scanner = check_scanner(&raw.scanner, limits.world_beams).map_err(|(f, m)| bad(&format!("scanner.{f}"), m))?;
+    let scanner =
+        check_scanner(&raw.scanner, limits.beams_per_scan).map_err(|(f, m)| bad(&format!("scanner.{f}"), m))?;
 
     if raw.wall.is_empty() {
         return Err(bad("wall", "the world needs at least one [[wall]] table".into()));
@@ -126,7 +127,7 @@ pub fn parse_world_str_with(text: &str, path: &Path, limits: &LimitsConfig) -> R
 /// Checks a scanner; errors are (field name, message).
 fn check_scanner(s: &ScannerSpec, max_beams: u64) -> std::result::Result<ScannerSpec, (&'static str, String)> {
     if s.beams == 0 || s.beams as u64 > max_beams {
-        let why = format!("must be between 1 and {max_beams} (limits.world_beams raises it), got {}", s.beams);
+        let why = format!("must be between 1 and {max_beams} (limits.beams_per_scan raises it), got {}", s.beams);
         return Err(("beams", why));
     }
     for (name, v) in [("angle_min", s.angle_min), ("angle_max", s.angle_max)] {
@@ -253,9 +254,9 @@ poses = [[0.0, 0.0, 0.0], [0.5, 0.0, 0.1]]
 
     #[test]
     fn poses_and_beams_past_the_limits_name_the_key_that_raises_them() {
-        let limits = LimitsConfig { world_poses: 1, world_beams: 2, ..Default::default() };
+        let limits = LimitsConfig { world_poses: 1, beams_per_scan: 2, ..Default::default() };
         let e = parse_world_str_with(GOOD, Path::new("w.toml"), &limits).unwrap_err().to_string();
-        assert!(e.contains("scanner.beams") && e.contains("limits.world_beams") && e.contains("got 3"), "{e}");
+        assert!(e.contains("scanner.beams") && e.contains("limits.beams_per_scan") && e.contains("got 3"), "{e}");
         let limits = LimitsConfig { world_poses: 1, ..Default::default() };
         let e = parse_world_str_with(GOOD, Path::new("w.toml"), &limits).unwrap_err().to_string();
         assert!(e.contains("trajectory.poses") && e.contains("2 poses, more than 1 (limits.world_poses"), "{e}");

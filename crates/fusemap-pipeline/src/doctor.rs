@@ -92,7 +92,7 @@ pub struct Report {
 
 /// The doctor's report on the log at `path`.
 pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
-    let log = Inventory::read_with(path, plan.limits.decompressed_bytes())?;
+    let log = Inventory::read_with(path, &plan.limits)?;
     let cfg = &plan.log;
     let limits = limits(cfg);
     let mut out = String::new();

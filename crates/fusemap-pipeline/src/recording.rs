@@ -8,6 +8,7 @@
 //! topics to the mapper through the time-ordered merge. Peak memory is the pose streams
 //! plus one merge window of scans, whatever the number of scans.
 
+use fusemap_core::config::LimitsConfig;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::time::{plausible_samples, MotionLimits, Stamp};
 use fusemap_io::log::{
@@ -182,9 +183,9 @@ impl From<&ImuMessage> for ImuSample {
 pub struct Inventory {
     /// The file.
     pub path: PathBuf,
-    /// The most bytes one chunk, message or line may inflate to, for every pass over the
-    /// file (`[limits] decompressed_mib`).
-    pub max_decompressed_bytes: u64,
+    /// What every pass over the file is held to (`[limits]`: bytes one chunk, message or
+    /// line may inflate to, beams of a scan, pixels of an image); no image pixels.
+    pub limits: ReadOptions,
     /// Where the file ends early, when it does (the reader's words): the log is what came
     /// before, and the later passes stop there too.
     pub truncated: Option<String>,
@@ -244,21 +245,21 @@ fn merged_stats(reader: &ReadStats, undecodable: ReadStats) -> ReadStats {
 }
 
 impl Inventory {
-    /// The first pass over `path`, with the default decompression limit.
+    /// The first pass over `path`, within the default `[limits]`.
     pub fn read(path: &Path) -> fusemap_io::Result<Inventory> {
-        Self::read_with(path, fusemap_io::log::DEFAULT_MAX_DECOMPRESSED_BYTES)
+        Self::read_with(path, &LimitsConfig::default())
     }
 
     /// The first pass over `path`; no chunk, message or line may inflate past
-    /// `max_decompressed_bytes`, in this pass or the later ones.
-    pub fn read_with(path: &Path, max_decompressed_bytes: u64) -> fusemap_io::Result<Inventory> {
+    /// `limits`, in this pass or the later ones.
+    pub fn read_with(path: &Path, limits: &LimitsConfig) -> fusemap_io::Result<Inventory> {
         let t0 = Instant::now();
-        let options = ReadOptions { max_decompressed_bytes, ..ReadOptions::default() };
+        let options = ReadOptions::within(limits);
         let opened = fusemap_io::log::open_log_with(path, &options)?;
         let mut reader = opened.reader;
         let mut inv = Inventory {
             path: path.to_path_buf(),
-            max_decompressed_bytes,
+            limits: options,
             format: opened.format,
             scans: BTreeMap::new(),
             images: BTreeMap::new(),
@@ -419,17 +420,16 @@ pub enum RangeMessage {
 
 /// The second pass over scans of `scan_topics` and images of `image_topics` (with their
 /// pixels; other images are not decoded), in log order; nothing inflates past
-/// `max_decompressed_bytes`.
+/// the `limits` of the first pass.
 pub fn for_each_range_message(
     path: &Path,
-    max_decompressed_bytes: u64,
+    limits: &ReadOptions,
     scan_topics: &[String],
     image_topics: &[String],
     mut f: impl FnMut(RangeMessage) -> Result<(), crate::PipelineError>,
 ) -> Result<f64, crate::PipelineError> {
     let t0 = Instant::now();
-    let options =
-        ReadOptions { max_decompressed_bytes, ..ReadOptions::with_image_topics(image_topics.iter().cloned()) };
+    let options = limits.clone().images_of(image_topics.iter().cloned());
     let opened = fusemap_io::log::open_log_with(path, &options)?;
     let mut reader = opened.reader;
     let mut ignored = ReadStats::default();

@@ -69,7 +69,7 @@ pub(crate) fn offset_ns(s: f64) -> i64 {
 /// Maps the log at `path` with `plan`.
 pub fn map_log(plan: &Plan, path: &Path, progress: &mut dyn FnMut(Progress)) -> Result<MapRun, PipelineError> {
     progress(Progress::Phase { name: "reading", total: 0 });
-    let inv = Inventory::read_with(path, plan.limits.decompressed_bytes())?;
+    let inv = Inventory::read_with(path, &plan.limits)?;
     progress(Progress::Done);
     map_inventory(plan, &inv, progress)
 }
@@ -358,7 +358,7 @@ pub fn map_with_track(
     };
     let t_map = Instant::now();
     let mut seq = 0i64;
-    let read_s = for_each_range_message(&inv.path, inv.max_decompressed_bytes, &topics, &image_topics, |msg| {
+    let read_s = for_each_range_message(&inv.path, &inv.limits, &topics, &image_topics, |msg| {
         let (stream, key) = match &msg {
             RangeMessage::Scan(scan) => {
                 let Some(l) = lidars.iter_mut().find(|l| l.report.topic == scan.topic) else { return Ok(()) };

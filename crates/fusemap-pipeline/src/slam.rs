@@ -222,7 +222,7 @@ pub fn run(
         slam.add_scan(ScanInput { stamp: t, track: pose, origin, hits: &hits, misses: &[] });
     };
     let mut seq = 0i64;
-    for_each_range_message(&inv.path, inv.max_decompressed_bytes, &topics, &[], |msg| {
+    for_each_range_message(&inv.path, &inv.limits, &topics, &[], |msg| {
         let RangeMessage::Scan(scan) = msg else { return Ok(()) };
         if scan.topic != b.topic {
             return Ok(());

@@ -17,8 +17,10 @@
 //!   sparsely instead of one dense raster of the bounding box of everything it touched.
 //! * `decompressed_mib` is passed to the log readers (`fusemap-io`'s `ReadOptions`): a
 //!   chunk that says or turns out to inflate past it is refused there.
-//! * `world_poses` and `world_beams` are checked by the world-file loader before it builds
-//!   the trajectory or a scan.
+//! * `beams_per_scan` and `image_pixels` are passed to the log readers too: a scan or an
+//!   image (whose pixels a pass decodes) past them ends the read with an error at that
+//!   message. The world-file loader holds its simulated scanner to `beams_per_scan`.
+//! * `world_poses` is checked by the world-file loader before it builds the trajectory.
 
 use super::{err, ConfigError};
 use crate::grid::TILE_CELLS;
@@ -43,11 +45,15 @@ pub struct LimitsConfig {
     /// chunks, MCAP chunks and records, rosbag2 zstd messages, gzipped CARMEN lines): past
     /// it the read stops with an error where the bomb or the corrupt size is met.
     pub decompressed_mib: u64,
+    /// Beams one scan may hold, in a log or from a world file's simulated scanner: real 2D
+    /// lidars have a few thousand, so 10⁶ is a corrupt message or a typo.
+    pub beams_per_scan: u64,
+    /// Pixels (`width × height`) of a camera image whose pixels a run decodes: 2²⁶ is an
+    /// 8192 × 8192 image, eight times a 4K frame.
+    pub image_pixels: u64,
     /// Poses (scans) a simulated world file's trajectory may have: 10⁷ is more than ten
     /// days of driving at 10 Hz; a larger `count` is far more likely a typo than a plan.
     pub world_poses: u64,
-    /// Beams of a world file's simulated scanner (real 2D lidars have a few thousand).
-    pub world_beams: u64,
 }
 
 impl Default for LimitsConfig {
@@ -57,8 +63,9 @@ impl Default for LimitsConfig {
             ray_cells: 50_000,
             export_cells: 100_000_000,
             decompressed_mib: 512,
+            beams_per_scan: 1_000_000,
+            image_pixels: 1 << 26,
             world_poses: 10_000_000,
-            world_beams: 1_000_000,
         }
     }
 }
@@ -81,8 +88,9 @@ impl LimitsConfig {
             ("ray_cells", self.ray_cells),
             ("export_cells", self.export_cells),
             ("decompressed_mib", self.decompressed_mib),
+            ("beams_per_scan", self.beams_per_scan),
+            ("image_pixels", self.image_pixels),
             ("world_poses", self.world_poses),
-            ("world_beams", self.world_beams),
         ] {
             if v == 0 {
                 return Err(err(format!("limits.{key}"), "must be at least 1"));

@@ -9,18 +9,16 @@
 //! needs, with the payload's length checked but its bytes neither decoded nor copied.
 //!
 //! Every image, header-only or not, passes [`check_image_layout`] before anything is
-//! allocated for its pixels: a message whose declared sizes do not fit its data, or
-//! exceed [`MAX_IMAGE_PIXELS`], is a malformed message (counted and skipped by callers
-//! like any other payload that does not decode), never a panic or an allocation sized
-//! by a header field.
+//! allocated for its pixels: a message whose declared sizes do not fit its data is a
+//! malformed message (counted and skipped by callers like any other payload that does
+//! not decode), never a panic or an allocation sized by a header field. An image whose
+//! pixels are wanted must also stay within [`ReadOptions::max_image_pixels`]
+//! (`[limits] image_pixels`), which bounds what a consumer allocates to decode it.
 
+use super::LogMessage;
+use fusemap_core::config::LimitsConfig;
 use fusemap_core::time::Stamp;
 use std::collections::BTreeSet;
-
-/// The most pixels (`width × height`) an image message may declare: 2²⁶, an 8192 × 8192
-/// image, eight times a 4K frame. Past it the message is refused as malformed, so a
-/// corrupt size field cannot make a consumer allocate gigabytes for its decoded pixels.
-pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 
 /// `sensor_msgs/Image` with its pixels (row 0 at the top, `step` bytes a row).
 #[derive(Clone, Debug, PartialEq)]
@@ -149,7 +147,7 @@ impl ImagePayloads {
 pub const DEFAULT_MAX_DECOMPRESSED_BYTES: u64 = 512 << 20;
 
 /// What a log reader decodes beyond the small messages it always decodes, and how large
-/// one piece of it may grow.
+/// one piece of it may grow (`[limits]`, [`ReadOptions::within`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ReadOptions {
     /// The images whose pixels are decoded.
@@ -158,23 +156,77 @@ pub struct ReadOptions {
     /// lz4 chunks, MCAP records, rosbag2 zstd messages, CARMEN lines): a decompression bomb
     /// or a corrupt size is refused at that point, not after the memory is taken.
     pub max_decompressed_bytes: u64,
+    /// The most beams one scan may hold (`[limits] beams_per_scan`). A scan's ranges are
+    /// already bounded by its message's bytes; this bounds the per-beam work and buffers
+    /// of everything downstream (points, de-skew, matching), checked as the scan is read.
+    pub max_scan_beams: u64,
+    /// The most pixels (`width × height`) of an image whose pixels are decoded
+    /// (`[limits] image_pixels`): it bounds what the camera model allocates per image.
+    /// Header-only images take no pixel memory and are not held to it.
+    pub max_image_pixels: u64,
 }
 
 impl Default for ReadOptions {
     fn default() -> Self {
-        Self { images: ImagePayloads::default(), max_decompressed_bytes: DEFAULT_MAX_DECOMPRESSED_BYTES }
+        Self::within(&LimitsConfig::default())
     }
 }
 
 impl ReadOptions {
+    /// Options within `limits` (`decompressed_mib`, `beams_per_scan`, `image_pixels`),
+    /// decoding no image's pixels.
+    pub fn within(limits: &LimitsConfig) -> Self {
+        Self {
+            images: ImagePayloads::default(),
+            max_decompressed_bytes: limits.decompressed_bytes(),
+            max_scan_beams: limits.beams_per_scan,
+            max_image_pixels: limits.image_pixels,
+        }
+    }
+
     /// Options that decode the pixels of the images of `topics`.
     pub fn with_image_topics<I, S>(topics: I) -> Self
     where
         I: IntoIterator<Item = S>,
         S: Into<String>,
     {
-        Self { images: ImagePayloads::Topics(topics.into_iter().map(Into::into).collect()), ..Self::default() }
+        Self::default().images_of(topics)
     }
+
+    /// These options, decoding the pixels of the images of `topics` (and no others).
+    pub fn images_of<I, S>(self, topics: I) -> Self
+    where
+        I: IntoIterator<Item = S>,
+        S: Into<String>,
+    {
+        Self { images: ImagePayloads::Topics(topics.into_iter().map(Into::into).collect()), ..self }
+    }
+
+    /// The budget a decoded message breaks, if any, in words that name the value met, the
+    /// limit and the key that raises it. Readers turn it into [`crate::Error::Limit`]
+    /// at the message: never a skip, for a limit that dropped scans silently would hide
+    /// that the budget is too small for the log.
+    pub fn over_limit(&self, message: &LogMessage) -> Option<String> {
+        match message {
+            LogMessage::Scan(s) => scan_over_limit(s.scan.ranges.len(), self.max_scan_beams),
+            LogMessage::Image(i) => {
+                let pixels = u64::from(i.width) * u64::from(i.height);
+                (pixels > self.max_image_pixels).then(|| {
+                    format!(
+                        "a {} × {} image is {pixels} pixels, over the limit of {} (limits.image_pixels raises it)",
+                        i.width, i.height, self.max_image_pixels
+                    )
+                })
+            }
+            _ => None,
+        }
+    }
+}
+
+/// The words for a scan of `beams` beams past a limit of `max`, if it is.
+pub(crate) fn scan_over_limit(beams: usize, max: u64) -> Option<String> {
+    (beams as u64 > max)
+        .then(|| format!("a scan of {beams} beams, over the limit of {max} (limits.beams_per_scan raises it)"))
 }
 
 /// Bytes per pixel of a `sensor_msgs/image_encodings.h` encoding: the named ones
@@ -206,22 +258,16 @@ pub fn bytes_per_pixel(encoding: &str) -> Option<u64> {
 }
 
 /// Checks an image's declared layout against its data before anything is allocated for
-/// it: `width × height` at most [`MAX_IMAGE_PIXELS`]; `step × height` within the
+/// it: rows and columns both or neither; `step × height` within the
 /// `data_len` bytes the message holds; and, for an encoding [`bytes_per_pixel`] knows,
 /// `step` at least a row of `width` pixels. Products are taken in 64 bits, where two
 /// 32-bit fields cannot overflow. The error says what is wrong, in the message's terms.
 pub fn check_image_layout(width: u32, height: u32, encoding: &str, step: u32, data_len: u64) -> Result<(), String> {
-    let pixels = u64::from(width) * u64::from(height);
     // 0 × 0 is an empty image; 0 × 10⁹ is no image either, but a decoder walking its rows
     // would take a billion steps for nothing (found by fuzzing the camera decoding).
     if (width == 0) != (height == 0) {
         return Err(format!(
             "declares {width} × {height} pixels: an image with rows but no columns, or columns but no rows"
-        ));
-    }
-    if pixels > MAX_IMAGE_PIXELS {
-        return Err(format!(
-            "declares {width} × {height} = {pixels} pixels, more than the {MAX_IMAGE_PIXELS} an image may have"
         ));
     }
     if let Some(bpp) = bytes_per_pixel(encoding) {
@@ -278,14 +324,41 @@ mod tests {
         assert!(e.contains("= 8 bytes") && e.contains("holds 7"), "{e}");
         let e = check_image_layout(4, 2, "mono16", 7, 100).unwrap_err();
         assert!(e.contains("step 7") && e.contains("8 bytes"), "{e}");
-        let e = check_image_layout(u32::MAX, u32::MAX, "mono8", u32::MAX, u64::MAX).unwrap_err();
-        assert!(e.contains("pixels"), "{e}");
+        // 64-bit products: two 32-bit fields cannot overflow them.
+        assert!(check_image_layout(u32::MAX, u32::MAX, "mono8", u32::MAX, 1 << 40).unwrap_err().contains("truncated"));
         // An unknown encoding still has its step × height checked.
         assert!(check_image_layout(2, 2, "weird", 1, 1).is_err());
         assert!(check_image_layout(2, 2, "weird", 1, 2).is_ok());
+    }
+
+    fn image(width: u32, height: u32) -> LogMessage {
+        LogMessage::Image(ImageMessage {
+            topic: "/depth".into(),
+            stamp: Stamp::from_sec_nsec(0, 0),
+            receive_stamp: None,
+            frame_id: "cam".into(),
+            width,
+            height,
+            encoding: "mono8".into(),
+            is_bigendian: false,
+            step: width,
+            data: Vec::new(),
+        })
+    }
+
+    #[test]
+    fn images_past_the_pixel_budget_name_the_key() {
+        let limits = LimitsConfig { image_pixels: 100, ..Default::default() };
+        let options = ReadOptions::within(&limits);
+        assert_eq!(options.over_limit(&image(10, 10)), None);
+        let e = options.over_limit(&image(101, 1)).unwrap();
+        for part in ["101 × 1", "101 pixels", "limit of 100", "limits.image_pixels"] {
+            assert!(e.contains(part), "{part}: {e}");
+        }
+        // The default is an 8192 × 8192 image.
         let side = 1u32 << 13;
-        assert!(check_image_layout(side, side, "mono8", side, u64::from(side) * u64::from(side)).is_ok());
-        assert!(check_image_layout(side + 1, side, "mono8", side + 1, u64::MAX).is_err());
+        assert_eq!(ReadOptions::default().over_limit(&image(side, side)), None);
+        assert!(ReadOptions::default().over_limit(&image(side + 1, side)).is_some());
     }
 
     #[test]

@@ -13,8 +13,13 @@
 //! [`ImageHeader`] (stamps, frame, size, encoding; pixels neither decoded nor copied);
 //! [`open_log_with`] and [`ReadOptions`] name the image topics whose pixels a pass wants,
 //! which then come as [`ImageMessage`]s. Either way an image's declared sizes are checked
-//! against its data first ([`check_image_layout`], [`MAX_IMAGE_PIXELS`]): one that does
-//! not fit is a malformed message like any other.
+//! against its data first ([`check_image_layout`]): one that does not fit is a malformed
+//! message like any other.
+//!
+//! [`ReadOptions`] also carry the `[limits]` a reader holds each piece to: bytes of a
+//! decompressed chunk, message or line, beams of a scan, pixels of a decoded image
+//! ([`ReadOptions::over_limit`]). A broken limit ends the read with
+//! [`crate::Error::Limit`] where it is met.
 
 pub mod carmen;
 mod image;
@@ -24,7 +29,7 @@ pub mod ros2;
 
 pub use image::{
     bytes_per_pixel, check_image_layout, CameraInfoMessage, ImageHeader, ImageMessage, ImagePayloads, ReadOptions,
-    DEFAULT_MAX_DECOMPRESSED_BYTES, MAX_IMAGE_PIXELS,
+    DEFAULT_MAX_DECOMPRESSED_BYTES,
 };
 pub use open::{detect, open_log, open_log_with, LogFormat, OpenedLog};
 

@@ -83,6 +83,7 @@ pub fn open_log_with(path: &Path, options: &ReadOptions) -> Result<OpenedLog> {
         LogFormat::Carmen => {
             let carmen = super::carmen::CarmenOptions {
                 max_line_bytes: Some(options.max_decompressed_bytes),
+                max_beams: Some(options.max_scan_beams),
                 ..Default::default()
             };
             Box::new(super::carmen::CarmenReader::open(path, carmen)?)

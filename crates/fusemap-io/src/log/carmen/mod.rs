@@ -69,6 +69,7 @@ use super::{LogMessage, LogReader, OdomMessage, ReadStats, ScanMessage};
 use crate::bounded::read_until_bounded;
 use crate::{Error, Location, Result};
 use flate2::bufread::MultiGzDecoder;
+use fusemap_core::config::LimitsConfig;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::Stamp;
@@ -142,6 +143,9 @@ pub struct CarmenOptions {
     /// longer one — a gzip that inflates to one endless line — ends the read with an error
     /// naming the line, before it is held whole.
     pub max_line_bytes: Option<u64>,
+    /// The most beams one laser line may hold (default `[limits] beams_per_scan`'s,
+    /// 10⁶): a line with more ends the read with [`Error::Limit`] naming the key.
+    pub max_beams: Option<u64>,
 }
 
 /// The beam angles of a `FLASER`/`RLASER` line with `n` readings, as
@@ -352,13 +356,23 @@ impl<R: BufRead> LogReader for CarmenReader<R> {
                         "longer than the limit of {limit} bytes (limits.decompressed_mib raises it): not a CARMEN \
                          log line; reading stops here"
                     );
-                    return Some(Err(Error::format(&self.path, Location::Line(self.line_number + 1), what)));
+                    return Some(Err(Error::limit(&self.path, Location::Line(self.line_number + 1), what)));
                 }
                 Ok(Some(_)) => {
                     self.line_number += 1;
                     match parse_line(&self.line, &self.options, &mut self.params) {
                         Parsed::Ignored => {}
-                        Parsed::Message(m) => return Some(Ok(m)),
+                        Parsed::Message(m) => {
+                            let max = self.options.max_beams.unwrap_or(LimitsConfig::default().beams_per_scan);
+                            let over = match &m {
+                                LogMessage::Scan(s) => super::image::scan_over_limit(s.scan.ranges.len(), max),
+                                _ => None,
+                            };
+                            return Some(match over {
+                                Some(why) => Err(Error::limit(&self.path, Location::Line(self.line_number), why)),
+                                None => Ok(m),
+                            });
+                        }
                         Parsed::Skipped(kind) => self.stats.skip_type(kind),
                         Parsed::Malformed(message) => {
                             let err = Error::format(&self.path, Location::Line(self.line_number), message);

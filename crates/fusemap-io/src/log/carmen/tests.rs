@@ -557,7 +557,7 @@ fn a_line_past_the_limit_ends_the_read_naming_it() {
         assert_eq!(got.len(), 3);
         assert!(got[0].is_ok() && got[1].is_ok());
         match &got[2] {
-            Err(Error::Format { path, location: Location::Line(3), message }) => {
+            Err(Error::Limit { path, location: Location::Line(3), message }) => {
                 assert_eq!(path, Path::new("big.log"));
                 assert!(
                     message.contains("limit of 4999 bytes") && message.contains("limits.decompressed_mib"),
@@ -570,5 +570,24 @@ fn a_line_past_the_limit_ends_the_read_naming_it() {
         let got = read(5000);
         assert!(got.iter().all(|m| m.is_ok()) && got.len() == 3, "{got:?}");
         assert!(read(n).len() == 3 && read(n - 1).len() == 1);
+    }
+}
+
+#[test]
+fn a_scan_past_the_beam_limit_ends_the_read_naming_the_key() {
+    let text = format!("{}{}", flaser_n(181), flaser_n(361));
+    let read = |max_beams| {
+        let options = CarmenOptions { max_beams, ..Default::default() };
+        CarmenReader::from_reader("wide.log", text.as_bytes(), options).unwrap().collect::<Vec<_>>()
+    };
+    assert!(read(None).iter().all(|m| m.is_ok()));
+    assert!(read(Some(361)).iter().all(|m| m.is_ok()));
+    let got = read(Some(360));
+    assert!(got[0].is_ok());
+    match &got[1] {
+        Err(Error::Limit { location: Location::Line(2), message, .. }) => {
+            assert!(message.contains("361 beams, over the limit of 360 (limits.beams_per_scan"), "{message}")
+        }
+        other => panic!("{other:?}"),
     }
 }

@@ -148,10 +148,6 @@ struct Head {
     data_len: u32,
 }
 
-/// The most memory reserved ahead for a record's data; past it the buffer grows with
-/// what is actually read, so a lying length costs nothing.
-const MAX_RESERVE: usize = 1 << 20;
-
 impl BagReader<BufReader<File>> {
     /// Opens the bag at `path` and reads its bag header.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
@@ -494,9 +490,13 @@ impl Decoder {
             return Ok(None);
         };
         let pixels = self.options.images.wants(&connection.topic);
-        messages::decode(kind, &connection.topic, receive, data, pixels).map(Some).map_err(|m| {
-            Error::format(&self.path, Location::Message { index: self.messages, topic: connection.topic.clone() }, m.0)
-        })
+        let at = || Location::Message { index: self.messages, topic: connection.topic.clone() };
+        let message = messages::decode(kind, &connection.topic, receive, data, pixels)
+            .map_err(|m| Error::format(&self.path, at(), m.0))?;
+        match self.options.over_limit(&message) {
+            Some(why) => Err(Error::limit(&self.path, at(), why)),
+            None => Ok(Some(message)),
+        }
     }
 
     /// Registers a connection, refusing a known type with an unexpected MD5 sum.
@@ -579,9 +579,9 @@ fn read_full(input: &mut impl Read, buf: &mut [u8]) -> io::Result<usize> {
 }
 
 /// Replaces `out` with the next `len` bytes of `input`, or as many as there are; the
-/// number read. Memory grows with what is actually read, not with what `len` claims.
+/// number read. Memory grows with what is actually read, not with what `len` claims, by
+/// fallible reservations ([`crate::bounded::read_to_end_bounded`]).
 fn read_into(input: &mut impl Read, len: u32, out: &mut Vec<u8>) -> io::Result<usize> {
-    out.clear();
-    out.reserve((len as usize).min(MAX_RESERVE));
-    input.by_ref().take(u64::from(len)).read_to_end(out)
+    crate::bounded::read_to_end_bounded(input.by_ref().take(u64::from(len)), u64::from(len), out)?;
+    Ok(out.len())
 }

@@ -582,10 +582,15 @@ fn decode_raw(
         payload = scratch;
     }
     let pixels = options.images.wants(&topic.name);
-    Some(
-        decode_known_with(kind, &topic.name, Some(raw.log_time), payload, pixels)
-            .map_err(|e| at(format!("{}: {e}", topic.type_name))),
-    )
+    let message = match decode_known_with(kind, &topic.name, Some(raw.log_time), payload, pixels) {
+        Ok(m) => m,
+        Err(e) => return Some(Err(at(format!("{}: {e}", topic.type_name)))),
+    };
+    if let Some(why) = options.over_limit(&message) {
+        let place = Location::Message { index, topic: topic.name.clone() };
+        return Some(Err(Error::limit(raw.path, place, format!("{}: {why}", topic.type_name))));
+    }
+    Some(Ok(message))
 }
 
 impl LogReader for Ros2Reader {

@@ -116,10 +116,11 @@ fn by_default_images_are_headers_and_only_the_asked_topics_get_pixels() {
 
 #[test]
 fn bad_images_are_skippable_message_errors_and_reading_goes_on() {
-    let cases: [(Vec<u8>, &str); 4] = [
+    let cases: [(Vec<u8>, &str); 5] = [
         (image_payload(3, 2, "mono8", 0, 3, &[0; 5]), "the data holds 5: the image is truncated"),
         (image_payload(3, 2, "mono16", 0, 4, &[0; 8]), "step 4 is shorter than a row of 3 mono16 pixels"),
-        (image_payload(u32::MAX, 1 << 20, "mono8", 0, 0, &[]), "pixels, more than"),
+        (image_payload(u32::MAX, 1 << 20, "mono8", 0, 0, &[]), "step 0 is shorter than a row"),
+        (image_payload(0, 1_124_073_476, "16UC1", 0, 0, &[]), "rows but no columns"),
         (
             {
                 let mut p = image_payload(1, 1, "mono8", 0, 1, &[7]);
@@ -150,6 +151,33 @@ fn bad_images_are_skippable_message_errors_and_reading_goes_on() {
             assert!(matches!(reader.next_message(), Some(Ok(LogMessage::Scan(_)))));
         }
     }
+}
+
+#[test]
+fn images_and_scans_past_their_limits_end_the_read_naming_the_key() {
+    let bytes = camera_bag(Compression::None);
+    let limits = fusemap_core::config::LimitsConfig { image_pixels: 3, beams_per_scan: 1, ..Default::default() };
+    // Header-only images take no pixel memory: the pixel budget does not apply to them.
+    assert_eq!(read_with(&bytes, ReadOptions::within(&limits)).len(), 4);
+    let mut reader = BagReader::from_reader(&bytes[..], "test.bag").unwrap();
+    reader.set_options(ReadOptions::within(&limits).images_of(["/labels"]));
+    assert!(matches!(reader.next_message(), Some(Ok(LogMessage::CameraInfo(_)))));
+    let e = reader.next_message().unwrap().unwrap_err();
+    assert!(matches!(e, crate::Error::Limit { .. }) && !e.is_skippable(), "{e}");
+    let text = e.to_string();
+    for part in ["test.bag", "/labels", "2 × 2 image is 4 pixels", "limit of 3", "limits.image_pixels"] {
+        assert!(text.contains(part), "{part}: {text}");
+    }
+    let limits = fusemap_core::config::LimitsConfig { beams_per_scan: 1, ..Default::default() };
+    let wide = bag(vec![(
+        Compression::None,
+        vec![Inner::Conn(SCAN), msg(SCAN, (2, 0), scan_payload((2, 0), &[1.0, 2.0], &[]))],
+    )]);
+    let mut reader = BagReader::from_reader(&wide[..], "test.bag").unwrap();
+    reader.set_options(ReadOptions::within(&limits));
+    let e = reader.next_message().unwrap().unwrap_err();
+    assert!(matches!(e, crate::Error::Limit { .. }), "{e}");
+    assert!(e.to_string().contains("a scan of 2 beams, over the limit of 1 (limits.beams_per_scan"), "{e}");
 }
 
 #[test]
