@@ -103,6 +103,14 @@ pub struct Outputs {
     set: OutputSet,
 }
 
+impl Outputs {
+    /// Where a writer puts `name` (which may hold a subdirectory, `lidar/map.npz`) so that
+    /// it moves into the output directory with the rest of the set.
+    pub fn staged(&self, name: &str) -> PathBuf {
+        self.set.staged(name)
+    }
+}
+
 /// Checks that no output would overwrite one of `inputs`, creates `dir`, takes its lock
 /// (a second run into it is refused while this one lives) and opens the set.
 pub fn prepare(dir: &Path, inputs: &[PathBuf]) -> Result<Outputs> {

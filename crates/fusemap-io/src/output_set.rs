@@ -104,7 +104,9 @@ impl OutputSet {
         &self.staging
     }
 
-    /// Where a writer puts the file `name` of this set until the commit.
+    /// Where a writer puts the file `name` of this set until the commit; `name` may name a
+    /// subdirectory (`lidar/map.npz`), which the writer creates inside the staging
+    /// directory and the commit recreates in the output directory.
     pub fn staged(&self, name: &str) -> PathBuf {
         self.staging.join(name)
     }
@@ -118,14 +120,8 @@ impl OutputSet {
         summary_name: &str,
         summary: impl FnOnce(&[OutputFile]) -> Result<Vec<u8>>,
     ) -> Result<Vec<OutputFile>> {
-        // An entry that cannot be read is an error, not a file quietly left out of the set.
         let mut names = Vec::new();
-        for e in std::fs::read_dir(&self.staging).map_err(|e| Error::io(&self.staging, e))? {
-            let name = e.map_err(|e| Error::io(&self.staging, e))?.file_name().to_string_lossy().into_owned();
-            if !name.starts_with('.') {
-                names.push(name);
-            }
-        }
+        list_files(&self.staging, "", &mut names)?;
         names.sort();
         let mut files = Vec::with_capacity(names.len());
         for name in &names {
@@ -143,6 +139,10 @@ impl OutputSet {
         // Every file is whole on disk (each was fsynced by its writer); now the names.
         for name in &names {
             let to = self.dir.join(name);
+            if let Some(parent) = Path::new(name).parent().filter(|p| !p.as_os_str().is_empty()) {
+                let parent = self.dir.join(parent);
+                std::fs::create_dir_all(&parent).map_err(|e| Error::io(&parent, e))?;
+            }
             std::fs::rename(self.staged(name), &to).map_err(|e| Error::io(&to, e))?;
         }
         for stale in known.iter().filter(|k| !names.iter().any(|n| n == *k) && **k != summary_name) {
@@ -167,6 +167,27 @@ impl Drop for OutputSet {
             let _ = std::fs::remove_dir_all(&self.staging);
         }
     }
+}
+
+/// Appends the files under `dir` to `names`, as paths relative to the staging directory
+/// (`prefix` is `dir`'s) with `/` between components; names starting with `.` are
+/// skipped. An entry that cannot be read is an error, not a file quietly left out of the
+/// set.
+fn list_files(dir: &Path, prefix: &str, names: &mut Vec<String>) -> Result<()> {
+    for e in std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))? {
+        let e = e.map_err(|e| Error::io(dir, e))?;
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with('.') {
+            continue;
+        }
+        let rel = format!("{prefix}{name}");
+        if e.file_type().map_err(|err| Error::io(&e.path(), err))?.is_dir() {
+            list_files(&e.path(), &format!("{rel}/"), names)?;
+        } else {
+            names.push(rel);
+        }
+    }
+    Ok(())
 }
 
 /// The size and SHA-256 (hex) of the file at `path`.
@@ -222,6 +243,28 @@ mod tests {
         // SHA-256 of the empty file and of "new pgm", as `sha256sum` prints them.
         assert_eq!(files[0].sha256, "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
         assert_eq!(files[1].sha256, digest(&dir.join("map.pgm")).unwrap().1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn files_in_subdirectories_move_with_the_set_and_are_listed_by_their_paths() {
+        let dir = crate::testdata::temp_dir("output-set-subdirs");
+        std::fs::create_dir_all(dir.join("lidar")).unwrap();
+        std::fs::write(dir.join("lidar/map.pgm"), b"old lidar").unwrap();
+        std::fs::write(dir.join("lidar/mine.txt"), b"the user's").unwrap();
+        let set = OutputSet::begin(&dir).unwrap();
+        std::fs::create_dir_all(set.staged("lidar")).unwrap();
+        std::fs::create_dir_all(set.staged("sim/bag")).unwrap();
+        std::fs::write(set.staged("lidar/map.pgm"), b"new lidar").unwrap();
+        std::fs::write(set.staged("sim/bag/metadata.yaml"), b"m").unwrap();
+        std::fs::write(set.staged("map.pgm"), b"p").unwrap();
+        let files = set.commit(&[], "summary.json", |_| Ok(Vec::new())).unwrap();
+        let listed: Vec<&str> = files.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(listed, ["lidar/map.pgm", "map.pgm", "sim/bag/metadata.yaml"]);
+        assert_eq!(std::fs::read(dir.join("lidar/map.pgm")).unwrap(), b"new lidar");
+        assert_eq!(std::fs::read(dir.join("lidar/mine.txt")).unwrap(), b"the user's");
+        assert_eq!(std::fs::read(dir.join("sim/bag/metadata.yaml")).unwrap(), b"m");
+        assert_eq!(names(&dir), [".fusemap.lock", "lidar", "map.pgm", "sim", "summary.json"]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -56,10 +56,12 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     let inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
     let files = output::prepare(out, &inputs)?;
     let rec = simulate(&Scenario::default()).map_err(|e| anyhow::anyhow!("scenario: {e}"))?;
-    let sim_dir = out.join("sim");
+    // Everything the demo writes — the simulated bag it reads back, the three maps, the
+    // comparison — is staged in the one output set and moves into `out` at its commit.
+    let sim_dir = files.staged("sim");
     let sim = fusemap_io::simulation::write_simulation(&rec, &sim_dir, plan.geometry.resolution(), true)
         .with_context(|| format!("writing the simulation to {}", sim_dir.display()))?;
-    let inv = Inventory::read_with(&sim.bag.dir, plan.limits.decompressed_bytes())?;
+    let inv = Inventory::read_with(&sim.bag.dir, &plan.limits)?;
     let (bound, chosen, track_s) = fusemap_pipeline::run::prepare(&plan, &inv)?;
     let run = fusemap_pipeline::map_with_track(
         &plan,
@@ -84,7 +86,12 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     // The fused map (the primary) with every output; the other two beside it.
     let mut log = serde_json::to_value(&run.report)?;
     log["scenario_scores"] = serde_json::to_value(&scores)?;
-    let source = format!("built-in production line, simulated to {}", sim.bag.dir.display());
+    let bag_in_out = out.join(sim.bag.dir.strip_prefix(files.staged("")).unwrap_or(&sim.bag.dir));
+    let source = format!("built-in production line, simulated to {}", bag_in_out.display());
+    for m in run.engine.maps().iter().skip(1) {
+        write_map_files(&files.staged(m.name()), &run.engine, m)?;
+    }
+    write_comparison(&files.staged("comparison.png"), &run.engine, &scores, &truth_occupancy, &plan)?;
     let summary = finish(
         &run.engine,
         files,
@@ -96,11 +103,7 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
         Some(log),
         Some(&run.trajectory),
     )?;
-    for m in run.engine.maps().iter().skip(1) {
-        write_map_files(&out.join(m.name()), &run.engine, m)?;
-    }
     let picture = out.join("comparison.png");
-    write_comparison(&picture, &run.engine, &scores, &truth_occupancy, &plan)?;
     summary.print();
     print_scores(&scores, &plan);
     println!("comparison    {}", picture.display());
