@@ -7,6 +7,10 @@
 //! fetched by id and decoded where SQLite holds it (never copied out), so memory stays
 //! small however large the bag, whether or not the file has rosbag2's index on
 //! `timestamp`.
+//!
+//! A cut or damaged file (SQLite: "database disk image is malformed") is read as far as a
+//! scan of `messages` in storage order reaches, and then ends with a truncation error
+//! saying how many rows were intact, like a cut bag or MCAP.
 
 use super::{error_chain, RawMessage, Source, Topic};
 use crate::error::{Error, Location, Result};
@@ -55,6 +59,40 @@ pub(crate) struct Db3Source {
     started: Instant,
     /// The most bytes one message's `data` may hold (`limits.decompressed_mib`).
     max_message: u64,
+    /// Why only part of `messages` could be read (a cut or damaged file), reported as a
+    /// truncation after the intact rows.
+    damaged: Option<String>,
+}
+
+/// Row ids of `messages` in timestamp order (ties by row id).
+fn message_order(conn: &Connection) -> rusqlite::Result<Vec<i64>> {
+    let mut stmt = conn.prepare("SELECT id FROM messages ORDER BY timestamp, id")?;
+    let rows = stmt.query_map([], |row| row.get::<_, i64>(0))?;
+    rows.collect()
+}
+
+/// True when SQLite says the file is damaged (a cut file reads as a malformed image).
+fn is_corrupt(e: &rusqlite::Error) -> bool {
+    matches!(e.sqlite_error_code(), Some(rusqlite::ErrorCode::DatabaseCorrupt))
+}
+
+/// The row ids a scan of `messages` in storage order reaches before the first error, in
+/// timestamp order (ties by row id), and that error. The scan reads the table itself
+/// (`NOT INDEXED`): rosbag2's `timestamp` index covers both columns, so SQLite would
+/// otherwise read the index, which is often the part a cut file lost.
+fn intact_rows(conn: &Connection) -> (Vec<i64>, Option<rusqlite::Error>) {
+    let mut rows: Vec<(i64, i64)> = Vec::new();
+    let mut scan = || -> rusqlite::Result<()> {
+        let mut stmt = conn.prepare("SELECT id, timestamp FROM messages NOT INDEXED")?;
+        let mut it = stmt.query([])?;
+        while let Some(row) = it.next()? {
+            rows.push((row.get(1)?, row.get(0)?));
+        }
+        Ok(())
+    };
+    let stop = scan().err();
+    rows.sort_unstable();
+    (rows.into_iter().map(|(_, id)| id).collect(), stop)
 }
 
 impl Db3Source {
@@ -86,10 +124,22 @@ impl Db3Source {
         // The rosbag2 schema: `topics` and `messages` are tables (a view can be any query).
         for table in ["topics", "messages"] {
             arm();
-            let kind: Option<String> = conn
-                .query_row("SELECT type FROM sqlite_master WHERE name = ?1", [table], |row| row.get(0))
-                .optional()
-                .map_err(|e| sql_error("reading the schema", e))?;
+            let query = || {
+                conn.query_row("SELECT type FROM sqlite_master WHERE name = ?1", [table], |row| row.get(0)).optional()
+            };
+            let kind: Option<String> = match query() {
+                // SQLite refuses a file shorter than its header says (a cut bag) as
+                // malformed before reading anything, unless `writable_schema` is on; on a
+                // read-only connection that only lifts this check, so the intact pages
+                // can be read (and a damaged row is met as a truncation, below).
+                Err(e) if is_corrupt(&e) => {
+                    conn.pragma_update(None, "writable_schema", true)
+                        .map_err(|e| sql_error("reading a damaged database", e))?;
+                    query()
+                }
+                other => other,
+            }
+            .map_err(|e| sql_error("reading the schema", e))?;
             match kind.as_deref() {
                 Some("table") => {}
                 Some(other) => {
@@ -130,16 +180,28 @@ impl Db3Source {
         }
 
         arm();
-        let order = {
-            let mut stmt = conn
-                .prepare("SELECT id FROM messages ORDER BY timestamp, id")
-                .map_err(|e| sql_error("reading table `messages`", e))?;
-            let rows =
-                stmt.query_map([], |row| row.get::<_, i64>(0)).map_err(|e| sql_error("reading table `messages`", e))?;
-            rows.collect::<rusqlite::Result<Vec<i64>>>().map_err(|e| sql_error("reading table `messages`", e))?
+        let (order, damaged) = match message_order(&conn) {
+            Ok(order) => (order, None),
+            // A cut or damaged file: rosbag2 writes rows in receive order, so the rows a
+            // scan of the table reaches before the damage are the log's intact start.
+            Err(e) if is_corrupt(&e) => {
+                arm();
+                let (order, stop) = intact_rows(&conn);
+                if order.is_empty() {
+                    return Err(sql_error("reading table `messages`", e));
+                }
+                let why = format!(
+                    "SQLite: the database is damaged after {} rows of table `messages` ({}): it is truncated or \
+                     corrupt; those rows are read, the rest is lost",
+                    order.len(),
+                    error_chain(&stop.unwrap_or(e))
+                );
+                (order, Some(why))
+            }
+            Err(e) => return Err(sql_error("reading table `messages`", e)),
         };
 
-        Ok(Self { path: path.to_path_buf(), conn, topics, order, next: 0, deadline, started, max_message })
+        Ok(Self { path: path.to_path_buf(), conn, topics, order, next: 0, deadline, started, max_message, damaged })
     }
 
     /// Fetches row `id` and hands it to `visit`, its payload borrowed from SQLite.
@@ -198,9 +260,27 @@ impl Db3Source {
                 format!("(topic id {topic_id})"),
                 format!("row id {id} of table `messages` has topic_id {topic_id}, which table `topics` does not list"),
             )),
-            Ok(None) => {
-                Err(at(format!("(row id {id})"), format!("row id {id} of table `messages` vanished while reading")))
-            }
+            // Listed when the order was read, gone when fetched: the file is immutable to
+            // SQLite here, so the row's page is damaged (a cut file reads as empty pages).
+            Ok(None) => Err(Error::truncated(
+                path,
+                Location::Message { index, topic: format!("(row id {id})") },
+                format!(
+                    "row id {id} of table `messages` is listed but cannot be found: the database is truncated or \
+                     corrupt; the messages before it are read"
+                ),
+            )),
+            // The order came from the timestamp index, but the row lies in a damaged part
+            // of the file: the log's intact part ends here.
+            Err(e) if is_corrupt(&e) => Err(Error::truncated(
+                path,
+                Location::Message { index, topic: format!("(row id {id})") },
+                format!(
+                    "SQLite: row id {id} of table `messages` lies in a damaged part of the database ({}): it is \
+                     truncated or corrupt; the messages before it are read",
+                    error_chain(&e)
+                ),
+            )),
             Err(e) => Err(at(
                 format!("(row id {id})"),
                 format!("SQLite: row id {id} of table `messages`: {}", error_chain(&e)),
@@ -211,8 +291,16 @@ impl Db3Source {
 
 impl Source for Db3Source {
     fn next_raw(&mut self, index: u64, visit: &mut dyn FnMut(RawMessage<'_>)) -> Option<Result<()>> {
-        let id = *self.order.get(self.next)?;
+        let Some(&id) = self.order.get(self.next) else {
+            let why = self.damaged.take()?;
+            return Some(Err(Error::truncated(&self.path, Location::File, why)));
+        };
         self.next += 1;
-        Some(self.fetch(index, id, visit))
+        let fetched = self.fetch(index, id, visit);
+        if fetched.as_ref().is_err_and(Error::is_truncation) {
+            self.next = self.order.len(); // nothing after the damage is read
+            self.damaged = None;
+        }
+        Some(fetched)
     }
 }

@@ -9,6 +9,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 mod camera;
+mod db3;
 mod pose_sensors;
 
 /// A little-endian CDR writer for tests. Padding is 0xAA, so a decoder that reads
@@ -437,18 +438,6 @@ fn mcap_uncompressed_zstd_and_lz4_chunks() {
 }
 
 #[test]
-fn db3_is_read_in_timestamp_order() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("bag_0.db3");
-    let mut log = sample_log();
-    log.reverse(); // inserted newest first: the reader must sort
-    write_db3(&path, &log, false);
-    let mut r = open_ros2(&path).unwrap();
-    let messages = read_all(r.as_mut());
-    check_sample(messages, r.stats());
-}
-
-#[test]
 fn rosbag2_directories_with_split_files_and_compression() {
     let log = sample_log();
     let (first, second) = log.split_at(3);
@@ -584,69 +573,6 @@ fn truncated_mcap_files_end_in_an_error_not_a_panic() {
         truncations += usize::from(last.as_ref().is_err_and(Error::is_truncation));
     }
     assert!(truncations > 50, "{truncations} cuts read as truncations");
-}
-
-#[test]
-fn db3_errors() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.db3");
-    write_db3(&path, &sample_log(), false);
-    let conn = rusqlite::Connection::open(&path).unwrap();
-    conn.execute("INSERT INTO messages(topic_id, timestamp, data) VALUES (42, 4500, x'00')", []).unwrap();
-    drop(conn);
-    let mut r = open_ros2(&path).unwrap();
-    let all = read_all(r.as_mut());
-    let err = all.iter().find_map(|m| m.as_ref().err()).unwrap();
-    match err {
-        Error::Format { location: Location::Message { index: 8, topic }, message, .. } => {
-            assert_eq!(topic, "(topic id 42)");
-            assert!(message.contains("topic_id 42"), "{message}");
-        }
-        other => panic!("{other}"),
-    }
-
-    // A SQLite file that is not a bag.
-    let other = dir.path().join("other.db3");
-    rusqlite::Connection::open(&other).unwrap().execute_batch("CREATE TABLE t(x);").unwrap();
-    let e = open_ros2(&other).err().unwrap();
-    assert!(e.to_string().contains("table `topics`"), "{e}");
-}
-
-#[test]
-fn db3_views_instead_of_tables_are_refused_at_once() {
-    let dir = tempfile::tempdir().unwrap();
-    // `messages` as an endless recursive query: reading it would never end.
-    let path = dir.path().join("view.db3");
-    rusqlite::Connection::open(&path)
-        .unwrap()
-        .execute_batch(
-            "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT, type TEXT, serialization_format TEXT,
-                                 offered_qos_profiles TEXT);
-             CREATE VIEW messages AS WITH RECURSIVE n(id) AS (SELECT 1 UNION ALL SELECT id + 1 FROM n)
-                 SELECT id, 1 AS topic_id, id AS timestamp, x'00' AS data FROM n;",
-        )
-        .unwrap();
-    let t0 = std::time::Instant::now();
-    let e = open_ros2(&path).err().expect("refused");
-    assert!(e.to_string().contains("`messages` is a view, not a table"), "{e}");
-    assert!(t0.elapsed() < std::time::Duration::from_secs(1));
-}
-
-#[test]
-fn db3_is_read_without_writing_beside_it() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("wal.db3");
-    write_db3(&path, &sample_log(), false);
-    let conn = rusqlite::Connection::open(&path).unwrap();
-    let mode: String = conn.query_row("PRAGMA journal_mode=WAL", [], |r| r.get(0)).unwrap();
-    assert_eq!(mode, "wal");
-    drop(conn);
-    let before: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
-    let mut r = open_ros2(&path).unwrap();
-    let all = read_all(r.as_mut());
-    assert!(!all.is_empty() && all.iter().all(|m| m.is_ok()));
-    let after: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
-    assert_eq!(before, after, "no -wal or -shm file beside the input");
 }
 
 #[test]
