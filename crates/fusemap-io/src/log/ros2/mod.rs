@@ -18,7 +18,7 @@
 //!
 //! Payloads are decoded where the container holds them (MCAP's chunk buffer, SQLite's
 //! row), never copied first; an image's pixels are copied only for the topics
-//! [`ReadOptions::images`] names, every other image is an [`ImageHeader`].
+//! [`ReadOptions::images`] names, every other image is an [`ImageHeader`](crate::log::ImageHeader).
 //!
 //! ```no_run
 //! use fusemap_io::log::ros2::open_ros2;
@@ -38,18 +38,15 @@
 
 pub mod cdr;
 mod db3;
+mod decode;
 mod mcap_reader;
 pub mod msgs;
 pub mod rosbag2;
 pub mod writer;
 
 use crate::error::{Error, Location, Result};
-use crate::log::{
-    planar_pose, CameraInfoMessage, GnssMessage, ImageHeader, ImageMessage, ImuMessage, LogMessage, LogReader,
-    OdomMessage, PoseMessage, ReadOptions, ReadStats, ScanMessage, TfMessage, Transform,
-};
-use cdr::{decode_cdr, CdrError};
-use fusemap_core::sensor::LaserScan;
+use crate::log::{LogMessage, LogReader, ReadOptions, ReadStats};
+pub use decode::{decode_known, decode_known_with, decode_message, KnownType};
 use fusemap_core::time::Stamp;
 use std::collections::VecDeque;
 use std::io::Read;
@@ -75,258 +72,6 @@ pub fn is_rosbag2_dir(path: &Path) -> bool {
 /// or a bare rosbag2 `.db3` file, told apart by their content rather than their names.
 pub fn open_ros2(path: &Path) -> Result<Box<dyn LogReader>> {
     Ok(Box::new(Ros2Reader::open(path)?))
-}
-
-/// The kinds of ROS 2 message fusemap decodes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum KnownType {
-    /// `sensor_msgs/msg/LaserScan`.
-    LaserScan,
-    /// `nav_msgs/msg/Odometry`.
-    Odometry,
-    /// `tf2_msgs/msg/TFMessage`.
-    TfMessage,
-    /// `sensor_msgs/msg/Imu`.
-    Imu,
-    /// `sensor_msgs/msg/NavSatFix`.
-    NavSatFix,
-    /// `geometry_msgs/msg/PoseWithCovarianceStamped`.
-    PoseWithCovarianceStamped,
-    /// `sensor_msgs/msg/Image`.
-    Image,
-    /// `sensor_msgs/msg/CameraInfo`.
-    CameraInfo,
-}
-
-impl KnownType {
-    /// All of them, for tests and fuzzing.
-    pub const ALL: [KnownType; 8] = [
-        KnownType::LaserScan,
-        KnownType::Odometry,
-        KnownType::TfMessage,
-        KnownType::Imu,
-        KnownType::NavSatFix,
-        KnownType::PoseWithCovarianceStamped,
-        KnownType::Image,
-        KnownType::CameraInfo,
-    ];
-
-    /// The type from its ROS 2 name (`sensor_msgs/msg/LaserScan`); the ROS 1 spelling
-    /// without `/msg/` is accepted too. `None` for types fusemap does not use.
-    pub fn from_name(type_name: &str) -> Option<Self> {
-        match type_name {
-            "sensor_msgs/msg/LaserScan" | "sensor_msgs/LaserScan" => Some(KnownType::LaserScan),
-            "nav_msgs/msg/Odometry" | "nav_msgs/Odometry" => Some(KnownType::Odometry),
-            "tf2_msgs/msg/TFMessage" | "tf2_msgs/TFMessage" => Some(KnownType::TfMessage),
-            "sensor_msgs/msg/Imu" | "sensor_msgs/Imu" => Some(KnownType::Imu),
-            "sensor_msgs/msg/NavSatFix" | "sensor_msgs/NavSatFix" => Some(KnownType::NavSatFix),
-            "geometry_msgs/msg/PoseWithCovarianceStamped" | "geometry_msgs/PoseWithCovarianceStamped" => {
-                Some(KnownType::PoseWithCovarianceStamped)
-            }
-            "sensor_msgs/msg/Image" | "sensor_msgs/Image" => Some(KnownType::Image),
-            "sensor_msgs/msg/CameraInfo" | "sensor_msgs/CameraInfo" => Some(KnownType::CameraInfo),
-            _ => None,
-        }
-    }
-
-    /// The ROS 2 type name.
-    pub fn name(self) -> &'static str {
-        match self {
-            KnownType::LaserScan => "sensor_msgs/msg/LaserScan",
-            KnownType::Odometry => "nav_msgs/msg/Odometry",
-            KnownType::TfMessage => "tf2_msgs/msg/TFMessage",
-            KnownType::Imu => "sensor_msgs/msg/Imu",
-            KnownType::NavSatFix => "sensor_msgs/msg/NavSatFix",
-            KnownType::PoseWithCovarianceStamped => "geometry_msgs/msg/PoseWithCovarianceStamped",
-            KnownType::Image => "sensor_msgs/msg/Image",
-            KnownType::CameraInfo => "sensor_msgs/msg/CameraInfo",
-        }
-    }
-}
-
-/// Decodes one CDR payload (encapsulation header included) of type `kind` received on
-/// `topic` into fusemap's message type; an image with its pixels.
-pub fn decode_known(
-    kind: KnownType,
-    topic: &str,
-    receive_stamp: Option<Stamp>,
-    payload: &[u8],
-) -> std::result::Result<LogMessage, CdrError> {
-    decode_known_with(kind, topic, receive_stamp, payload, true)
-}
-
-/// [`decode_known`], with an image's pixels copied only with `pixels` (else it becomes
-/// an [`ImageHeader`]; its layout is checked either way).
-pub fn decode_known_with(
-    kind: KnownType,
-    topic: &str,
-    receive_stamp: Option<Stamp>,
-    payload: &[u8],
-    pixels: bool,
-) -> std::result::Result<LogMessage, CdrError> {
-    use msgs::{geometry_msgs, nav_msgs, sensor_msgs, tf2_msgs};
-    Ok(match kind {
-        KnownType::LaserScan => {
-            let m: sensor_msgs::LaserScan = decode_cdr(payload)?;
-            LogMessage::Scan(ScanMessage {
-                topic: topic.to_owned(),
-                frame_id: m.header.frame_id,
-                receive_stamp,
-                scan: LaserScan {
-                    stamp: m.header.stamp.to_stamp(),
-                    angle_min: f64::from(m.angle_min),
-                    angle_increment: f64::from(m.angle_increment),
-                    ranges: m.ranges,
-                },
-                angle_max: m.angle_max,
-                time_increment: m.time_increment,
-                scan_time: m.scan_time,
-                range_min: m.range_min,
-                range_max: m.range_max,
-                pose: None,
-                odom_pose: None,
-                laser_pose: None,
-            })
-        }
-        KnownType::Odometry => {
-            let m: nav_msgs::Odometry = decode_cdr(payload)?;
-            let p = m.pose.pose;
-            let t = m.twist.twist;
-            LogMessage::Odometry(OdomMessage {
-                topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
-                receive_stamp,
-                frame_id: m.header.frame_id,
-                child_frame_id: m.child_frame_id,
-                pose: planar_pose([p.position.x, p.position.y, p.position.z], p.orientation.to_array()),
-                pose_covariance: m.pose.covariance,
-                twist: [t.linear.x, t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z],
-                twist_covariance: m.twist.covariance,
-            })
-        }
-        KnownType::TfMessage => {
-            let m: tf2_msgs::TfMessage = decode_cdr(payload)?;
-            LogMessage::Tf(TfMessage {
-                topic: topic.to_owned(),
-                is_static: topic == "/tf_static",
-                receive_stamp,
-                transforms: m
-                    .transforms
-                    .into_iter()
-                    .map(|t| Transform {
-                        stamp: t.header.stamp.to_stamp(),
-                        parent: t.header.frame_id,
-                        child: t.child_frame_id,
-                        translation: t.transform.translation.to_array(),
-                        rotation: t.transform.rotation.to_array(),
-                    })
-                    .collect(),
-            })
-        }
-        KnownType::Imu => {
-            let m: sensor_msgs::Imu = decode_cdr(payload)?;
-            LogMessage::Imu(ImuMessage {
-                topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
-                receive_stamp,
-                frame_id: m.header.frame_id,
-                orientation: m.orientation.to_array(),
-                angular_velocity: m.angular_velocity.to_array(),
-                linear_acceleration: m.linear_acceleration.to_array(),
-                orientation_covariance: m.orientation_covariance,
-                angular_velocity_covariance: m.angular_velocity_covariance,
-                linear_acceleration_covariance: m.linear_acceleration_covariance,
-            })
-        }
-        KnownType::NavSatFix => {
-            let m: sensor_msgs::NavSatFix = decode_cdr(payload)?;
-            LogMessage::Gnss(GnssMessage {
-                topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
-                receive_stamp,
-                frame_id: m.header.frame_id,
-                status: m.status.status,
-                service: m.status.service,
-                latitude: m.latitude,
-                longitude: m.longitude,
-                altitude: m.altitude,
-                position_covariance: m.position_covariance,
-                position_covariance_type: m.position_covariance_type,
-            })
-        }
-        KnownType::PoseWithCovarianceStamped => {
-            let m: geometry_msgs::PoseWithCovarianceStamped = decode_cdr(payload)?;
-            let p = m.pose.pose;
-            LogMessage::Pose(PoseMessage {
-                topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
-                receive_stamp,
-                frame_id: m.header.frame_id,
-                position: [p.position.x, p.position.y, p.position.z],
-                orientation: p.orientation.to_array(),
-                covariance: m.pose.covariance,
-            })
-        }
-        KnownType::Image => {
-            let m = sensor_msgs::Image::from_payload(payload)?;
-            let stamp = m.header.stamp.to_stamp();
-            let is_bigendian = m.is_bigendian != 0;
-            if pixels {
-                LogMessage::Image(ImageMessage {
-                    topic: topic.to_owned(),
-                    stamp,
-                    receive_stamp,
-                    frame_id: m.header.frame_id,
-                    width: m.width,
-                    height: m.height,
-                    encoding: m.encoding,
-                    is_bigendian,
-                    step: m.step,
-                    data: m.data.to_vec(),
-                })
-            } else {
-                LogMessage::ImageHeader(ImageHeader {
-                    topic: topic.to_owned(),
-                    stamp,
-                    receive_stamp,
-                    frame_id: m.header.frame_id,
-                    width: m.width,
-                    height: m.height,
-                    encoding: m.encoding,
-                    is_bigendian,
-                    step: m.step,
-                    data_len: m.data.len() as u64,
-                })
-            }
-        }
-        KnownType::CameraInfo => {
-            let m: sensor_msgs::CameraInfo = decode_cdr(payload)?;
-            LogMessage::CameraInfo(CameraInfoMessage {
-                topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
-                receive_stamp,
-                frame_id: m.header.frame_id,
-                width: m.width,
-                height: m.height,
-                distortion_model: m.distortion_model,
-                d: m.d,
-                k: m.k,
-            })
-        }
-    })
-}
-
-/// Decodes a payload by its ROS type name: `Ok(None)` for a type fusemap does not use.
-pub fn decode_message(
-    type_name: &str,
-    topic: &str,
-    receive_stamp: Option<Stamp>,
-    payload: &[u8],
-) -> std::result::Result<Option<LogMessage>, CdrError> {
-    match KnownType::from_name(type_name) {
-        Some(kind) => decode_known(kind, topic, receive_stamp, payload).map(Some),
-        None => Ok(None),
-    }
 }
 
 /// A topic as a container declares it.
