@@ -76,11 +76,13 @@ fn is_corrupt(e: &rusqlite::Error) -> bool {
     matches!(e.sqlite_error_code(), Some(rusqlite::ErrorCode::DatabaseCorrupt))
 }
 
-/// The row ids a scan of `messages` in storage order reaches before the first error, in
-/// timestamp order (ties by row id), and that error. The scan reads the table itself
-/// (`NOT INDEXED`): rosbag2's `timestamp` index covers both columns, so SQLite would
-/// otherwise read the index, which is often the part a cut file lost.
-fn intact_rows(conn: &Connection) -> (Vec<i64>, Option<rusqlite::Error>) {
+/// The row ids a scan of `messages` in storage order reaches before the file's damage,
+/// in timestamp order (ties by row id), and the damage met (`None` when the scan read the
+/// whole table). Any other error (the time budget, say) is an error, not damage: reading part of the log because a query was interrupted
+/// would give different logs on different runs. The scan reads the table itself (`NOT
+/// INDEXED`): rosbag2's `timestamp` index covers both columns, so SQLite would otherwise
+/// read the index, which is often the part a cut file lost.
+fn intact_rows(conn: &Connection) -> rusqlite::Result<(Vec<i64>, Option<rusqlite::Error>)> {
     let mut rows: Vec<(i64, i64)> = Vec::new();
     let mut scan = || -> rusqlite::Result<()> {
         let mut stmt = conn.prepare("SELECT id, timestamp FROM messages NOT INDEXED")?;
@@ -90,9 +92,15 @@ fn intact_rows(conn: &Connection) -> (Vec<i64>, Option<rusqlite::Error>) {
         }
         Ok(())
     };
-    let stop = scan().err();
+    // A damaged page can also read as rows whose `id` or `timestamp` (both `NOT NULL`
+    // integers in rosbag2's schema) is NULL: that too is where the intact part ends.
+    let stop = match scan() {
+        Ok(()) => None,
+        Err(e) if is_corrupt(&e) || matches!(e, rusqlite::Error::InvalidColumnType(..)) => Some(e),
+        Err(e) => return Err(e),
+    };
     rows.sort_unstable();
-    (rows.into_iter().map(|(_, id)| id).collect(), stop)
+    Ok((rows.into_iter().map(|(_, id)| id).collect(), stop))
 }
 
 impl Db3Source {
@@ -121,11 +129,19 @@ impl Db3Source {
             .map_err(|e| sql_error("setting a time budget", e))?;
         }
         let arm = || deadline.store((started.elapsed() + QUERY_BUDGET).as_nanos() as u64, Ordering::Relaxed);
-        // The rosbag2 schema: `topics` and `messages` are tables (a view can be any query).
+        // The rosbag2 schema: `topics` and `messages` are tables (a view can be any query,
+        // a virtual table any code). The type is the one SQLite gave the object it loaded
+        // (`pragma_table_list`), not the `type` column of `sqlite_master`, which a crafted
+        // file can set to `table` over a `CREATE VIEW`.
         for table in ["topics", "messages"] {
             arm();
             let query = || {
-                conn.query_row("SELECT type FROM sqlite_master WHERE name = ?1", [table], |row| row.get(0)).optional()
+                conn.query_row(
+                    "SELECT type FROM pragma_table_list WHERE schema = 'main' AND name = ?1",
+                    [table],
+                    |row| row.get(0),
+                )
+                .optional()
             };
             let kind: Option<String> = match query() {
                 // SQLite refuses a file shorter than its header says (a cut bag) as
@@ -186,17 +202,21 @@ impl Db3Source {
             // scan of the table reaches before the damage are the log's intact start.
             Err(e) if is_corrupt(&e) => {
                 arm();
-                let (order, stop) = intact_rows(&conn);
-                if order.is_empty() {
-                    return Err(sql_error("reading table `messages`", e));
+                let (order, stop) = intact_rows(&conn).map_err(|e| sql_error("reading table `messages`", e))?;
+                match stop {
+                    // The index was damaged, the table whole: every row is read.
+                    None => (order, None),
+                    Some(_) if order.is_empty() => return Err(sql_error("reading table `messages`", e)),
+                    Some(stop) => {
+                        let why = format!(
+                            "SQLite: the database is damaged after {} rows of table `messages` ({}): it is \
+                             truncated or corrupt; those rows are read, the rest is lost",
+                            order.len(),
+                            error_chain(&stop)
+                        );
+                        (order, Some(why))
+                    }
                 }
-                let why = format!(
-                    "SQLite: the database is damaged after {} rows of table `messages` ({}): it is truncated or \
-                     corrupt; those rows are read, the rest is lost",
-                    order.len(),
-                    error_chain(&stop.unwrap_or(e))
-                );
-                (order, Some(why))
             }
             Err(e) => return Err(sql_error("reading table `messages`", e)),
         };
