@@ -101,9 +101,18 @@ pub struct Outputs {
     /// Where each file is written until the commit.
     pub files: OutputFiles,
     set: OutputSet,
+    /// Subdirectories the set owns (`lidar/`), see [`Outputs::own_dir`].
+    owned: Vec<String>,
 }
 
 impl Outputs {
+    /// Declares the subdirectory `name` of the output directory the set's own: at the
+    /// commit, files under it that this run did not write are removed with the other
+    /// stale files.
+    pub fn own_dir(&mut self, name: &str) {
+        self.owned.push(format!("{name}/"));
+    }
+
     /// Where a writer puts `name` (which may hold a subdirectory, `lidar/map.npz`) so that
     /// it moves into the output directory with the rest of the set.
     pub fn staged(&self, name: &str) -> PathBuf {
@@ -119,7 +128,7 @@ pub fn prepare(dir: &Path, inputs: &[PathBuf]) -> Result<Outputs> {
     }
     let set =
         OutputSet::begin(dir).with_context(|| format!("cannot write into the output directory {}", dir.display()))?;
-    Ok(Outputs { files: OutputFiles::in_dir(set.staging()), set })
+    Ok(Outputs { files: OutputFiles::in_dir(set.staging()), set, owned: Vec::new() })
 }
 
 /// The semantic and dynamic layers of a run with a camera, over the occupancy raster's
@@ -176,7 +185,7 @@ pub fn write(
     summary: &mut Summary,
     trajectory: Option<&[(Stamp, Pose2)]>,
 ) -> Result<()> {
-    let Outputs { files, set } = outputs;
+    let Outputs { files, set, owned } = outputs;
     if let Some(t) = trajectory {
         fusemap_io::trajectory::write_tum(&files.trajectory, t)?;
     }
@@ -204,7 +213,8 @@ pub fn write(
     // Files of an earlier run that this run does not write are removed at the commit: a
     // run never leaves files beside its summary that look like its own.
     let summary_path = set.dir().join("summary.json");
-    set.commit(&OutputFiles::NAMES, "summary.json", |list| {
+    let known: Vec<&str> = OutputFiles::NAMES.iter().copied().chain(owned.iter().map(String::as_str)).collect();
+    set.commit(&known, "summary.json", |list| {
         summary.files = list.to_vec();
         serde_json::to_vec_pretty(&*summary).map_err(|e| fusemap_io::Error::io(&summary_path, std::io::Error::other(e)))
     })?;

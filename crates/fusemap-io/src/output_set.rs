@@ -113,7 +113,13 @@ impl OutputSet {
 
     /// Moves every staged file into the output directory, removes the files of `known`
     /// this set does not hold, and writes `summary_name` last with the bytes
-    /// `summary(files)` makes of the list of files moved (name, size, SHA-256).
+    /// `summary(files)` makes of the list of files moved (name, size, SHA-256). A `known`
+    /// entry ending in `/` names a directory the set owns: every file under it that the
+    /// set does not hold is removed.
+    ///
+    /// Every destination is checked before anything in the output directory changes: a
+    /// parent that is a symbolic link or not a directory, or a destination that is a
+    /// directory, is an error while the previous set is still whole.
     pub fn commit(
         mut self,
         known: &[&str],
@@ -128,6 +134,9 @@ impl OutputSet {
             let path = self.staged(name);
             let (bytes, sha256) = digest(&path).map_err(|e| Error::io(&path, e))?;
             files.push(OutputFile { name: name.clone(), bytes, sha256 });
+        }
+        for name in &names {
+            check_destination(&self.dir, name)?;
         }
         // The old summary goes first: should the commit stop half-way (a rename refused, the
         // process killed), the directory holds no summary that claims a complete set.
@@ -145,7 +154,20 @@ impl OutputSet {
             }
             std::fs::rename(self.staged(name), &to).map_err(|e| Error::io(&to, e))?;
         }
-        for stale in known.iter().filter(|k| !names.iter().any(|n| n == *k) && **k != summary_name) {
+        let mut known_files: Vec<String> = Vec::new();
+        for k in known {
+            match k.strip_suffix('/') {
+                Some(sub) => {
+                    let dir = self.dir.join(sub);
+                    let is_dir = std::fs::symlink_metadata(&dir).is_ok_and(|m| m.is_dir());
+                    if is_dir {
+                        list_files(&dir, k, &mut known_files)?;
+                    }
+                }
+                None => known_files.push(k.to_string()),
+            }
+        }
+        for stale in known_files.iter().filter(|k| !names.iter().any(|n| n == *k) && *k != summary_name) {
             let path = self.dir.join(stale);
             match std::fs::remove_file(&path) {
                 Err(e) if e.kind() != io::ErrorKind::NotFound => return Err(Error::io(&path, e)),
@@ -167,6 +189,34 @@ impl Drop for OutputSet {
             let _ = std::fs::remove_dir_all(&self.staging);
         }
     }
+}
+
+/// Refuses to move `name` (a `/`-separated path) into `dir` when one of its parents there
+/// is a symbolic link or not a directory, or when the destination is a directory: the
+/// rename would fail half-way through the commit, or land outside `dir`.
+fn check_destination(dir: &Path, name: &str) -> Result<()> {
+    let mut at = dir.to_path_buf();
+    let parts: Vec<&str> = name.split('/').collect();
+    for (i, part) in parts.iter().enumerate() {
+        at.push(part);
+        let last = i + 1 == parts.len();
+        let meta = match std::fs::symlink_metadata(&at) {
+            Ok(m) => m,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+            Err(e) => return Err(Error::io(&at, e)),
+        };
+        let what = if meta.file_type().is_symlink() && !last {
+            "is a symbolic link; the set's files go only into directories of the output directory"
+        } else if !last && !meta.is_dir() {
+            "is not a directory, and this run writes files into it"
+        } else if last && meta.is_dir() {
+            "is a directory, and this run writes a file of that name"
+        } else {
+            continue;
+        };
+        return Err(Error::io(&at, io::Error::new(io::ErrorKind::AlreadyExists, what)));
+    }
+    Ok(())
 }
 
 /// Appends the files under `dir` to `names`, as paths relative to the staging directory
@@ -265,7 +315,41 @@ mod tests {
         assert_eq!(std::fs::read(dir.join("lidar/mine.txt")).unwrap(), b"the user's");
         assert_eq!(std::fs::read(dir.join("sim/bag/metadata.yaml")).unwrap(), b"m");
         assert_eq!(names(&dir), [".fusemap.lock", "lidar", "map.pgm", "sim", "summary.json"]);
+        // A directory the set owns loses the files the next set does not write; a
+        // directory it does not own keeps them.
+        std::fs::write(dir.join("sim/bag/old.db3"), b"old").unwrap();
+        let set = OutputSet::begin(&dir).unwrap();
+        std::fs::create_dir_all(set.staged("sim/bag")).unwrap();
+        std::fs::write(set.staged("sim/bag/metadata.yaml"), b"m2").unwrap();
+        set.commit(&["sim/"], "summary.json", |_| Ok(Vec::new())).unwrap();
+        assert!(!dir.join("sim/bag/old.db3").exists());
+        assert!(dir.join("lidar/mine.txt").exists() && dir.join("lidar/map.pgm").exists());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_destination_that_cannot_take_the_file_fails_before_the_old_set_changes() {
+        let dir = crate::testdata::temp_dir("output-set-destinations");
+        let elsewhere = crate::testdata::temp_dir("output-set-elsewhere");
+        std::fs::write(dir.join("summary.json"), b"old summary").unwrap();
+        std::fs::write(dir.join("lidar"), b"a file where a directory goes").unwrap();
+        #[cfg(unix)]
+        std::os::unix::fs::symlink(&elsewhere, dir.join("sim")).unwrap();
+        std::fs::create_dir(dir.join("map.png")).unwrap();
+        let cases: &[&str] =
+            if cfg!(unix) { &["lidar/map.pgm", "sim/bag.mcap", "map.png"] } else { &["lidar/map.pgm"] };
+        for name in cases {
+            let set = OutputSet::begin(&dir).unwrap();
+            let staged = set.staged(name);
+            std::fs::create_dir_all(staged.parent().unwrap()).unwrap();
+            std::fs::write(&staged, b"new").unwrap();
+            let e = set.commit(&[], "summary.json", |_| Ok(Vec::new())).unwrap_err().to_string();
+            assert!(e.contains(name.split('/').next().unwrap()), "{name}: {e}");
+            assert_eq!(std::fs::read(dir.join("summary.json")).unwrap(), b"old summary", "{name}");
+        }
+        assert_eq!(std::fs::read_dir(&elsewhere).unwrap().count(), 0, "nothing moved through the link");
+        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(&elsewhere).unwrap();
     }
 
     #[test]

@@ -54,7 +54,10 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     let started = Instant::now();
     let plan = plan_of(config, || Ok(production_line_plan()?))?;
     let inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
-    let files = output::prepare(out, &inputs)?;
+    let mut files = output::prepare(out, &inputs)?;
+    for owned in ["sim", "lidar", "camera"] {
+        files.own_dir(owned);
+    }
     let rec = simulate(&Scenario::default()).map_err(|e| anyhow::anyhow!("scenario: {e}"))?;
     // Everything the demo writes — the simulated bag it reads back, the three maps, the
     // comparison — is staged in the one output set and moves into `out` at its commit.
