@@ -360,6 +360,11 @@ def rosbag2_cases(tmp: Path) -> None:
              edit=sql("ALTER TABLE messages RENAME TO m2; CREATE VIEW messages(id, topic_id, timestamp, data) AS "
                       "WITH RECURSIVE r(n) AS (SELECT 1 UNION ALL SELECT n + 1 FROM r) "
                       "SELECT n, 1, n, zeroblob(10) FROM r ORDER BY n DESC;"))
+    bag_case("rosbag2/db3-recursive-view-disguised-as-table", db3_bag, "error", names=["view"], max_seconds=1.0,
+             edit=sql("ALTER TABLE messages RENAME TO m2; CREATE VIEW messages(id, topic_id, timestamp, data) AS "
+                      "WITH RECURSIVE r(n) AS (SELECT 1 UNION ALL SELECT n + 1 FROM r) "
+                      "SELECT n, 1, n, zeroblob(10) FROM r; PRAGMA writable_schema = ON; "
+                      "UPDATE sqlite_master SET type = 'table' WHERE name = 'messages';"))
     bag_case("rosbag2/db3-topics-is-a-view", db3_bag, "error", names=["view"],
              edit=sql("ALTER TABLE topics RENAME TO t2; CREATE VIEW topics AS SELECT * FROM t2;"))
     bag_case("rosbag2/db3-no-messages-table", db3_bag, "error", names=["messages"],

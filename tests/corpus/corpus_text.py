@@ -313,6 +313,10 @@ def output_cases() -> None:
                  absent=["out/.fusemap-staging-99999999"])
     (d / "out" / ".fusemap-staging-99999999").mkdir(parents=True)
     (d / "out" / ".fusemap-staging-99999999" / "map.pgm").write_text("half-written")
+    d = with_log("output/map-png-is-a-directory", ["map", "--out", "{case}/out", "{case}/room.log"], "error",
+                 names=["{case}/out/map.png", "is a directory"])
+    (d / "out" / "map.png").mkdir(parents=True)
+    (d / "out" / "summary.json").write_text("{}\n")
     with_log("output/locked-by-another-run", ["map", "--out", "{case}/out", "{case}/room.log"], "error",
              names=[".fusemap.lock"], setup="lock")
     with_log("output/disk-full-keeps-old-set", ["map", "--out", "{case}/out", "{case}/room.log"], "error",
