@@ -55,12 +55,10 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     let plan = plan_of(config, || Ok(production_line_plan()?))?;
     let inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
     let mut files = output::prepare(out, &inputs)?;
-    for owned in ["sim", "lidar", "camera"] {
-        files.own_dir(owned);
-    }
     let rec = simulate(&Scenario::default()).map_err(|e| anyhow::anyhow!("scenario: {e}"))?;
     // Everything the demo writes — the simulated bag it reads back, the three maps, the
     // comparison — is staged in the one output set and moves into `out` at its commit.
+    files.own_dir("sim");
     let sim_dir = files.staged("sim");
     let sim = fusemap_io::simulation::write_simulation(&rec, &sim_dir, plan.geometry.resolution(), true)
         .with_context(|| format!("writing the simulation to {}", sim_dir.display()))?;
@@ -92,6 +90,7 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     let bag_in_out = out.join(sim.bag.dir.strip_prefix(files.staged("")).unwrap_or(&sim.bag.dir));
     let source = format!("built-in production line, simulated to {}", bag_in_out.display());
     for m in run.engine.maps().iter().skip(1) {
+        files.own_dir(m.name());
         write_map_files(&files.staged(m.name()), &run.engine, m)?;
     }
     write_comparison(&files.staged("comparison.png"), &run.engine, &scores, &truth_occupancy, &plan)?;

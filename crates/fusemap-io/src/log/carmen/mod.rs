@@ -362,17 +362,14 @@ impl<R: BufRead> LogReader for CarmenReader<R> {
                     self.line_number += 1;
                     match parse_line(&self.line, &self.options, &mut self.params) {
                         Parsed::Ignored => {}
-                        Parsed::Message(m) => {
+                        Parsed::Message(LogMessage::Scan(s)) => {
                             let max = self.options.max_beams.unwrap_or(LimitsConfig::default().beams_per_scan);
-                            let over = match &m {
-                                LogMessage::Scan(s) => super::image::scan_over_limit(s.scan.ranges.len(), max),
-                                _ => None,
-                            };
-                            return Some(match over {
+                            return Some(match super::image::scan_over_limit(s.scan.ranges.len(), max) {
                                 Some(why) => Err(Error::limit(&self.path, Location::Line(self.line_number), why)),
-                                None => Ok(m),
+                                None => Ok(LogMessage::Scan(s)),
                             });
                         }
+                        Parsed::Message(m) => return Some(Ok(m)),
                         Parsed::Skipped(kind) => self.stats.skip_type(kind),
                         Parsed::Malformed(message) => {
                             let err = Error::format(&self.path, Location::Line(self.line_number), message);
