@@ -76,6 +76,18 @@ enum Command {
         /// nearest pose is taken.
         #[arg(long, default_value_t = 1.0)]
         tolerance_ms: f64,
+        /// A stamp with no pose within the tolerance takes the pose interpolated between
+        /// the two around it when they are at most this far apart, milliseconds (a
+        /// trajectory written at the odometry's rate has no pose at the scan stamps the
+        /// relations name).
+        #[arg(long, default_value_t = 500.0)]
+        max_gap_ms: f64,
+        /// `X,Y,YAW` (metres, radians): score the pose of a sensor mounted here on the
+        /// trajectory's frame instead. The benchmark's relations are between laser poses and
+        /// fusemap writes the base frame's: give `log.slam.sensor_in_base` of
+        /// `summary.json`.
+        #[arg(long, value_name = "X,Y,YAW")]
+        sensor_in_base: Option<String>,
         /// One JSON object instead of the table.
         #[arg(long)]
         json: bool,
@@ -133,8 +145,9 @@ fn main() {
             commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out, crop)
         }
         Command::Doctor { config, log } => commands::doctor::run(config.as_deref(), &log),
-        Command::Relations { relations, trajectory, tolerance_ms, json } => {
-            commands::relations::run(&relations, &trajectory, tolerance_ms, json)
+        Command::Relations { relations, trajectory, tolerance_ms, max_gap_ms, sensor_in_base, json } => {
+            let sensor = sensor_in_base.as_deref();
+            commands::relations::run(&relations, &trajectory, tolerance_ms, max_gap_ms, sensor, json)
         }
         Command::Simulate { scenario, out, resolution, overwrite } => {
             commands::simulate::run(scenario.as_deref(), &out, resolution, overwrite)

@@ -71,6 +71,10 @@ pub struct SlamSummary {
     pub nodes: Vec<GraphNode>,
     /// Its edges.
     pub edges: Vec<GraphEdge>,
+    /// The lidar's pose in the base frame, `[x, y, yaw]` (metres, radians). The
+    /// trajectory is the base frame's; the SLAM benchmark's relations are between laser
+    /// poses, so `fusemap relations --sensor-in-base` composes the two.
+    pub sensor_in_base: [f64; 3],
     /// Every scan's optimised pose (in `trajectory.tum` through the track, not here).
     #[serde(skip)]
     pub scan_poses: Vec<(Stamp, Pose2)>,
@@ -250,7 +254,9 @@ pub fn run(
     }
     progress(Progress::Done);
     let result = slam.finish();
-    let summary = summary(&result, reason, b.topic.clone(), without_pose, late, t0.elapsed().as_secs_f64());
+    let mut summary = summary(&result, reason, b.topic.clone(), without_pose, late, t0.elapsed().as_secs_f64());
+    let sensor = mount.base_from_sensor;
+    summary.sensor_in_base = [sensor.x, sensor.y, sensor.theta];
     Ok(SlamRun { summary })
 }
 
@@ -304,6 +310,7 @@ fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, lat
         track: String::new(),
         nodes,
         edges,
+        sensor_in_base: [0.0; 3],
         scan_poses: r.trajectory.clone(),
     }
 }

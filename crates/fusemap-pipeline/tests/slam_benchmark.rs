@@ -5,6 +5,7 @@
 //! Each log is its own test; `-- --nocapture` prints the table row.
 
 use fusemap_core::config::Config;
+use fusemap_core::geometry::Pose2;
 use fusemap_core::metrics::{parse_relations, score_relations, RelationScore};
 use fusemap_core::time::{Stamp, SyncMode};
 use fusemap_io::testdata::dataset;
@@ -36,7 +37,7 @@ fn score(log: &str, relations: &str) -> Option<Scored> {
     let (bound, chosen, _) = prepare(&plan, &inv).unwrap();
     let slam = chosen.slam.as_ref().expect("SLAM runs on a raw log");
     eprintln!(
-        "{}: {} scans ({} without a track pose, {} late), {} matched, {} degenerate, {} nodes, {} submaps, loop closures {}/{} accepted, {} optimisations; matching {:.2} s, loop search {:.2} s, optimisation {:.2} s, total {:.2} s",
+        "{}: {} scans ({} without a track pose, {} late), {} matched, {} degenerate, {} nodes, {} submaps, loop closures {}/{} accepted, {} optimisations, {} held readings, {} of {} rescue searches taken; matching {:.2} s, loop search {:.2} s, optimisation {:.2} s, total {:.2} s",
         log.display(),
         slam.counts.scans,
         slam.scans_without_pose,
@@ -48,6 +49,9 @@ fn score(log: &str, relations: &str) -> Option<Scored> {
         slam.counts.loop_accepted,
         slam.counts.loop_searches,
         slam.counts.optimisations,
+        slam.counts.held_readings,
+        slam.counts.rescued,
+        slam.counts.rescue_searched,
         slam.counts.matching_s,
         slam.counts.loop_search_s,
         slam.counts.optimisation_s,
@@ -58,8 +62,12 @@ fn score(log: &str, relations: &str) -> Option<Scored> {
         eprintln!("estimator: {}", &e[..e.len().min(3000)]);
     }
     let stamps = &inv.scans[&bound.lidars[0].topic].stamps;
+    // The relations are between laser poses (the scans' origins); fusemap's trajectory is
+    // the base frame's. Freiburg 079's laser sits 4 cm ahead of its base, the others' at it.
+    let [x, y, yaw] = slam.sensor_in_base;
+    let laser = Pose2::new(x, y, yaw);
     let Track::Timed(track) = &chosen.track else { panic!("SLAM gives a timed track") };
-    let at = |t: &Stamp| track.pose_at(*t, SyncMode::Interpolate).ok().map(|p| (*t, p));
+    let at = |t: &Stamp| track.pose_at(*t, SyncMode::Interpolate).ok().map(|p| (*t, p.compose(laser)));
     let mut tracked: Vec<_> = stamps.iter().filter_map(at).collect();
     tracked.sort_by_key(|s| s.0);
     let odo_plan = {
@@ -69,18 +77,19 @@ fn score(log: &str, relations: &str) -> Option<Scored> {
     };
     let (_, raw, _) = prepare(&odo_plan, &inv).unwrap();
     let mut odometry: Vec<_> = match &raw.track {
-        Track::Timed(t) => {
-            stamps.iter().filter_map(|s| t.pose_at(*s, SyncMode::Interpolate).ok().map(|p| (*s, p))).collect()
-        }
+        Track::Timed(t) => stamps
+            .iter()
+            .filter_map(|s| t.pose_at(*s, SyncMode::Interpolate).ok().map(|p| (*s, p.compose(laser))))
+            .collect(),
         Track::ScanLine => Vec::new(),
     };
     odometry.sort_by_key(|s| s.0);
+    let scan_poses: Vec<(Stamp, Pose2)> = slam.scan_poses.iter().map(|&(t, p)| (t, p.compose(laser))).collect();
     if let Ok(dir) = std::env::var("FUSEMAP_SLAM_DUMP") {
         let name = log.file_name().unwrap().to_string_lossy().to_string();
-        let lines: String =
-            slam.scan_poses.iter().map(|(t, p)| format!("{} {} {} {}\n", t.0, p.x, p.y, p.theta)).collect();
+        let lines: String = scan_poses.iter().map(|(t, p)| format!("{} {} {} {}\n", t.0, p.x, p.y, p.theta)).collect();
         std::fs::write(format!("{dir}/{name}.slam.txt"), lines).unwrap();
-        let errs = fusemap_core::metrics::relation_errors(&relations, &slam.scan_poses, TOLERANCE_NS);
+        let errs = fusemap_core::metrics::relation_errors(&relations, &scan_poses, TOLERANCE_NS);
         let lines: String = relations
             .iter()
             .zip(errs)
@@ -89,7 +98,7 @@ fn score(log: &str, relations: &str) -> Option<Scored> {
         std::fs::write(format!("{dir}/{name}.errors.txt"), lines).unwrap();
     }
     Some(Scored {
-        slam: score_relations(&relations, &slam.scan_poses, TOLERANCE_NS),
+        slam: score_relations(&relations, &scan_poses, TOLERANCE_NS),
         track: score_relations(&relations, &tracked, TOLERANCE_NS),
         odometry: score_relations(&relations, &odometry, TOLERANCE_NS),
     })

@@ -3,24 +3,41 @@
 //! SLAM algorithms"), the figures Hess et al. 2016 report in Table II.
 
 use anyhow::{bail, Result};
-use fusemap_core::metrics::score_relations;
+use fusemap_core::geometry::Pose2;
+use fusemap_core::metrics::{at_relation_stamps, score_relations};
 use std::path::Path;
 
-/// `fusemap relations`: reads both files, matches each relation's stamps to the nearest
-/// trajectory pose within `tolerance_ms`, and prints the table (or one JSON object).
+/// `fusemap relations`: reads both files, finds the pose at each relation's stamps (the
+/// nearest within `tolerance_ms`, else interpolated across a gap of at most `max_gap_ms`),
+/// optionally moved to the sensor, and prints the table (or one JSON object).
 /// Fails when no relation could be scored: a mean over nothing would look like a result.
-pub fn run(relations: &Path, trajectory: &Path, tolerance_ms: f64, json: bool) -> Result<()> {
-    if !(tolerance_ms.is_finite() && tolerance_ms >= 0.0) {
-        bail!("--tolerance-ms must be a finite number of milliseconds, at least 0 (got {tolerance_ms})");
+pub fn run(
+    relations: &Path,
+    trajectory: &Path,
+    tolerance_ms: f64,
+    max_gap_ms: f64,
+    sensor: Option<&str>,
+    json: bool,
+) -> Result<()> {
+    for (flag, v) in [("--tolerance-ms", tolerance_ms), ("--max-gap-ms", max_gap_ms)] {
+        if !(v.is_finite() && v >= 0.0) {
+            bail!("{flag} must be a finite number of milliseconds, at least 0 (got {v})");
+        }
     }
     // `as` saturates: an absurdly large tolerance becomes "any sample", not a wrap-around.
     let tolerance_ns = (tolerance_ms * 1e6).round() as i64;
+    let max_gap_ns = (max_gap_ms * 1e6).round() as i64;
     let rel = fusemap_io::relations::read_relations(relations)?;
-    let traj = fusemap_io::trajectory::read_tum(trajectory)?;
-    let score = score_relations(&rel, &traj, tolerance_ns);
+    let mut traj = fusemap_io::trajectory::read_tum(trajectory)?;
+    if let Some(text) = sensor {
+        let mount = parse_pose(text)?;
+        traj.iter_mut().for_each(|(_, p)| *p = p.compose(mount));
+    }
+    let at_stamps = at_relation_stamps(&rel, &traj, tolerance_ns, max_gap_ns);
+    let score = score_relations(&rel, &at_stamps, tolerance_ns);
     if score.scored == 0 {
         bail!(
-            "{}: none of its {} relations has both stamps among the {} poses of {} (within {tolerance_ms} ms)",
+            "{}: none of its {} relations has both stamps among the {} poses of {} (within {tolerance_ms} ms, or between two poses at most {max_gap_ms} ms apart)",
             relations.display(),
             score.relations,
             traj.len(),
@@ -43,4 +60,29 @@ pub fn run(relations: &Path, trajectory: &Path, tolerance_ms: f64, json: bool) -
         score.rotation_mean_deg, score.rotation_std_deg, score.rotation_max_deg
     );
     Ok(())
+}
+
+/// `X,Y,YAW` as a pose.
+fn parse_pose(text: &str) -> Result<Pose2> {
+    let v: Vec<f64> = text.split(',').map(|f| f.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|e| {
+        anyhow::anyhow!("--sensor-in-base: `{text}` is not three numbers X,Y,YAW (metres, radians): {e}")
+    })?;
+    match v[..] {
+        [x, y, yaw] if v.iter().all(|c| c.is_finite()) => Ok(Pose2::new(x, y, yaw)),
+        _ => bail!("--sensor-in-base: `{text}` is not three finite numbers X,Y,YAW (metres, radians)"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_pose;
+
+    #[test]
+    fn a_sensor_pose_is_three_finite_numbers() {
+        let p = parse_pose("0.04, 0,-1.5").unwrap();
+        assert_eq!((p.x, p.y, p.theta), (0.04, 0.0, -1.5));
+        for bad in ["0.04,0", "a,b,c", "1,2,3,4", "1,NaN,0", ""] {
+            assert!(parse_pose(bad).unwrap_err().to_string().contains("--sensor-in-base"), "{bad}");
+        }
+    }
 }

@@ -58,3 +58,29 @@ fn relations_bad_input_names_the_file_and_line() {
         assert!(e.contains("--tolerance-ms must be a finite number"), "{bad}: {e}");
     }
 }
+
+#[test]
+fn relations_interpolate_across_short_gaps_and_score_the_sensor_when_asked() {
+    let dir = temp_dir("relations-sensor");
+    let tum = write_file(&dir, "track.tum", TUM);
+    // Between the samples (1 s apart): the poses at 1.5 s and 2.5 s are (0.5, 0, 45°) and
+    // (1, 0.5, 90°), so the motion is (√½, 0, 45°).
+    let mid = write_file(&dir, "mid.relations", "1.5 2.5 0.7071067811865476 0 0 0 0 0.7853981633974483\n");
+    let args = ["relations", "--relations", mid.to_str().unwrap(), "--trajectory", tum.to_str().unwrap()];
+    let e = one_line_error(&run(&args));
+    assert!(e.contains("at most 500 ms apart"), "the default gap is shorter than 1 s: {e}");
+    let o = run(&[&args[..], &["--max-gap-ms", "1000"]].concat());
+    assert_success(&o);
+    assert!(stdout(&o).contains("translation (m)  0.000000 ± 0.000000"), "{}", stdout(&o));
+
+    // A sensor 0.5 m ahead of the base: from (0.5, 0, 0°) to (1, 0.5, 90°), the motion
+    // (0.5, 0.5, 90°); the base's own motion (1, 0, 90°) is √½ m off it.
+    let ahead = write_file(&dir, "ahead.relations", "1.0 2.0 0.5 0.5 0 0 0 1.5707963267948966\n");
+    let args = ["relations", "--relations", ahead.to_str().unwrap(), "--trajectory", tum.to_str().unwrap()];
+    let o = run(&args);
+    assert!(stdout(&o).contains("translation (m)  0.707107"), "{}", stdout(&o));
+    let o = run(&[&args[..], &["--sensor-in-base", "0.5,0,0"]].concat());
+    assert!(stdout(&o).contains("translation (m)  0.000000"), "{}", stdout(&o));
+    let e = one_line_error(&run(&[&args[..], &["--sensor-in-base", "0.5,0"]].concat()));
+    assert!(e.contains("--sensor-in-base: `0.5,0` is not three"), "{e}");
+}

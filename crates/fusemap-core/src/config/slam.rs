@@ -66,6 +66,12 @@ pub struct SlamConfig {
     /// The constant-velocity prediction replaces the track's when its match's mean
     /// probability is higher by this much (odometry that stalls, then jumps).
     pub moving_prediction_margin: f64,
+    /// A match scoring below this share of the recent matches' is searched again wider.
+    pub rescue_score_ratio: f64,
+    /// That wider search's half-width in x and y, metres.
+    pub rescue_linear_window_m: f64,
+    /// That wider search's half-width in heading, degrees.
+    pub rescue_angular_window_deg: f64,
     /// Odometry edge σ per metre travelled.
     pub odometry_translation_per_m: f64,
     /// Odometry edge σ floor, metres.
@@ -133,6 +139,9 @@ impl Default for SlamConfig {
             match_residual_sigma: p.local.residual_sigma,
             degeneracy_ratio: p.local.degeneracy_ratio,
             moving_prediction_margin: p.moving_prediction_margin,
+            rescue_score_ratio: p.rescue_score_ratio,
+            rescue_linear_window_m: p.rescue_linear_window_m,
+            rescue_angular_window_deg: 20.0,
             odometry_translation_per_m: p.odometry_translation_per_m,
             odometry_floor_m: p.odometry_floor_m,
             odometry_rotation_per_rad: p.odometry_rotation_per_rad,
@@ -150,7 +159,7 @@ impl Default for SlamConfig {
             loop_closure_min_score: p.loop_closure_min_score as f64,
             loop_closure_huber: p.loop_closure_huber,
             loop_closure_sigma_m: p.loop_closure_sigma_m,
-            loop_closure_sigma_deg: 1.0,
+            loop_closure_sigma_deg: 0.2,
             optimize_every_n_nodes: p.optimize_every_n_nodes,
             branch_and_bound_depth: p.branch_and_bound_depth,
         }
@@ -207,7 +216,8 @@ impl SlamConfig {
         }
         let angular = non_negative("search_angular_window_deg", self.search_angular_window_deg)?;
         let lc_angular = non_negative("loop_closure_angular_window_deg", self.loop_closure_angular_window_deg)?;
-        if angular > 180.0 || lc_angular > 180.0 {
+        let rescue_angular = non_negative("rescue_angular_window_deg", self.rescue_angular_window_deg)?;
+        if angular > 180.0 || lc_angular > 180.0 || rescue_angular > 180.0 {
             return Err(err("slam", "angular search windows must be at most 180°"));
         }
         Ok(SlamParams {
@@ -232,6 +242,9 @@ impl SlamConfig {
                 degeneracy_ratio: non_negative("degeneracy_ratio", self.degeneracy_ratio)?,
             },
             moving_prediction_margin: non_negative("moving_prediction_margin", self.moving_prediction_margin)?,
+            rescue_score_ratio: non_negative("rescue_score_ratio", self.rescue_score_ratio)?,
+            rescue_linear_window_m: non_negative("rescue_linear_window_m", self.rescue_linear_window_m)?.min(5.0),
+            rescue_angular_window_rad: rescue_angular.to_radians(),
             odometry_translation_per_m: non_negative("odometry_translation_per_m", self.odometry_translation_per_m)?,
             odometry_floor_m: positive("odometry_floor_m", self.odometry_floor_m)?,
             odometry_rotation_per_rad: non_negative("odometry_rotation_per_rad", self.odometry_rotation_per_rad)?,

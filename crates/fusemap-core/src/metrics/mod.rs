@@ -8,7 +8,8 @@ mod semantic;
 
 pub use entropy::{binary_entropy, map_entropy, sparse_entropy, EntropyReport};
 pub use relations::{
-    parse_relations, relation_errors, score_relations, Relation, RelationScore, RelationsError, PLANAR_TOLERANCE,
+    at_relation_stamps, parse_relations, relation_errors, score_relations, Relation, RelationScore, RelationsError,
+    PLANAR_TOLERANCE,
 };
 pub use scores::{Confusion, TolerantScore};
 pub use semantic::{ClassAccuracy, SemanticAccuracy};

@@ -285,9 +285,15 @@ pub fn refine(grid: &ProbabilityGrid, points: &[Point2], start: Pose2, target: P
             + wr2 * normalize_angle(pose.theta - target.theta).powi(2)
     };
     let mut pose = start;
-    let (mut h, mut g, mut map_cost) = map_system(grid, points, pose);
+    let (mut h, mut g, map_cost) = map_system(grid, points, pose);
     let mut cost = total(pose, map_cost);
-    let mut lambda = 1e-6;
+    // Levenberg–Marquardt with Nielsen's damping update (Madsen, Nielsen & Tingleff 2004,
+    // *Methods for non-linear least squares problems*, §3.2): λ shrinks by up to 3× after a
+    // step the quadratic model predicted well (gain ratio ρ near 1) and grows by doubling
+    // factors after a rejected one. A plain ×10 / ÷10 schedule settles at λ ≈ 1 on this
+    // cost and rejects every other step, so it ran to the cap on nearly every scan.
+    let mut lambda = 1.0;
+    let mut nu = 2.0;
     for _ in 0..30 {
         let mut a = [[0.0; 3]; 3];
         for i in 0..3 {
@@ -303,6 +309,7 @@ pub fn refine(grid: &ProbabilityGrid, points: &[Point2], start: Pose2, target: P
             -(wm2 * g[1] + wt2 * (pose.y - target.y)),
             -(wm2 * g[2] + wr2 * normalize_angle(pose.theta - target.theta)),
         ];
+        let diagonal = [a[0][0], a[1][1], a[2][2]];
         for (i, row) in a.iter_mut().enumerate() {
             row[i] *= 1.0 + lambda;
         }
@@ -310,21 +317,26 @@ pub fn refine(grid: &ProbabilityGrid, points: &[Point2], start: Pose2, target: P
         let cand = Pose2::new(pose.x + d[0], pose.y + d[1], normalize_angle(pose.theta + d[2]));
         let (h2, g2, mc2) = map_system(grid, points, cand);
         let c2 = total(cand, mc2);
+        // The decrease the damped quadratic model predicts: dᵀ(λ·diag·d + b) (the cost is a
+        // plain sum of squares and `b` half its negative gradient).
+        let predicted: f64 = (0..3).map(|i| d[i] * (lambda * diagonal[i] * d[i] + b[i])).sum();
         if c2 <= cost {
             let small = d[0].abs() < 1e-5 && d[1].abs() < 1e-5 && d[2].abs() < 1e-6;
-            (pose, h, g, map_cost, cost) = (cand, h2, g2, mc2, c2);
-            lambda = (lambda * 0.1).max(1e-9);
+            let rho = (cost - c2) / predicted.max(f64::MIN_POSITIVE);
+            (pose, h, g, cost) = (cand, h2, g2, c2);
+            lambda *= f64::max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0).powi(3));
+            nu = 2.0;
             if small {
                 break;
             }
         } else {
-            lambda *= 10.0;
+            lambda *= nu;
+            nu *= 2.0;
             if lambda > 1e4 {
                 break;
             }
         }
     }
-    let _ = map_cost;
     pose
 }
 

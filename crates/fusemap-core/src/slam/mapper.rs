@@ -94,6 +94,8 @@ pub struct Slam {
     /// The last two scans' stamps and local poses (the constant-velocity prediction).
     recent: [Option<(Stamp, Pose2)>; 2],
     global_from_local: Pose2,
+    /// The recent matches' mean probability (the rescue search's reference).
+    typical_score: Option<f64>,
     since_optimisation: usize,
     closures_since_optimisation: usize,
     report: SlamReport,
@@ -113,6 +115,11 @@ pub struct SlamResult {
     pub scan_nodes: Vec<usize>,
     /// Counts and timings.
     pub report: SlamReport,
+}
+
+/// Two poses equal to the bit (a repeated reading, not a coincidence of motion).
+fn same_bits(a: Pose2, b: Pose2) -> bool {
+    [a.x, a.y, a.theta].map(f64::to_bits) == [b.x, b.y, b.theta].map(f64::to_bits)
 }
 
 fn information_diag(sx: f64, sth: f64) -> [[f64; 3]; 3] {
@@ -135,6 +142,7 @@ impl Slam {
             last: None,
             recent: [None, None],
             global_from_local: Pose2::IDENTITY,
+            typical_score: None,
             since_optimisation: 0,
             closures_since_optimisation: 0,
             report: SlamReport::default(),
@@ -159,7 +167,20 @@ impl Slam {
             q.is_finite() && dx * dx + dy * dy <= max2
         };
         let hits: Vec<Point2> = scan.hits.iter().filter(in_range).copied().collect();
+        // A reading that repeats the anchor's bit for bit is held, not a standstill: odometry
+        // latched on the scan lines (CARMEN logs) repeats its last value for a few scans
+        // during a fast turn, then jumps by the whole turn. It says nothing of the motion
+        // since, so the scan is predicted from the previous scan (the search and the
+        // constant-velocity hypothesis find it), it is no node (a scan matched without a
+        // prior must not go into the submaps), and the next fresh reading is composed onto
+        // the scan where the held one was first seen. A robot at rest loses nothing: its
+        // scans repeat the same view.
+        let held = matches!((self.last, scan.track), (Some((_, Some(before))), Some(now)) if same_bits(before, now));
+        if held {
+            self.report.held_readings += 1;
+        }
         let predicted = match (self.last, scan.track) {
+            _ if held => self.recent[1].map_or(Pose2::IDENTITY, |r| r.1),
             (Some((local, Some(before))), Some(now)) => local.compose(before.inverse().compose(now)),
             // In or just out of a gap of the track: no motion known, the search finds it.
             (Some((local, _)), _) => local,
@@ -189,7 +210,9 @@ impl Slam {
             ScanOutcome::Degenerate => self.report.degenerate += 1,
             _ => self.report.predicted += 1,
         }
-        self.last = Some((local, scan.track));
+        if !held {
+            self.last = Some((local, scan.track));
+        }
         let anchor = self.nodes.last().map(|_| self.nodes.len() - 1);
         self.scans.push(ScanRecord { stamp: scan.stamp, local, anchor });
         let new_node = match self.nodes.last() {
@@ -201,7 +224,7 @@ impl Slam {
                     || (scan.stamp.0 - n.stamp.0) as f64 * 1e-9 >= self.p.node_time_s
             }
         };
-        if new_node {
+        if new_node && !held {
             let misses: Vec<Point2> = scan.misses.iter().filter(|q| q.is_finite()).copied().collect();
             self.add_node(scan.stamp, local, scan.track, scan.origin, hits, &misses, information);
             self.scans.last_mut().expect("pushed above").anchor = Some(self.nodes.len() - 1);
@@ -247,6 +270,26 @@ impl Slam {
                 (m, predicted) = (m2, alt);
             }
         }
+        // A match far below the recent ones lost the scan: the prediction was off by more
+        // than the window (odometry that overshoots a fast turn). It is searched again in
+        // the wide window and replaced only if that is clearly better.
+        let typical = self.typical_score.unwrap_or(0.0);
+        if f64::from(m.score) < self.p.rescue_score_ratio * typical {
+            let wide = LocalMatchParams {
+                linear_window_m: self.p.rescue_linear_window_m,
+                angular_window_rad: self.p.rescue_angular_window_rad,
+                ..*local
+            };
+            let r = super::local_match::match_scan(&submap.grid, hits, predicted, &wide);
+            self.report.rescue_searched += 1;
+            if f64::from(r.score) > f64::from(m.score) + self.p.moving_prediction_margin {
+                m = r;
+                self.report.rescued += 1;
+            }
+        }
+        // The recent matches' score, an exponential average over about ten scans.
+        let score = f64::from(m.score);
+        self.typical_score = Some(self.typical_score.map_or(score, |t| 0.9 * t + 0.1 * score));
         if m.degenerate {
             let strong = LocalMatchParams {
                 translation_weight: self.p.local.translation_weight * 10.0,

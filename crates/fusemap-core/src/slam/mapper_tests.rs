@@ -65,9 +65,13 @@ struct Run {
 
 /// Runs SLAM over `truth` with `track` as the pose track, scans of `beams` beams.
 fn run(truth: &[Pose2], track: &[Option<Pose2>], beams: usize) -> Run {
+    run_with(SlamParams::default(), truth, track, beams)
+}
+
+fn run_with(p: SlamParams, truth: &[Pose2], track: &[Option<Pose2>], beams: usize) -> Run {
     let world = World::room();
     let mut noise = Noise(7);
-    let mut slam = Slam::new(SlamParams::default());
+    let mut slam = Slam::new(p);
     for (i, (pose, track)) in truth.iter().zip(track).enumerate() {
         let hits: Vec<Point2> = world
             .scan(*pose, beams, 30.0)
@@ -198,4 +202,72 @@ fn a_non_finite_track_pose_is_refused_and_counted() {
     assert_eq!(r.result.report.without_track, 1);
     // The refused scan has no pose; the others do.
     assert_eq!(r.result.trajectory.len(), truth.len() - 1);
+}
+
+/// The largest heading error of a run, degrees.
+fn worst_heading_deg(r: &Run) -> f64 {
+    let worst = r
+        .result
+        .trajectory
+        .iter()
+        .zip(&r.truth)
+        .map(|((_, p), t)| normalize_angle(p.theta - t.theta).abs())
+        .fold(0.0, f64::max);
+    worst.to_degrees()
+}
+
+/// At rest for 20 scans, a turn in place of `steps` × `deg_per_scan`, at rest for 20 more.
+fn turn_in_place(steps: usize, deg_per_scan: f64) -> Vec<Pose2> {
+    let mut th = 0.3;
+    let mut out = vec![Pose2::new(6.0, 4.0, th); 20];
+    for _ in 0..steps {
+        th += deg_per_scan.to_radians();
+        out.push(Pose2::new(6.0, 4.0, normalize_angle(th)));
+    }
+    out.extend(vec![Pose2::new(6.0, 4.0, normalize_angle(th)); 20]);
+    out
+}
+
+#[test]
+fn odometry_held_through_a_fast_turn_is_not_taken_for_a_standstill() {
+    // Turning at 15° a scan, odometry latched on the scan lines: it repeats its value for
+    // four scans, then jumps by the whole turn since (as the MIT CSAIL log's does).
+    let truth = turn_in_place(36, 15.0);
+    let track: Vec<Option<Pose2>> =
+        (0..truth.len()).map(|i| Some(if (25..29).contains(&i) { truth[24] } else { truth[i] })).collect();
+    let r = run(&truth, &track, 360);
+    let rep = &r.result.report;
+    // At rest the reading repeats too: 19 scans before the turn, 4 held in it, 20 after.
+    assert_eq!(rep.held_readings, 19 + 4 + 20, "{rep:?}");
+    let worst = worst_heading_deg(&r);
+    assert!(worst < 1.0, "heading error up to {worst} deg: {rep:?}");
+    // No node was made of a scan matched without a reading: the nodes are the first scan
+    // and one per fresh reading of the turn. (In this clean world the constant-velocity
+    // hypothesis follows the turn even when the held readings are taken for a standstill,
+    // but then the held scans of the turn become nodes too.)
+    assert!(rep.nodes <= 1 + 36 - 4, "{rep:?}");
+}
+
+#[test]
+fn a_match_lost_by_a_bad_prediction_is_searched_again_wider() {
+    // The robot starts turning at 10° a scan; its odometry reads 2.2 times the turn. At the
+    // first turning scans neither the track (22°) nor the constant velocity (0°) is within
+    // the 6° window of the truth.
+    let truth = turn_in_place(18, 10.0);
+    let mut track = vec![Some(truth[0])];
+    for w in truth.windows(2) {
+        let d = w[0].inverse().compose(w[1]);
+        let last = track.last().unwrap().unwrap();
+        track.push(Some(last.compose(Pose2::new(0.0, 0.0, 2.2 * d.theta))));
+    }
+    let r = run(&truth, &track, 360);
+    let rep = &r.result.report;
+    assert!(rep.rescued >= 1 && rep.rescue_searched >= rep.rescued, "{rep:?}");
+    let worst = worst_heading_deg(&r);
+    assert!(worst < 1.0, "heading error up to {worst} deg: {rep:?}");
+    // Without the wider search the same log loses the turn.
+    let off = run_with(SlamParams { rescue_score_ratio: 0.0, ..SlamParams::default() }, &truth, &track, 360);
+    assert_eq!(off.result.report.rescue_searched, 0);
+    let lost = worst_heading_deg(&off);
+    assert!(lost > 5.0, "without the rescue: heading error up to {lost} deg");
 }

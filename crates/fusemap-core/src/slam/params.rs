@@ -32,6 +32,14 @@ pub struct SlamParams {
     /// stalls for a few scans and then catches up is followed, a corridor (where both fit
     /// equally) is not.
     pub moving_prediction_margin: f64,
+    /// A match whose mean probability is below this share of the recent matches' (an
+    /// average over about ten scans) is searched again in the wide window below: the
+    /// prediction was off by more than the search window.
+    pub rescue_score_ratio: f64,
+    /// Half-width of that wider search in x and y, metres …
+    pub rescue_linear_window_m: f64,
+    /// … and in heading, radians.
+    pub rescue_angular_window_rad: f64,
     /// The local matcher.
     pub local: LocalMatchParams,
     /// Odometry edge σ: translational, per metre travelled (plus `odometry_floor_m`).
@@ -91,6 +99,12 @@ impl Default for SlamParams {
             node_angle_rad: 2f64.to_radians(),
             node_time_s: 5.0,
             moving_prediction_margin: 0.1,
+            // Lost matches score about half the usual (points on free space); 0.7 leaves
+            // the ordinary spread of a good match's score out. The window is that of
+            // Cartographer's real-time correlative matcher (20°), with twice its reach.
+            rescue_score_ratio: 0.7,
+            rescue_linear_window_m: 0.3,
+            rescue_angular_window_rad: 20f64.to_radians(),
             local: LocalMatchParams::default(),
             odometry_translation_per_m: 0.1,
             odometry_floor_m: 0.02,
@@ -108,8 +122,12 @@ impl Default for SlamParams {
             loop_closure_angular_window_rad: 20f64.to_radians(),
             loop_closure_min_score: 0.55,
             loop_closure_huber: 1.0,
-            loop_closure_sigma_m: 0.05,
-            loop_closure_sigma_rad: 1f64.to_radians(),
+            // A closure is refined to a fraction of a cell like a local match (whose own σ
+            // is capped at 5 mm, 0.05°): a fifth of a 5 cm cell, and the angle that moves a
+            // point 3 m away by about that much. Beyond one σ the Huber loss makes a closure
+            // pull with a constant force, so a wrong one cannot drag the graph far.
+            loop_closure_sigma_m: 0.01,
+            loop_closure_sigma_rad: 0.2f64.to_radians(),
             optimize_every_n_nodes: 90,
             branch_and_bound_depth: 7,
         }

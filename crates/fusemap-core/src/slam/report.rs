@@ -24,6 +24,14 @@ pub struct SlamReport {
     /// Scans matched from the constant-velocity prediction because it matched better than
     /// the track's (stalled or jumping odometry).
     pub moving_prediction_used: u64,
+    /// Scans whose match scored far below the recent matches', searched again in the wide
+    /// window (`[slam] rescue_*`).
+    pub rescue_searched: u64,
+    /// … and taken from that wider search, clearly better.
+    pub rescued: u64,
+    /// Scans whose track reading repeated the previous scan's bit for bit (a held reading:
+    /// no motion information, not made a node).
+    pub held_readings: u64,
     /// Odometry edges left out: the odometry disagreed with the matched motion by > 5 σ.
     pub odometry_edges_rejected: u64,
     /// Pose-graph nodes (scans that moved far enough).

@@ -138,6 +138,37 @@ fn in_stamp_order(trajectory: &[(Stamp, Pose2)]) -> Cow<'_, [(Stamp, Pose2)]> {
     }
 }
 
+/// `trajectory` at the stamps the relations name, for a trajectory not sampled at the
+/// scans (a `trajectory.tum` written at the odometry's rate): at each stamp the nearest
+/// pose within `tolerance_ns`, else the pose interpolated between the two around it
+/// (linear in translation, shortest arc in heading, as tf2 does) when they are at most
+/// `max_gap_ns` apart; a stamp in a longer gap or outside the trajectory gets no pose and
+/// its relations stay unmatched.
+pub fn at_relation_stamps(
+    relations: &[Relation],
+    trajectory: &[(Stamp, Pose2)],
+    tolerance_ns: i64,
+    max_gap_ns: i64,
+) -> Vec<(Stamp, Pose2)> {
+    let trajectory = in_stamp_order(trajectory);
+    let mut stamps: Vec<Stamp> = relations.iter().flat_map(|r| [r.t1, r.t2]).collect();
+    stamps.sort();
+    stamps.dedup();
+    stamps
+        .into_iter()
+        .filter_map(|t| {
+            if let Some(p) = nearest(&trajectory, t, tolerance_ns) {
+                return Some((t, p));
+            }
+            let i = trajectory.partition_point(|s| s.0 < t);
+            let ((ta, a), (tb, b)) = (*trajectory.get(i.checked_sub(1)?)?, *trajectory.get(i)?);
+            let gap = tb.0 as i128 - ta.0 as i128;
+            (gap > 0 && gap <= max_gap_ns as i128)
+                .then(|| (t, a.interpolate(b, (t.0 as i128 - ta.0 as i128) as f64 / gap as f64)))
+        })
+        .collect()
+}
+
 /// The error transform ε = δ*⁻¹ ∘ δ of each relation (Kümmerle et al. 2009, eq. 1), in the
 /// order of `relations`; `None` for a relation whose `t1` or `t2` has no trajectory sample
 /// within `tolerance_ns` (a negative tolerance counts as 0: exact stamps only).

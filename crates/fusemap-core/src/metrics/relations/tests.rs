@@ -252,3 +252,27 @@ proptest! {
         prop_assert!(close(a.translation_std_m, b.translation_std_m, 1e-9), "{:?} {:?}", a, b);
     }
 }
+
+#[test]
+fn a_trajectory_between_the_relation_stamps_is_interpolated_within_the_gap() {
+    // Straight at 1 m/s turning 0.1 rad/s, sampled every 100 ms; the relations name stamps
+    // 30 ms after samples.
+    let truth = |ns: i64| {
+        let t = ns as f64 * 1e-9;
+        Pose2::new(t, 0.0, 0.1 * t)
+    };
+    let trajectory: Vec<(Stamp, Pose2)> = (0..100).map(|k| (Stamp(k * 100_000_000), truth(k * 100_000_000))).collect();
+    let (t1, t2) = (Stamp(1_030_000_000), Stamp(5_030_000_000));
+    let motion = truth(t1.0).inverse().compose(truth(t2.0));
+    let relations = [rel(t1, t2, motion), rel(t2, Stamp(20_000_000_000), Pose2::IDENTITY)];
+    // Nearest-pose matching finds nothing within 1 ms …
+    assert_eq!(score_relations(&relations, &trajectory, 1_000_000).scored, 0);
+    // … the resampled trajectory scores the first relation, its translation exact and its
+    // heading within the interpolation's linearisation.
+    let resampled = at_relation_stamps(&relations, &trajectory, 1_000_000, 200_000_000);
+    let score = score_relations(&relations, &resampled, 1_000_000);
+    assert_eq!((score.scored, score.unmatched), (1, 1), "20 s lies past the trajectory");
+    assert!(score.translation_max_m < 1e-9 && score.rotation_max_deg < 1e-9, "{score:?}");
+    // A gap wider than allowed is not bridged.
+    assert!(at_relation_stamps(&relations, &trajectory, 1_000_000, 50_000_000).is_empty());
+}
