@@ -19,7 +19,7 @@
 
 use super::global_match::{match_branch_and_bound, GlobalSearch};
 use super::grid_cache::GridCache;
-use super::local_match::{mean_probability, refine, LocalMatchParams};
+use super::local_match::{match_information, mean_probability, refine, LocalMatchParams};
 use super::parallel::{join, on_worker};
 use super::params::SlamParams;
 use super::pose_graph::{Edge, EdgeKind, Loss, OptimizeOptions, PoseGraph};
@@ -484,6 +484,13 @@ impl Slam {
         let score = mean_probability(&sm.grid, &node.points, pose);
         if score < self.p.loop_closure_min_score {
             self.report.loop_rejected += 1;
+            return;
+        }
+        // A closure along a corridor fits anywhere in the window: it would hold the node
+        // wherever the search happened to stop, against the odometry.
+        if match_information(&sm.grid, &node.points, pose, &self.p.local).1 {
+            self.report.loop_rejected += 1;
+            self.report.loop_degenerate += 1;
             return;
         }
         let e = Edge {

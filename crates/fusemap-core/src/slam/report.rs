@@ -42,8 +42,11 @@ pub struct SlamReport {
     pub loop_searches: u64,
     /// Loop closures accepted.
     pub loop_accepted: u64,
-    /// Loop-closure searches that found nothing above the score threshold.
+    /// Loop-closure searches that found nothing above the score threshold, or only a
+    /// degenerate match.
     pub loop_rejected: u64,
+    /// … of which degenerate: a match that fits anywhere along one direction (a corridor).
+    pub loop_degenerate: u64,
     /// Branch-and-bound grids built for finished submaps (first builds and rebuilds after
     /// the memory budget dropped them).
     pub grids_built: u64,
