@@ -241,6 +241,18 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
     Ok(Inputs { inputs: out, gnss: gnss_reports, config: est, notes, odometry_glitches })
 }
 
+/// The GNSS fixes as the estimator is given them: antenna positions in its map frame
+/// (the shared local ENU frame), covariances floored per fix quality, lever arms.
+pub fn gnss_positions(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Vec<EstimatorInput>, PipelineError> {
+    let (tree, _) = frame_tree(&plan.log, &inv.tf_static, &inv.tf_dynamic);
+    let datum = shared_datum(inv, bound);
+    let mut out = Vec::new();
+    for s in bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::Gnss) {
+        out.extend(gnss_inputs(s, inv, &tree, &plan.log, datum)?.0);
+    }
+    Ok(out)
+}
+
 /// One map frame for every GNSS sensor: the first configured datum, else the earliest good
 /// fix of any GNSS topic (two receivers must not get two ENU frames metres apart).
 fn shared_datum(inv: &Inventory, bound: &Bound) -> Option<((f64, f64, f64), &'static str)> {

@@ -4,7 +4,9 @@
 //! under an `odom` frame, the odometry written on raw CARMEN lines), a pass over the
 //! first lidar's scans runs [`fusemap_core::slam`]: each scan predicted from the track's
 //! motion, matched against the local submap, turned into a pose-graph node, searched
-//! against older submaps for loop closures, and the graph optimised. The track (odometry,
+//! against older submaps for loop closures, and the graph optimised; when the track is the
+//! estimator's, the GNSS fixes it was given are position priors on the nodes too
+//! ([`fusemap_core::slam::PositionFix`]). The track (odometry,
 //! or the estimator's fusion of odometry, IMU and GNSS) is then corrected at every scan by
 //! the optimised pose ([`track`]), and that corrected track places every measurement —
 //! the scans, de-skewed, and the camera frames — at its own stamp. With poses on the scan
@@ -19,9 +21,10 @@ use crate::sensors::Bound;
 use crate::track::{ChosenTrack, TfTrack, Track, TrackCounts};
 use crate::PipelineError;
 use fusemap_core::config::{Plan, PoseSource, SlamMode};
+use fusemap_core::estimator::{EstimatorInput, FixQuality};
 use fusemap_core::geometry::{PlanarMount, Point2, Pose2};
 use fusemap_core::slam::pose_graph::EdgeKind;
-use fusemap_core::slam::{CorrectedTrack, ScanInput, Slam, SlamReport, SlamResult};
+use fusemap_core::slam::{CorrectedTrack, PositionFix, ScanInput, Slam, SlamReport, SlamResult};
 use fusemap_core::time::{PoseBuffer, Stamp, SyncMode};
 use fusemap_io::log::ScanMessage;
 use serde::Serialize;
@@ -50,6 +53,15 @@ pub struct GraphEdge {
     pub kind: &'static str,
 }
 
+/// A GNSS fix's position prior on a node, as the run report shows it.
+#[derive(Clone, Debug, Serialize)]
+pub struct GraphPrior {
+    /// Index into the nodes.
+    pub node: usize,
+    /// The antenna's measured position `[x, y]` in the map frame.
+    pub position: [f64; 2],
+}
+
 /// What the SLAM pass did, for `summary.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct SlamSummary {
@@ -71,6 +83,8 @@ pub struct SlamSummary {
     pub nodes: Vec<GraphNode>,
     /// Its edges.
     pub edges: Vec<GraphEdge>,
+    /// Its GNSS position priors.
+    pub priors: Vec<GraphPrior>,
     /// The lidar's pose in the base frame, `[x, y, yaw]` (metres, radians). The
     /// trajectory is the base frame's; the SLAM benchmark's relations are between laser
     /// poses, so `fusemap relations --sensor-in-base` composes the two.
@@ -153,6 +167,7 @@ pub fn run(
     let stamps = &inv.scans[&b.topic].stamps;
     let mode = sync_mode(cfg, stamps);
     let mut slam = Slam::new(plan.slam);
+    slam.add_fixes(&fixes(plan, inv, bound, chosen, mode)?);
     let line_glitches = match chosen.track {
         Track::ScanLine => inv.scans[&b.topic].line_glitches(&cfg.motion_limits()),
         Track::Timed(_) => Default::default(),
@@ -260,6 +275,48 @@ pub fn run(
     Ok(SlamRun { summary })
 }
 
+/// The GNSS fixes for the pose graph, when the track is the estimator's: its map frame is
+/// the fixes' (any other track's is not, and gets none).
+fn fixes(
+    plan: &Plan,
+    inv: &Inventory,
+    bound: &Bound,
+    chosen: &ChosenTrack,
+    mode: SyncMode,
+) -> Result<Vec<PositionFix>, PipelineError> {
+    let Track::Timed(track) = &chosen.track else { return Ok(Vec::new()) };
+    if chosen.source != PoseSource::Estimator || !plan.slam.fixes {
+        return Ok(Vec::new());
+    }
+    let inputs = crate::estimation::gnss_positions(plan, inv, bound)?;
+    // The estimator's rule for which fixes are RTK fixed (white errors) and which share a
+    // correlated error.
+    let e = &plan.estimator;
+    let rtk_var = e.rtk_fix_max_sigma_m * e.rtk_fix_max_sigma_m;
+    Ok(inputs
+        .into_iter()
+        .filter_map(|i| match i {
+            EstimatorInput::Position { stamp, enu, covariance, antenna, quality } => Some(PositionFix {
+                stamp,
+                position: Point2::new(enu[0], enu[1]),
+                covariance,
+                antenna,
+                correlation_time_s: match quality {
+                    FixQuality::RtkFixed if covariance[0][0].max(covariance[1][1]) <= rtk_var => {
+                        e.rtk_fix_correlation_time_s
+                    }
+                    _ => e.fix_correlation_time_s,
+                },
+                track: track
+                    .pose_at(stamp, mode)
+                    .ok()
+                    .map(|p| (p, track.covariance_at(stamp).unwrap_or([[0.0; 3]; 3]))),
+            }),
+            _ => None,
+        })
+        .collect())
+}
+
 /// The track's pose at `t` interpolated between its samples whatever the gap between
 /// them; `None` outside the samples.
 fn across_gap(samples: &[(Stamp, Pose2)], t: Stamp) -> Option<Pose2> {
@@ -300,6 +357,12 @@ fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, lat
             },
         })
         .collect();
+    let priors = r
+        .graph
+        .position_priors()
+        .iter()
+        .map(|p| GraphPrior { node: p.node, position: [p.position.x, p.position.y] })
+        .collect();
     SlamSummary {
         reason,
         topic,
@@ -310,6 +373,7 @@ fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, lat
         track: String::new(),
         nodes,
         edges,
+        priors,
         sensor_in_base: [0.0; 3],
         scan_poses: r.trajectory.clone(),
     }

@@ -19,7 +19,7 @@ use fusemap_core::sim::production::{simulate, Scenario, SimRecording};
 use fusemap_core::time::{InFrame, PoseBuffer, PoseTrack, Stamp, SyncMode};
 use fusemap_pipeline::recording::Inventory;
 use fusemap_pipeline::run::{prepare, prepare_track, topics_by_kind};
-use fusemap_pipeline::track::ChosenTrack;
+use fusemap_pipeline::track::{ChosenTrack, Track};
 use fusemap_pipeline::{estimation, map_with_track, sensors};
 use std::collections::HashSet;
 use std::sync::OnceLock;
@@ -158,6 +158,14 @@ fn gyro_bias_and_odometry_scale_are_learnt() {
     assert!((scale - true_scale).abs() <= 0.2 * (1.0 - true_scale).abs());
 }
 
+/// A chosen track's pose at `t`.
+fn timed(c: &ChosenTrack, t: Stamp) -> Option<Pose2> {
+    match &c.track {
+        Track::Timed(track) => track.pose_at(t, SyncMode::Interpolate).ok(),
+        Track::ScanLine => None,
+    }
+}
+
 /// The occupied cells of a map and the cells it observed.
 fn occupied(run: &fusemap_pipeline::MapRun) -> (HashSet<CellIndex>, HashSet<CellIndex>) {
     let r = run.engine.grid().known_raster().expect("a map");
@@ -186,9 +194,12 @@ fn the_fused_map_scores_far_above_raw_odometry_and_slam_comes_within_003_of_true
     // matching and loop closure over it), as `map` does by default on this log.
     let (bound, fused, track_s) = prepare_track(&f.plan, &f.inv).unwrap();
     assert!(fused.name.starts_with("estimator"), "{}", fused.name);
+    let (est_ate, _) = rms(f, |t| timed(&fused, t), None);
     let fused_map = map_with_track(&f.plan, &f.inv, &bound, fused, track_s, None, &mut quiet).unwrap();
     let (bound, slam, track_s) = prepare(&f.plan, &f.inv).unwrap();
     assert!(slam.name.starts_with("SLAM") && slam.name.contains("estimator"), "{}", slam.name);
+    let (slam_ate, n) = rms(f, |t| timed(&slam, t), None);
+    println!("ATE RMS over {n} true poses: estimator {est_ate:.4} m, SLAM {slam_ate:.4} m");
     let slam_map = map_with_track(&f.plan, &f.inv, &bound, slam, track_s, None, &mut quiet).unwrap();
     let raw = ChosenTrack::given("raw odometry", Box::new(raw_odometry(f)));
     let raw_map = map_with_track(&f.plan, &f.inv, &bound, raw, 0.0, None, &mut quiet).unwrap();
@@ -211,6 +222,9 @@ fn the_fused_map_scores_far_above_raw_odometry_and_slam_comes_within_003_of_true
     }
     assert!(u.f1 >= r.f1 + 0.25, "fused F1 {:.3} vs raw odometry {:.3}", u.f1, r.f1);
     assert!(s.f1 >= p.f1 - 0.03, "SLAM F1 {:.3} vs true poses {:.3}", s.f1, p.f1);
+    // The pose graph holds the same fixes as the estimator (position priors) and the
+    // lidar's matches and closures besides: its track is no worse than the estimator's.
+    assert!(slam_ate <= est_ate, "SLAM ATE {slam_ate:.4} m vs the estimator's {est_ate:.4} m");
     // The trajectory written is the smoothed track.
     assert!(fused_map.trajectory.len() > 1000);
 }

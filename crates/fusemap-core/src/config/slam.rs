@@ -112,6 +112,13 @@ pub struct SlamConfig {
     pub optimize_every_n_nodes: usize,
     /// Levels of the branch-and-bound precomputation (2^(depth−1) cells at the top).
     pub branch_and_bound_depth: usize,
+    /// GNSS fixes become position priors on the pose graph's nodes (when the track is the
+    /// estimator's, whose map frame is the fixes').
+    pub fixes: bool,
+    /// A fix is attached to the node nearest in time if within this, seconds.
+    pub fix_max_offset_s: f64,
+    /// Huber scale of a fix's prior (whitened units).
+    pub fix_huber: f64,
 }
 
 /// Angles are written as the literal degrees of [`SlamParams::default`]: a round trip
@@ -162,6 +169,9 @@ impl Default for SlamConfig {
             loop_closure_sigma_deg: 0.2,
             optimize_every_n_nodes: p.optimize_every_n_nodes,
             branch_and_bound_depth: p.branch_and_bound_depth,
+            fixes: p.fixes,
+            fix_max_offset_s: p.fix_max_offset_s,
+            fix_huber: p.fix_huber,
         }
     }
 }
@@ -269,6 +279,9 @@ impl SlamConfig {
             loop_closure_sigma_rad: positive("loop_closure_sigma_deg", self.loop_closure_sigma_deg)?.to_radians(),
             optimize_every_n_nodes: self.optimize_every_n_nodes,
             branch_and_bound_depth: self.branch_and_bound_depth,
+            fixes: self.fixes,
+            fix_max_offset_s: non_negative("fix_max_offset_s", self.fix_max_offset_s)?.min(60.0),
+            fix_huber: positive("fix_huber", self.fix_huber)?,
         })
     }
 }

@@ -14,9 +14,11 @@
 //! the previous node by the track's motion (an odometry edge, whose σ grows with the
 //! distance). Nodes are searched against finished submaps near them by branch-and-bound
 //! (loop closures, Huber loss), and the graph is optimised every few nodes and at the end.
-//! Every scan's final pose is its nearest earlier node's optimised pose composed with the
-//! local offset between the two.
+//! GNSS fixes, when given, are position priors on the nodes nearest them in time
+//! (`fixes.rs`). Every scan's final pose is its nearest earlier node's optimised pose
+//! composed with the local offset between the two.
 
+use super::fixes::{FixNode, FixPriors, PositionFix};
 use super::global_match::{match_branch_and_bound, GlobalSearch};
 use super::grid_cache::GridCache;
 use super::local_match::{match_information, mean_probability, refine, LocalMatchParams};
@@ -98,6 +100,7 @@ pub struct Slam {
     typical_score: Option<f64>,
     since_optimisation: usize,
     closures_since_optimisation: usize,
+    fixes: FixPriors,
     report: SlamReport,
 }
 
@@ -145,6 +148,7 @@ impl Slam {
             typical_score: None,
             since_optimisation: 0,
             closures_since_optimisation: 0,
+            fixes: FixPriors::new(),
             report: SlamReport::default(),
         }
     }
@@ -152,6 +156,27 @@ impl Slam {
     /// The counters so far.
     pub fn report(&self) -> &SlamReport {
         &self.report
+    }
+
+    /// Adds GNSS fixes in the track's map frame (any order, before or between scans): each
+    /// becomes a position prior on the node nearest it in time. Ignored when
+    /// [`SlamParams::fixes`] is off.
+    pub fn add_fixes(&mut self, fixes: &[PositionFix]) {
+        if self.p.fixes {
+            self.fixes.add(fixes, &mut self.report);
+        }
+    }
+
+    /// The node `n` as a fix sees it.
+    fn fix_node(&self, n: usize) -> Option<FixNode> {
+        self.nodes.get(n).map(|n| FixNode { stamp: n.stamp, track: n.track, graph: n.graph })
+    }
+
+    /// Attaches the fixes up to `upto` to node `n` or the one before it.
+    fn attach_fixes(&mut self, upto: Stamp, n: usize) {
+        let in_track_frame = self.nodes.first().is_some_and(|n| n.track.is_some());
+        let (before, after) = (n.checked_sub(1).and_then(|b| self.fix_node(b)), self.fix_node(n));
+        self.fixes.attach(upto, before, after, in_track_frame, &mut self.graph, &self.p, &mut self.report);
     }
 
     /// Adds the next scan (stamps non-decreasing).
@@ -402,6 +427,7 @@ impl Slam {
         let search_points = near.into_iter().step_by(stride).collect();
         self.nodes.push(Node { stamp, local, track, graph: g, points: hits, search_points, submaps: into });
         self.report.nodes += 1;
+        self.attach_fixes(stamp, self.nodes.len() - 1);
         self.report.submaps = self.submaps.all().len();
         if self.p.loop_closure {
             let t0 = Instant::now();
@@ -414,7 +440,8 @@ impl Slam {
             self.report.loop_search_s += t0.elapsed().as_secs_f64();
         }
         self.since_optimisation += 1;
-        if self.since_optimisation >= self.p.optimize_every_n_nodes && self.closures_since_optimisation > 0 {
+        let news = self.closures_since_optimisation + self.fixes.since_optimisation;
+        if self.since_optimisation >= self.p.optimize_every_n_nodes && news > 0 {
             self.optimise();
         }
     }
@@ -487,7 +514,7 @@ impl Slam {
             return;
         }
         // A closure along a corridor fits anywhere in the window: it would hold the node
-        // wherever the search happened to stop, against the odometry.
+        // wherever the search happened to stop, against the odometry and the fixes.
         if match_information(&sm.grid, &node.points, pose, &self.p.local).1 {
             self.report.loop_rejected += 1;
             self.report.loop_degenerate += 1;
@@ -508,6 +535,11 @@ impl Slam {
 
     fn optimise(&mut self) {
         let t0 = Instant::now();
+        // Fixes spread widely enough hold the graph in their frame: the first node is
+        // then one more node, not the anchor.
+        if let Some(first) = self.nodes.first().filter(|_| self.fixes.anchor_the_graph()) {
+            self.graph.set_fixed(first.graph, false);
+        }
         let opts = OptimizeOptions::default();
         match self.graph.optimize(&opts) {
             Ok(r) => {
@@ -521,6 +553,7 @@ impl Slam {
         }
         self.since_optimisation = 0;
         self.closures_since_optimisation = 0;
+        self.fixes.since_optimisation = 0;
         self.report.optimisation_s += t0.elapsed().as_secs_f64();
     }
 
@@ -528,7 +561,8 @@ impl Slam {
     pub fn finish(mut self) -> SlamResult {
         self.report.grids_built = self.grids.built;
         self.report.grids_peak_bytes = self.grids.peak_bytes;
-        if !self.nodes.is_empty() {
+        if let Some(last) = self.nodes.len().checked_sub(1) {
+            self.attach_fixes(Stamp(i64::MAX), last + 1);
             self.optimise();
         }
         let trajectory = self

@@ -9,10 +9,12 @@
 //! | branch-and-bound loop-closure search | `global_match.rs` |
 //! | its precomputed grids within a memory budget | `grid_cache.rs` |
 //! | sparse pose-graph optimisation | `pose_graph.rs` |
+//! | GNSS fixes as position priors on nodes | `fixes.rs` |
 //! | the loop over scans | `mapper.rs` |
 //! | the corrected pose track | `corrected_track.rs` |
 //! | the matcher's exact two-way parallelism | `parallel.rs` |
 mod corrected_track;
+mod fixes;
 pub mod global_match;
 pub mod grid;
 mod grid_cache;
@@ -28,6 +30,7 @@ pub mod submap;
 mod test_world;
 
 pub use corrected_track::CorrectedTrack;
+pub use fixes::PositionFix;
 pub use local_match::LocalMatchParams;
 pub use mapper::{ScanInput, ScanOutcome, Slam, SlamResult};
 pub use parallel::adopt_calling_thread;

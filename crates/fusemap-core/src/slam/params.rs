@@ -84,6 +84,13 @@ pub struct SlamParams {
     pub optimize_every_n_nodes: usize,
     /// Levels of the branch-and-bound precomputation.
     pub branch_and_bound_depth: usize,
+    /// GNSS fixes given with [`Slam::add_fixes`](super::Slam::add_fixes) become position
+    /// priors on the nodes.
+    pub fixes: bool,
+    /// A fix is attached to the node nearest in time, if that is within this, seconds.
+    pub fix_max_offset_s: f64,
+    /// Huber scale of a fix's prior (whitened units).
+    pub fix_huber: f64,
 }
 
 impl Default for SlamParams {
@@ -130,6 +137,13 @@ impl Default for SlamParams {
             loop_closure_sigma_rad: 0.2f64.to_radians(),
             optimize_every_n_nodes: 90,
             branch_and_bound_depth: 7,
+            fixes: true,
+            // Nodes come every 10 cm or 5 s; the track's motion over half a second moves the
+            // lever arm by far less than a fix's σ.
+            fix_max_offset_s: 0.5,
+            // Fixes are gated already; past 2 σ one pulls with a constant force, so a
+            // surviving multipath fix cannot bend the graph.
+            fix_huber: 2.0,
         }
     }
 }

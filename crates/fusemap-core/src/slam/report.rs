@@ -34,6 +34,16 @@ pub struct SlamReport {
     pub held_readings: u64,
     /// Odometry edges left out: the odometry disagreed with the matched motion by > 5 σ.
     pub odometry_edges_rejected: u64,
+    /// GNSS fixes given.
+    pub fixes: u64,
+    /// Fixes made position priors on nodes.
+    pub fix_priors: u64,
+    /// Fixes left out: too far from the pose track for both covariances (χ², 99.9 %).
+    pub fixes_gated: u64,
+    /// Fixes left out: no node with a track pose within `fix_max_offset_s`, no track pose at
+    /// the fix, a covariance that is not positive definite, or a graph not in the fixes'
+    /// frame (its first node had no track pose).
+    pub fixes_unplaced: u64,
     /// Pose-graph nodes (scans that moved far enough).
     pub nodes: u64,
     /// Submaps built.
