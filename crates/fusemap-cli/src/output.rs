@@ -206,8 +206,8 @@ pub fn write(
         }
         fusemap_io::map_server::write_map_server(&files.yaml, r)?;
         fusemap_io::picture::write_map_png(&files.png, r)?;
-        if let Some((trajectory, closures)) = graph {
-            fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, &trajectory, &closures)?;
+        if let Some((trajectory, closures, fixes)) = graph {
+            fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, &trajectory, &closures, &fixes)?;
         }
     }
     // Files of an earlier run that this run does not write are removed at the commit: a
@@ -221,11 +221,12 @@ pub fn write(
     Ok(())
 }
 
-/// The trajectory of scan nodes and the loop closures (submap origin, node).
-type GraphPicture = (Vec<Point2>, Vec<(Point2, Point2)>);
+/// The trajectory of scan nodes, the loop closures (submap origin, node) and the GNSS fixes
+/// taken as priors.
+type GraphPicture = (Vec<Point2>, Vec<(Point2, Point2)>, Vec<Point2>);
 
-/// The scan nodes and the loop closures (submap origin, node) of the pose graph in a run
-/// report's `slam` section.
+/// The scan nodes, the loop closures (submap origin, node) and the fix priors of the pose
+/// graph in a run report's `slam` section.
 fn pose_graph_of(log: &serde_json::Value) -> Option<GraphPicture> {
     let slam = log.get("slam")?;
     let nodes: Vec<(bool, Point2)> = slam
@@ -249,7 +250,17 @@ fn pose_graph_of(log: &serde_json::Value) -> Option<GraphPicture> {
             Some((i("from")?, i("to")?))
         })
         .collect();
-    Some((trajectory, closures))
+    let fixes = slam
+        .get("priors")
+        .and_then(|p| p.as_array())
+        .into_iter()
+        .flatten()
+        .filter_map(|p| {
+            let xy = p.get("position")?.as_array()?;
+            Some(Point2::new(xy.first()?.as_f64()?, xy.get(1)?.as_f64()?))
+        })
+        .collect();
+    Some((trajectory, closures, fixes))
 }
 
 /// Builds the summary of a finished engine and writes every output: the view of the map

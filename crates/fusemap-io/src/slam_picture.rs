@@ -3,7 +3,8 @@
 //! An RGB PNG (colour type 2) of the map shaded as `map.png` is (see [`crate::picture`]),
 //! with the trajectory through the pose-graph nodes in blue and every accepted loop
 //! closure as a red segment from the submap's origin to the node it was matched with, so
-//! a user sees at a glance where the lidar closed loops and whether the walls agree.
+//! a user sees at a glance where the lidar closed loops and whether the walls agree. The
+//! GNSS fixes the graph took as position priors are green crosses.
 
 use crate::atomic::{check_raster, write_atomic};
 use crate::picture::{scale_factor, shade};
@@ -15,6 +16,7 @@ use std::path::Path;
 
 const TRAJECTORY: [u8; 3] = [30, 90, 230];
 const LOOP_CLOSURE: [u8; 3] = [230, 30, 30];
+const FIX: [u8; 3] = [20, 150, 50];
 
 struct Canvas {
     width: usize,
@@ -62,6 +64,7 @@ pub fn write_pose_graph_png(
     raster: &Raster,
     trajectory: &[Point2],
     loop_closures: &[(Point2, Point2)],
+    fixes: &[Point2],
 ) -> Result<usize> {
     check_raster(path, raster, true)?;
     let factor = scale_factor(raster.width, raster.height);
@@ -93,6 +96,10 @@ pub fn write_pose_graph_png(
     for (a, b) in loop_closures.iter().filter(|(a, b)| finite(a) && finite(b)) {
         canvas.line(to_px(*a), to_px(*b), LOOP_CLOSURE);
     }
+    for (x, y) in fixes.iter().filter(|p| finite(p)).map(|p| to_px(*p)) {
+        canvas.line((x - 2, y), (x + 2, y), FIX);
+        canvas.line((x, y - 2), (x, y + 2), FIX);
+    }
     write_atomic(path, |w| {
         let mut encoder = png::Encoder::new(w, width as u32, height as u32);
         encoder.set_color(png::ColorType::Rgb);
@@ -101,8 +108,8 @@ pub fn write_pose_graph_png(
             .add_text_chunk(
                 "Description".into(),
                 format!(
-                    "fusemap pose graph over the map: {} x {} cells of {} m, lower-left corner at ({}, {}) m, {} pixels per cell; blue the optimised trajectory, red the {} loop closures (submap origin to node)",
-                    raster.width, raster.height, raster.resolution, raster.origin.x, raster.origin.y, factor, loop_closures.len()
+                    "fusemap pose graph over the map: {} x {} cells of {} m, lower-left corner at ({}, {}) m, {} pixels per cell; blue the optimised trajectory, red the {} loop closures (submap origin to node), green the {} GNSS fixes taken as priors",
+                    raster.width, raster.height, raster.resolution, raster.origin.x, raster.origin.y, factor, loop_closures.len(), fixes.len()
                 ),
             )
             .map_err(io::Error::from)?;
@@ -112,4 +119,47 @@ pub fn write_pose_graph_png(
         Ok(())
     })?;
     Ok(factor)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fusemap_core::grid::{CellIndex, OccupancyParams};
+
+    #[test]
+    fn the_trajectory_closures_and_fixes_are_drawn_in_their_colours() {
+        let d = crate::testdata::temp_dir("slam-picture");
+        let p = d.join("slam.png");
+        // 20 × 10 cells of 0.1 m, all free.
+        let r = Raster {
+            width: 20,
+            height: 10,
+            resolution: 0.1,
+            origin: Point2::new(0.0, 0.0),
+            first_cell: CellIndex { x: 0, y: 0 },
+            log_odds: vec![-2.0; 200],
+            known: vec![true; 200],
+            params: OccupancyParams::default(),
+        };
+        let trajectory = [Point2::new(0.05, 0.55), Point2::new(1.95, 0.55)];
+        let closures = [(Point2::new(0.55, 0.05), Point2::new(0.55, 0.95))];
+        let fixes = [Point2::new(1.55, 0.25), Point2::new(f64::NAN, 0.0)];
+        let factor = write_pose_graph_png(&p, &r, &trajectory, &closures, &fixes).unwrap();
+        let file = std::io::BufReader::new(std::fs::File::open(&p).unwrap());
+        let mut reader = png::Decoder::new(file).read_info().unwrap();
+        let mut px = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut px).unwrap();
+        let (w, h) = (info.width as usize, info.height as usize);
+        assert_eq!((w, h), (20 * factor, 10 * factor));
+        let at = |x: f64, y: f64| {
+            let (u, v) = ((x / 0.1 * factor as f64) as usize, h - 1 - (y / 0.1 * factor as f64) as usize);
+            let i = 3 * (v * w + u);
+            [px[i], px[i + 1], px[i + 2]]
+        };
+        assert_eq!(at(1.0, 0.55), TRAJECTORY);
+        assert_eq!(at(0.55, 0.8), LOOP_CLOSURE);
+        assert_eq!(at(1.55, 0.25), FIX);
+        let free = at(1.0, 0.9);
+        assert_eq!(free[0], free[1], "free cells stay grey");
+    }
 }
