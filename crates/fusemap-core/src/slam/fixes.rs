@@ -177,6 +177,11 @@ impl FixPriors {
         }
     }
 
+    /// Fixes queued and not yet attached (nor gated, nor counted as unplaced).
+    pub fn pending(&self) -> usize {
+        self.fixes.len() - self.next
+    }
+
     /// True once the attached fixes span at least ten times their largest σ: they then
     /// hold the graph's heading as well as its position, and its first node need not be
     /// held where the track put it.

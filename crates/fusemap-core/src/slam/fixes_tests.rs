@@ -215,6 +215,14 @@ fn fixes_are_ignored_when_turned_off_or_when_the_graph_is_not_in_their_frame() {
     }
     let r = slam.finish();
     assert_eq!((r.report.fix_priors, r.report.fixes_unplaced), (0, fixes.len() as u64));
+    // No scan at all: every fix is counted as unplaced.
+    let mut slam = Slam::new(SlamParams::default());
+    slam.add_fixes(&fixes);
+    let r = slam.finish();
+    assert_eq!(
+        (r.report.fixes, r.report.fix_priors, r.report.fixes_unplaced),
+        (fixes.len() as u64, 0, fixes.len() as u64)
+    );
 }
 
 #[test]

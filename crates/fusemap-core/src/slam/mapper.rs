@@ -565,6 +565,8 @@ impl Slam {
             self.attach_fixes(Stamp(i64::MAX), last + 1);
             self.optimise();
         }
+        // Without a node (no scan), every fix is left unplaced, and counted.
+        self.report.fixes_unplaced += self.fixes.pending() as u64;
         let trajectory = self
             .scans
             .iter()
