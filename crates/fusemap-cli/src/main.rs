@@ -108,6 +108,31 @@ enum Command {
         #[arg(long)]
         overwrite: bool,
     },
+    /// The SLAM generalisation bench: every corrected CARMEN log of the shared datasets
+    /// turned into a raw log with odometry of a known error (none, mild, strong drift),
+    /// mapped with SLAM and scored against the corrected poses (local and revisit
+    /// relations, ATE), SLAM off beside it. Prints a markdown table.
+    SlamBench {
+        /// The shared directory holding `datasets/` (default: ../shared).
+        #[arg(long, default_value = "../shared")]
+        shared: PathBuf,
+        /// Config file (TOML) whose `[slam]` and other settings the runs use.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Only these logs (comma-separated names; default: all eleven).
+        #[arg(long, value_delimiter = ',')]
+        logs: Vec<String>,
+        /// Only these drifts (zero, mild, strong; comma-separated; default: all).
+        #[arg(long, value_delimiter = ',')]
+        drift: Vec<String>,
+        /// Stamp every message 0.1 s after the last instead of as the log has it (some
+        /// logs print every stamp as the same number).
+        #[arg(long)]
+        distinct_stamps: bool,
+        /// One JSON object per case instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Insertion throughput on fixed synthetic workloads (a: corridor, b: corridor x500,
     /// c: 39 m box with 1,081-beam scans, d and e: 640 x 480 camera frames projected and
     /// fused at stride 4 and 1).
@@ -151,6 +176,9 @@ fn main() {
         }
         Command::Simulate { scenario, out, resolution, overwrite } => {
             commands::simulate::run(scenario.as_deref(), &out, resolution, overwrite)
+        }
+        Command::SlamBench { shared, config, logs, drift, distinct_stamps, json } => {
+            commands::slam_bench::run(&shared, config.as_deref(), &logs, &drift, distinct_stamps, json)
         }
         Command::Bench { workload, scanfile, max_scans, json } => {
             commands::bench::run(workload, scanfile.as_deref(), max_scans, json)

@@ -38,6 +38,7 @@ pub mod run;
 pub mod scenario;
 pub mod sensors;
 pub mod slam;
+pub mod slam_bench;
 pub mod track;
 
 pub use run::{map_inventory, map_log, map_with_track, MapRun, Progress};

@@ -6,3 +6,4 @@ pub mod doctor;
 pub mod map;
 pub mod relations;
 pub mod simulate;
+pub mod slam_bench;

@@ -5,6 +5,7 @@ mod entropy;
 mod relations;
 mod scores;
 mod semantic;
+mod trajectory;
 
 pub use entropy::{binary_entropy, map_entropy, sparse_entropy, EntropyReport};
 pub use relations::{
@@ -13,3 +14,7 @@ pub use relations::{
 };
 pub use scores::{Confusion, TolerantScore};
 pub use semantic::{ClassAccuracy, SemanticAccuracy};
+pub use trajectory::{
+    absolute_trajectory_error, consecutive_relations, revisit_relations, score_index_relations, IndexRelation,
+    RevisitRule,
+};

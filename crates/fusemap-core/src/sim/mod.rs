@@ -2,12 +2,14 @@
 //! worlds benchmarks and tests need, with exact ground truth.
 
 pub mod camera_frame;
+mod odometry_drift;
 pub mod production;
 mod rng;
 mod scanner;
 mod workloads;
 mod world;
 
+pub use odometry_drift::OdometryErrorModel;
 pub use rng::SplitMix64;
 pub use scanner::{simulate_moving_scan, simulate_scan, ScannerSpec, SimulatedRun};
 pub use workloads::{workload, Workload, WORKLOADS};

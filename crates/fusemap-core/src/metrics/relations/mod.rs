@@ -242,6 +242,12 @@ fn stats(v: &[f64]) -> (f64, f64, f64) {
 /// stamps and [`RelationScore`] for the figures).
 pub fn score_relations(relations: &[Relation], trajectory: &[(Stamp, Pose2)], tolerance_ns: i64) -> RelationScore {
     let errors: Vec<Pose2> = relation_errors(relations, trajectory, tolerance_ns).into_iter().flatten().collect();
+    score_errors(relations.len(), &errors)
+}
+
+/// The figures of [`RelationScore`] from the error transforms of the relations that could
+/// be scored, out of `relations` given.
+pub(crate) fn score_errors(relations: usize, errors: &[Pose2]) -> RelationScore {
     let trans: Vec<f64> = errors.iter().map(|e| e.x.hypot(e.y)).collect();
     let rot: Vec<f64> = errors.iter().map(|e| normalize_angle(e.theta).abs().to_degrees()).collect();
     let square = |v: &[f64]| v.iter().map(|x| x * x).collect::<Vec<f64>>();
@@ -250,9 +256,9 @@ pub fn score_relations(relations: &[Relation], trajectory: &[(Stamp, Pose2)], to
     let (translation_sq_mean_m2, translation_sq_std_m2, _) = stats(&square(&trans));
     let (rotation_sq_mean_deg2, rotation_sq_std_deg2, _) = stats(&square(&rot));
     RelationScore {
-        relations: relations.len(),
+        relations,
         scored: errors.len(),
-        unmatched: relations.len() - errors.len(),
+        unmatched: relations - errors.len(),
         translation_mean_m,
         translation_std_m,
         translation_max_m,

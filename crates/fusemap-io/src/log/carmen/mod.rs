@@ -81,6 +81,7 @@ use std::path::{Path, PathBuf};
 use std::str::SplitAsciiWhitespace;
 
 mod lines;
+pub mod rewrite;
 use lines::*;
 
 /// The first two bytes of every gzip stream.
