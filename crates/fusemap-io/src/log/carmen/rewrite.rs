@@ -49,13 +49,13 @@ pub struct PoseLog {
 
 /// Field positions of a pose line: the pose fields to replace, and the two stamps.
 fn layout(fields: &[&str]) -> Option<(PoseLineKind, Vec<usize>, [usize; 2])> {
-    match fields.first()? {
-        &"FLASER" => {
+    match *fields.first()? {
+        "FLASER" => {
             let n: usize = fields.get(1)?.parse().ok()?;
             let p = 2 + n;
             (fields.len() == p + 9).then(|| (PoseLineKind::Scan, (p..p + 6).collect(), [p + 6, p + 8]))
         }
-        &"ODOM" => (fields.len() == 10).then(|| (PoseLineKind::Odometry, vec![1, 2, 3], [7, 9])),
+        "ODOM" => (fields.len() == 10).then(|| (PoseLineKind::Odometry, vec![1, 2, 3], [7, 9])),
         _ => None,
     }
 }
