@@ -62,6 +62,13 @@ pub enum Loss {
     /// Cauchy (Lorentzian) with scale `c` σ: `ρ(s) = c² ln(1 + s/c²)`; outliers' influence
     /// decays towards zero, stronger than Huber against gross mistakes.
     Cauchy(f64),
+    /// Dynamic covariance scaling with parameter `Φ` (Agarwal et al. 2013, "Robust map
+    /// optimization using dynamic covariance scaling"): the closed form of switchable
+    /// constraints (Sünderhauf & Protzel 2012), each edge's information scaled by
+    /// `s² = min(1, 2Φ / (Φ + χ²))²`. Quadratic up to `χ² = Φ`, then
+    /// `ρ(s) = 3Φ − 4Φ² / (Φ + s)`, bounded: an edge far off the rest of the graph stops
+    /// pulling at all, where Huber's pull stays constant.
+    Dcs(f64),
 }
 
 impl Loss {
@@ -83,13 +90,21 @@ impl Loss {
                 let q = 1.0 + s / c2;
                 (c2 * q.ln(), 1.0 / q)
             }
+            Loss::Dcs(phi) => {
+                if s <= phi {
+                    (s, 1.0)
+                } else {
+                    let k = 2.0 * phi / (phi + s);
+                    (3.0 * phi - 4.0 * phi * phi / (phi + s), k * k)
+                }
+            }
         }
     }
 
     fn is_valid(self) -> bool {
         match self {
             Loss::Trivial => true,
-            Loss::Huber(k) | Loss::Cauchy(k) => k.is_finite() && k > 0.0,
+            Loss::Huber(k) | Loss::Cauchy(k) | Loss::Dcs(k) => k.is_finite() && k > 0.0,
         }
     }
 }
@@ -313,6 +328,16 @@ impl PoseGraph {
     /// The edges, in insertion order.
     pub fn edges(&self) -> &[Edge] {
         &self.edges
+    }
+
+    /// Gives every edge of `kind` the loss `loss` (a schedule of losses: Huber to bring
+    /// closures in, then a redescending loss to let the wrong ones go).
+    pub fn set_loss_of(&mut self, kind: EdgeKind, loss: Loss) -> Result<(), PoseGraphError> {
+        if !loss.is_valid() {
+            return Err(PoseGraphError::BadLoss);
+        }
+        self.edges.iter_mut().filter(|e| e.kind == kind).for_each(|e| e.loss = loss);
+        Ok(())
     }
 
     /// The position priors, in insertion order.
