@@ -4,7 +4,7 @@
 //! reasons for them beside each field there.
 
 use super::{err, finite, probability, ConfigError};
-use crate::slam::{LocalMatchParams, SlamParams};
+use crate::slam::{LocalMatchParams, SlamParams, SubmapBounds};
 use serde::{Deserialize, Serialize};
 
 /// When SLAM corrects the pose track.
@@ -31,12 +31,18 @@ pub struct SlamConfig {
     pub mode: SlamMode,
     /// Submap cell size, metres.
     pub resolution_m: f64,
-    /// Scans each submap takes before the next one starts.
-    pub scans_per_submap: usize,
+    /// A submap is full (the next one starts) after this much travel, metres …
+    pub submap_distance_m: f64,
+    /// … or this much turning, degrees …
+    pub submap_rotation_deg: f64,
+    /// … or this many scans.
+    pub submap_max_scans: usize,
     /// Occupancy probability of one hit in a submap.
     pub hit_probability: f64,
     /// Occupancy probability of one miss in a submap.
     pub miss_probability: f64,
+    /// σ of the likelihood field scans are matched against, metres.
+    pub field_sigma_m: f64,
     /// Returns farther than this are not used by SLAM, metres.
     pub max_range_m: f64,
     /// Scans with fewer usable returns are not matched.
@@ -84,10 +90,15 @@ pub struct SlamConfig {
     pub loop_closure: bool,
     /// Share of nodes searched for loop closures: the loop-closure rate.
     pub loop_closure_sampling_ratio: f64,
+    /// … and at most one node per this much travel, metres.
+    pub loop_closure_node_spacing_m: f64,
     /// A searched node tries at most this many nearest finished submaps.
     pub loop_closure_submaps_per_node: usize,
     /// A finished submap is tried by at most this many earlier nodes near it.
     pub loop_closure_nodes_per_submap: usize,
+    /// Two submaps tied by this many accepted closures are not searched again (0: no
+    /// limit).
+    pub loop_closure_links_per_pair: usize,
     /// Returns farther than this are left out of the loop-closure search, metres.
     pub loop_closure_max_range_m: f64,
     /// At most this many returns (evenly spread) go into a loop-closure search.
@@ -102,14 +113,44 @@ pub struct SlamConfig {
     pub loop_closure_angular_window_deg: f64,
     /// Minimum mean probability of a loop closure's points (the score threshold).
     pub loop_closure_min_score: f64,
-    /// Huber scale of loop-closure edges, in σ.
+    /// Huber scale of loop-closure edges, in σ (the first pass of each optimisation).
     pub loop_closure_huber: f64,
+    /// Φ of the dynamic covariance scaling of loop-closure edges (the second pass).
+    pub loop_closure_dcs: f64,
+    /// Metres the loop-closure window grows per metre driven since the last closure.
+    pub loop_closure_window_growth: f64,
+    /// Degrees the loop-closure window grows per metre driven since the last closure.
+    pub loop_closure_angular_growth_deg_per_m: f64,
+    /// The widest loop-closure window, metres.
+    pub loop_closure_max_linear_window_m: f64,
+    /// A closure moving its node by at most this much (metres) …
+    pub loop_closure_accept_shift_m: f64,
+    /// … and this much (degrees) is accepted at once; more needs a confirmation.
+    pub loop_closure_accept_shift_deg: f64,
+    /// Half-width of the search that confirms a large correction, metres …
+    pub loop_closure_confirm_linear_window_m: f64,
+    /// … and degrees.
+    pub loop_closure_confirm_angular_window_deg: f64,
+    /// A large correction must be confirmed within this much travel, metres.
+    pub loop_closure_confirm_within_m: f64,
+    /// Travel without a closure after which global searches begin, metres.
+    pub loop_closure_global_after_m: f64,
+    /// Submaps searched globally per batch.
+    pub loop_closure_global_submaps_per_batch: usize,
+    /// Score a global match needs.
+    pub loop_closure_global_min_score: f64,
+    /// Searches run together every this many nodes.
+    pub loop_closure_batch_nodes: usize,
+    /// At most this much work a batch (millions of grid lookups).
+    pub loop_closure_million_lookups_per_batch: f64,
     /// σ of a loop closure's translation, metres.
     pub loop_closure_sigma_m: f64,
     /// σ of a loop closure's rotation, degrees.
     pub loop_closure_sigma_deg: f64,
     /// Optimise the pose graph every this many nodes (and at the end).
     pub optimize_every_n_nodes: usize,
+    /// … and at least this much travel, metres.
+    pub optimize_every_m: f64,
     /// Levels of the branch-and-bound precomputation (2^(depth−1) cells at the top).
     pub branch_and_bound_depth: usize,
     /// GNSS fixes become position priors on the pose graph's nodes (when the track is the
@@ -129,9 +170,12 @@ impl Default for SlamConfig {
         Self {
             mode: SlamMode::Auto,
             resolution_m: p.resolution,
-            scans_per_submap: p.scans_per_submap,
+            submap_distance_m: p.submap.distance_m,
+            submap_rotation_deg: 360.0,
+            submap_max_scans: p.submap.max_scans,
             hit_probability: p.hit_probability as f64,
             miss_probability: p.miss_probability as f64,
+            field_sigma_m: p.field_sigma_m,
             max_range_m: p.max_range_m,
             min_points: p.min_points,
             node_distance_m: p.node_distance_m,
@@ -155,8 +199,10 @@ impl Default for SlamConfig {
             odometry_floor_deg: 1.0,
             loop_closure: p.loop_closure,
             loop_closure_sampling_ratio: p.loop_closure_sampling_ratio,
+            loop_closure_node_spacing_m: p.loop_closure_node_spacing_m,
             loop_closure_submaps_per_node: p.loop_closure_submaps_per_node,
             loop_closure_nodes_per_submap: p.loop_closure_nodes_per_submap,
+            loop_closure_links_per_pair: p.loop_closure_links_per_pair,
             loop_closure_max_range_m: p.loop_closure_max_range_m,
             loop_closure_max_points: p.loop_closure_max_points,
             loop_closure_grid_cache_mib: p.loop_closure_grid_cache_mib,
@@ -165,9 +211,24 @@ impl Default for SlamConfig {
             loop_closure_angular_window_deg: 20.0,
             loop_closure_min_score: p.loop_closure_min_score as f64,
             loop_closure_huber: p.loop_closure_huber,
+            loop_closure_dcs: p.loop_closure_dcs,
+            loop_closure_window_growth: p.loop_closure_window_growth,
+            loop_closure_angular_growth_deg_per_m: 0.02,
+            loop_closure_accept_shift_m: p.loop_closure_accept_shift_m,
+            loop_closure_accept_shift_deg: 5.0,
+            loop_closure_max_linear_window_m: p.loop_closure_max_linear_window_m,
+            loop_closure_confirm_linear_window_m: p.loop_closure_confirm_linear_window_m,
+            loop_closure_confirm_angular_window_deg: 3.0,
+            loop_closure_confirm_within_m: p.loop_closure_confirm_within_m,
+            loop_closure_global_after_m: p.loop_closure_global_after_m,
+            loop_closure_global_submaps_per_batch: p.loop_closure_global_submaps_per_batch,
+            loop_closure_global_min_score: p.loop_closure_global_min_score as f64,
+            loop_closure_batch_nodes: p.loop_closure_batch_nodes,
+            loop_closure_million_lookups_per_batch: p.loop_closure_work_per_batch / 1e6,
             loop_closure_sigma_m: p.loop_closure_sigma_m,
             loop_closure_sigma_deg: 0.2,
             optimize_every_n_nodes: p.optimize_every_n_nodes,
+            optimize_every_m: p.optimize_every_m,
             branch_and_bound_depth: p.branch_and_bound_depth,
             fixes: p.fixes,
             fix_max_offset_s: p.fix_max_offset_s,
@@ -212,7 +273,7 @@ impl SlamConfig {
             return Err(err("slam.resolution_m", format!("must be within 0.005..=1 m, got {res}")));
         }
         for (k, v) in
-            [("scans_per_submap", self.scans_per_submap), ("optimize_every_n_nodes", self.optimize_every_n_nodes)]
+            [("submap_max_scans", self.submap_max_scans), ("optimize_every_n_nodes", self.optimize_every_n_nodes)]
         {
             if v == 0 {
                 return Err(err(format!("slam.{k}"), "must be at least 1"));
@@ -232,9 +293,14 @@ impl SlamConfig {
         }
         Ok(SlamParams {
             resolution: res,
-            scans_per_submap: self.scans_per_submap,
+            submap: SubmapBounds {
+                distance_m: positive("submap_distance_m", self.submap_distance_m)?,
+                rotation_rad: positive("submap_rotation_deg", self.submap_rotation_deg)?.to_radians(),
+                max_scans: self.submap_max_scans,
+            },
             hit_probability: hit as f32,
             miss_probability: miss as f32,
+            field_sigma_m: non_negative("field_sigma_m", self.field_sigma_m)?.min(1.0),
             max_range_m: positive("max_range_m", self.max_range_m)?,
             min_points: self.min_points,
             node_distance_m: non_negative("node_distance_m", self.node_distance_m)?,
@@ -261,8 +327,13 @@ impl SlamConfig {
             odometry_floor_rad: positive("odometry_floor_deg", self.odometry_floor_deg)?.to_radians(),
             loop_closure: self.loop_closure,
             loop_closure_sampling_ratio: ratio,
+            loop_closure_node_spacing_m: non_negative(
+                "slam.loop_closure_node_spacing_m",
+                self.loop_closure_node_spacing_m,
+            )?,
             loop_closure_submaps_per_node: self.loop_closure_submaps_per_node,
             loop_closure_nodes_per_submap: self.loop_closure_nodes_per_submap,
+            loop_closure_links_per_pair: self.loop_closure_links_per_pair,
             loop_closure_max_range_m: positive("loop_closure_max_range_m", self.loop_closure_max_range_m)?,
             loop_closure_max_points: self.loop_closure_max_points,
             loop_closure_grid_cache_mib: self.loop_closure_grid_cache_mib,
@@ -275,9 +346,55 @@ impl SlamConfig {
             loop_closure_angular_window_rad: lc_angular.to_radians(),
             loop_closure_min_score: score as f32,
             loop_closure_huber: positive("loop_closure_huber", self.loop_closure_huber)?,
+            loop_closure_dcs: positive("loop_closure_dcs", self.loop_closure_dcs)?,
+            loop_closure_window_growth: non_negative("loop_closure_window_growth", self.loop_closure_window_growth)?,
+            loop_closure_angular_growth_rad_per_m: non_negative(
+                "loop_closure_angular_growth_deg_per_m",
+                self.loop_closure_angular_growth_deg_per_m,
+            )?
+            .to_radians(),
+            loop_closure_max_linear_window_m: non_negative(
+                "loop_closure_max_linear_window_m",
+                self.loop_closure_max_linear_window_m,
+            )?
+            .min(100.0),
+            loop_closure_accept_shift_m: non_negative("loop_closure_accept_shift_m", self.loop_closure_accept_shift_m)?,
+            loop_closure_accept_shift_rad: non_negative(
+                "loop_closure_accept_shift_deg",
+                self.loop_closure_accept_shift_deg,
+            )?
+            .min(180.0)
+            .to_radians(),
+            loop_closure_confirm_linear_window_m: non_negative(
+                "loop_closure_confirm_linear_window_m",
+                self.loop_closure_confirm_linear_window_m,
+            )?
+            .min(100.0),
+            loop_closure_confirm_angular_window_rad: non_negative(
+                "loop_closure_confirm_angular_window_deg",
+                self.loop_closure_confirm_angular_window_deg,
+            )?
+            .min(180.0)
+            .to_radians(),
+            loop_closure_confirm_within_m: non_negative(
+                "loop_closure_confirm_within_m",
+                self.loop_closure_confirm_within_m,
+            )?,
+            loop_closure_global_after_m: non_negative("loop_closure_global_after_m", self.loop_closure_global_after_m)?,
+            loop_closure_global_submaps_per_batch: self.loop_closure_global_submaps_per_batch,
+            loop_closure_global_min_score: probability(
+                "slam.loop_closure_global_min_score",
+                self.loop_closure_global_min_score,
+            )? as f32,
+            loop_closure_batch_nodes: self.loop_closure_batch_nodes.max(1),
+            loop_closure_work_per_batch: positive(
+                "loop_closure_million_lookups_per_batch",
+                self.loop_closure_million_lookups_per_batch,
+            )? * 1e6,
             loop_closure_sigma_m: positive("loop_closure_sigma_m", self.loop_closure_sigma_m)?,
             loop_closure_sigma_rad: positive("loop_closure_sigma_deg", self.loop_closure_sigma_deg)?.to_radians(),
             optimize_every_n_nodes: self.optimize_every_n_nodes,
+            optimize_every_m: non_negative("optimize_every_m", self.optimize_every_m)?,
             branch_and_bound_depth: self.branch_and_bound_depth,
             fixes: self.fixes,
             fix_max_offset_s: non_negative("fix_max_offset_s", self.fix_max_offset_s)?.min(60.0),
@@ -294,7 +411,8 @@ mod tests {
     fn defaults_round_trip_to_the_parameters() {
         let p = SlamConfig::default().validate().unwrap();
         let d = SlamParams::default();
-        assert_eq!(p.scans_per_submap, d.scans_per_submap);
+        assert_eq!(p.submap.max_scans, d.submap.max_scans);
+        assert!((p.submap.rotation_rad - d.submap.rotation_rad).abs() < 1e-12);
         assert!((p.node_angle_rad - d.node_angle_rad).abs() < 1e-12);
         assert!((p.loop_closure_angular_window_rad - d.loop_closure_angular_window_rad).abs() < 1e-12);
         assert_eq!(p.local.linear_window_m, d.local.linear_window_m);
@@ -308,7 +426,7 @@ mod tests {
         assert!(c.validate().unwrap_err().to_string().contains("hit_probability"));
         let c = SlamConfig { loop_closure_sampling_ratio: 2.0, ..Default::default() };
         assert!(c.validate().unwrap_err().to_string().contains("slam.loop_closure_sampling_ratio"));
-        let c = SlamConfig { scans_per_submap: 0, ..Default::default() };
-        assert!(c.validate().unwrap_err().to_string().contains("slam.scans_per_submap"));
+        let c = SlamConfig { submap_max_scans: 0, ..Default::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("slam.submap_max_scans"));
     }
 }

@@ -16,6 +16,7 @@
 //! vector instructions. [`ProbabilityGrid::freeze`] drops the mirror when the submap is
 //! finished (loop closure reads its own precomputed grids).
 
+use super::field::Crossing;
 use crate::geometry::Point2;
 use crate::grid::{CellIndex, CellRay};
 
@@ -225,13 +226,43 @@ impl ProbabilityGrid {
         self.limits = CellLimits { min: CellIndex::new(nx0, ny0), width: w, height: h };
     }
 
+    /// Grows the grid (with a margin) to hold every cell of the box `[lo, hi]`.
+    pub(crate) fn ensure_cells(&mut self, lo: (i64, i64), hi: (i64, i64)) {
+        self.grow_to(lo, hi);
+    }
+
+    /// The stored value of cell `(x, y)`; `0` when unknown or outside.
     #[inline]
-    fn apply(&mut self, x: i64, y: i64, table: &UpdateTable) {
+    pub fn value(&self, x: i64, y: i64) -> u16 {
+        self.limits.index(x, y).map_or(0, |i| self.cells[i] & !MARK)
+    }
+
+    /// Sets the stored value of cell `(x, y)` (inside the grid: see
+    /// [`ensure_cells`](Self::ensure_cells)), and its mirror.
+    #[inline]
+    pub(crate) fn set_value(&mut self, x: i64, y: i64, v: u16) {
+        if let Some(i) = self.limits.index(x, y) {
+            self.cells[i] = v;
+            if let Some(m) = &mut self.mirror {
+                m[i] = value_to_probability(v);
+            }
+        }
+    }
+
+    #[inline]
+    fn apply(&mut self, x: i64, y: i64, table: &UpdateTable, crossings: &mut Option<&mut Vec<Crossing>>) {
         if let Some(i) = self.limits.index(x, y) {
             let v = self.cells[i];
             if v & MARK == 0 {
-                self.cells[i] = table.table[v as usize];
+                let new = table.table[v as usize];
+                self.cells[i] = new;
                 self.marked.push(i as u32);
+                if let Some(out) = crossings {
+                    let occupied = |v: u16| v & !MARK != 0 && value_to_probability(v) > 0.5;
+                    if occupied(v) != occupied(new) {
+                        out.push(Crossing { cell: CellIndex::new(x, y), occupied: occupied(new) });
+                    }
+                }
             }
         }
     }
@@ -248,6 +279,32 @@ impl ProbabilityGrid {
         hit: &UpdateTable,
         miss: &UpdateTable,
     ) {
+        self.insert_with(origin, hits, misses, hit, miss, None);
+    }
+
+    /// [`insert`](Self::insert), and the cells whose occupancy (probability above ½)
+    /// changed appended to `crossings`.
+    pub fn insert_tracking(
+        &mut self,
+        origin: Point2,
+        hits: &[Point2],
+        misses: &[Point2],
+        hit: &UpdateTable,
+        miss: &UpdateTable,
+        crossings: &mut Vec<Crossing>,
+    ) {
+        self.insert_with(origin, hits, misses, hit, miss, Some(crossings));
+    }
+
+    fn insert_with(
+        &mut self,
+        origin: Point2,
+        hits: &[Point2],
+        misses: &[Point2],
+        hit: &UpdateTable,
+        miss: &UpdateTable,
+        mut crossings: Option<&mut Vec<Crossing>>,
+    ) {
         let o = self.to_cell_units(origin);
         let (mut lo, mut hi) = ((o.0.floor() as i64, o.1.floor() as i64), (o.0.floor() as i64, o.1.floor() as i64));
         for p in hits.iter().chain(misses) {
@@ -259,7 +316,7 @@ impl ProbabilityGrid {
         self.grow_to(lo, hi);
         for p in hits {
             let c = self.to_cell_units(*p);
-            self.apply(c.0.floor() as i64, c.1.floor() as i64, hit);
+            self.apply(c.0.floor() as i64, c.1.floor() as i64, hit, &mut crossings);
         }
         for (p, is_hit) in hits.iter().map(|p| (p, true)).chain(misses.iter().map(|p| (p, false))) {
             let ray = CellRay::new(o, self.to_cell_units(*p));
@@ -268,7 +325,7 @@ impl ProbabilityGrid {
                 if is_hit && k as u64 + 1 == n {
                     break;
                 }
-                self.apply(c.x, c.y, miss);
+                self.apply(c.x, c.y, miss, &mut crossings);
             }
         }
         for i in self.marked.drain(..) {

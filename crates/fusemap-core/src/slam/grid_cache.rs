@@ -39,26 +39,42 @@ impl GridCache {
         self.grids.push(None);
     }
 
-    /// The grids of submap `s` (built from `grid` if not held), now the most recently used.
-    pub fn get(&mut self, s: usize, grid: &ProbabilityGrid) -> &PrecomputedGrids {
-        if self.grids[s].is_none() {
-            let g = PrecomputedGrids::new(grid, self.depth);
+    /// Builds the grids of every submap of `needed` not held (in parallel), makes them the
+    /// most recently used, and drops the least recently used others past the budget: every
+    /// one of `needed` can then be [`peek`](Self::peek)ed, however small the budget.
+    pub fn prepare<'a>(&mut self, needed: &[usize], grid_of: impl Fn(usize) -> &'a ProbabilityGrid + Sync) {
+        let missing: Vec<usize> = needed.iter().copied().filter(|&s| self.grids[s].is_none()).collect();
+        let depth = self.depth;
+        let built = super::parallel::map_all(&missing, |&s| PrecomputedGrids::new(grid_of(s), depth));
+        for (s, g) in missing.into_iter().zip(built) {
             self.bytes += g.memory_bytes();
             self.grids[s] = Some(g);
             self.built += 1;
-            self.peak_bytes = self.peak_bytes.max(self.bytes);
         }
-        if let Some(i) = self.recent.iter().position(|&x| x == s) {
-            self.recent.remove(i);
+        self.peak_bytes = self.peak_bytes.max(self.bytes);
+        for &s in needed {
+            if let Some(i) = self.recent.iter().position(|&x| x == s) {
+                self.recent.remove(i);
+            }
+            self.recent.push_back(s);
         }
-        self.recent.push_back(s);
-        while self.bytes > self.budget && self.recent.len() > 1 {
-            let old = self.recent.pop_front().expect("more than one held");
+        let mut k = 0;
+        while self.bytes > self.budget && k < self.recent.len() {
+            let old = self.recent[k];
+            if needed.contains(&old) {
+                k += 1;
+                continue;
+            }
+            self.recent.remove(k);
             if let Some(g) = self.grids[old].take() {
                 self.bytes -= g.memory_bytes();
             }
         }
-        self.grids[s].as_ref().expect("built above and never dropped: it is the most recent")
+    }
+
+    /// The grids of submap `s`, if held.
+    pub fn peek(&self, s: usize) -> Option<&PrecomputedGrids> {
+        self.grids.get(s)?.as_ref()
     }
 }
 
@@ -82,21 +98,27 @@ mod tests {
         let one = PrecomputedGrids::new(&grids[0], 4).memory_bytes();
         let mut c = GridCache::new(2 * one + one / 2, 4);
         (0..4).for_each(|_| c.add_submap());
-        let first = format!("{:?}", c.get(0, &grids[0]).memory_bytes());
-        c.get(1, &grids[1]);
-        c.get(0, &grids[0]); // 0 is now more recent than 1
-        c.get(2, &grids[2]); // over budget: 1 goes
+        let of = |s: usize| &grids[s];
+        c.prepare(&[0], of);
+        let first = c.peek(0).unwrap().memory_bytes();
+        c.prepare(&[1], of);
+        c.prepare(&[0], of); // 0 is now more recent than 1
+        c.prepare(&[2], of); // over budget: 1 goes
         assert_eq!(c.built, 3);
+        assert!(c.peek(1).is_none() && c.peek(0).is_some() && c.peek(2).is_some());
         // At most the budget plus the grid just built, before the oldest is dropped.
         assert!(c.peak_bytes <= 3 * one && c.bytes <= 2 * one + one / 2, "{} {}", c.peak_bytes, c.bytes);
-        c.get(0, &grids[0]);
+        c.prepare(&[0], of);
         assert_eq!(c.built, 3, "0 was kept");
-        c.get(1, &grids[1]);
+        c.prepare(&[1], of);
         assert_eq!(c.built, 4, "1 was dropped and is rebuilt");
-        assert_eq!(format!("{:?}", c.get(0, &grids[0]).memory_bytes()), first);
-        // A budget of nothing still holds the grids in use.
+        assert_eq!(c.peek(0).unwrap().memory_bytes(), first);
+        // A batch keeps every grid it needs, whatever the budget.
         let mut tiny = GridCache::new(0, 4);
-        tiny.add_submap();
-        assert!(tiny.get(0, &grids[0]).memory_bytes() > 0);
+        (0..3).for_each(|_| tiny.add_submap());
+        tiny.prepare(&[0, 1, 2], of);
+        assert!((0..3).all(|s| tiny.peek(s).is_some()));
+        tiny.prepare(&[2], of);
+        assert!(tiny.peek(0).is_none() && tiny.peek(2).is_some());
     }
 }

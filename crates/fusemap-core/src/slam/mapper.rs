@@ -19,9 +19,10 @@
 //! composed with the local offset between the two.
 
 use super::fixes::{FixNode, FixPriors, PositionFix};
-use super::global_match::{match_branch_and_bound, GlobalSearch};
 use super::grid_cache::GridCache;
-use super::local_match::{match_information, mean_probability, refine, LocalMatchParams};
+use super::local_match::{refine, LocalMatchParams};
+use super::loop_closure::{Loops, OpenSearch};
+use super::odometry::OdometryAgreement;
 use super::parallel::{join, on_worker};
 use super::params::SlamParams;
 use super::pose_graph::{Edge, EdgeKind, Loss, OptimizeOptions, PoseGraph};
@@ -68,40 +69,45 @@ struct ScanRecord {
     anchor: Option<usize>,
 }
 
-struct Node {
-    stamp: Stamp,
-    local: Pose2,
-    track: Option<Pose2>,
-    graph: usize,
-    points: Vec<Point2>,
-    search_points: Vec<Point2>,
-    submaps: Vec<usize>,
+pub(super) struct Node {
+    pub(super) stamp: Stamp,
+    pub(super) local: Pose2,
+    pub(super) track: Option<Pose2>,
+    pub(super) graph: usize,
+    pub(super) points: Vec<Point2>,
+    pub(super) search_points: Vec<Point2>,
+    pub(super) submaps: Vec<usize>,
+    /// Travel of the local trajectory up to this node, metres.
+    pub(super) path_m: f64,
 }
 
 /// The SLAM state over one log. Feed scans in time order with [`add_scan`](Self::add_scan),
 /// then [`finish`](Self::finish).
 pub struct Slam {
-    p: SlamParams,
-    submaps: Submaps,
-    submap_graph: Vec<usize>,
+    pub(super) p: SlamParams,
+    pub(super) submaps: Submaps,
+    pub(super) submap_graph: Vec<usize>,
     /// Finished submaps (searched for loop closures).
-    finished: Vec<bool>,
-    grids: GridCache,
-    node_sampler: f64,
-    graph: PoseGraph,
-    nodes: Vec<Node>,
+    pub(super) finished: Vec<bool>,
+    pub(super) grids: GridCache,
+    pub(super) loops: Loops,
+    pub(super) graph: PoseGraph,
+    pub(super) nodes: Vec<Node>,
     scans: Vec<ScanRecord>,
     /// The last scan's local pose, and its track pose if it had one.
-    last: Option<(Pose2, Option<Pose2>)>,
+    pub(super) last: Option<(Pose2, Option<Pose2>)>,
     /// The last two scans' stamps and local poses (the constant-velocity prediction).
-    recent: [Option<(Stamp, Pose2)>; 2],
-    global_from_local: Pose2,
+    pub(super) recent: [Option<(Stamp, Pose2)>; 2],
+    pub(super) global_from_local: Pose2,
     /// The recent matches' mean probability (the rescue search's reference).
-    typical_score: Option<f64>,
-    since_optimisation: usize,
-    closures_since_optimisation: usize,
-    fixes: FixPriors,
-    report: SlamReport,
+    pub(super) typical_score: Option<f64>,
+    pub(super) since_optimisation: usize,
+    /// Travel at the last optimisation, metres.
+    optimised_at_m: f64,
+    pub(super) fixes: FixPriors,
+    /// How well the track's motion has agreed with the matches.
+    pub(super) odometry: OdometryAgreement,
+    pub(super) report: SlamReport,
 }
 
 /// The result of a SLAM run.
@@ -118,6 +124,9 @@ pub struct SlamResult {
     pub scan_nodes: Vec<usize>,
     /// Counts and timings.
     pub report: SlamReport,
+    /// The loop-closure searches that closed no loop, and why (at most
+    /// [`MAX_OPEN_REPORTED`](super::loop_closure::MAX_OPEN_REPORTED)).
+    pub open_loops: Vec<OpenSearch>,
 }
 
 /// Two poses equal to the bit (a repeated reading, not a coincidence of motion).
@@ -125,7 +134,31 @@ fn same_bits(a: Pose2, b: Pose2) -> bool {
     [a.x, a.y, a.theta].map(f64::to_bits) == [b.x, b.y, b.theta].map(f64::to_bits)
 }
 
-fn information_diag(sx: f64, sth: f64) -> [[f64; 3]; 3] {
+/// The information floor of a match edge, σ: enough to keep the graph solvable where a
+/// match says nothing (along a corridor), and far below the odometry's, so that there the
+/// odometry and the fixes place the node, not the submap it went into. (A floor of 0.5 m
+/// counted the odometry twice along a corridor: each submap stiffened the odometry's
+/// scale error over its length.)
+const FLOOR_M: f64 = 10.0;
+const FLOOR_DEG: f64 = 30.0;
+
+/// A match whose translational information is this well conditioned (smallest over largest
+/// eigenvalue) constrains both directions of the plane: a room, not a corridor.
+const WELL_POSED: f64 = 0.25;
+
+/// The smallest over the largest eigenvalue of the translational part of `info`.
+fn translation_conditioning(info: &[[f64; 3]; 3]) -> f64 {
+    let (a, b, c) = (info[0][0], info[0][1], info[1][1]);
+    let disc = ((a - c) * (a - c) / 4.0 + b * b).sqrt();
+    let (hi, lo) = ((a + c) / 2.0 + disc, (a + c) / 2.0 - disc);
+    if hi > 0.0 {
+        (lo / hi).max(0.0)
+    } else {
+        0.0
+    }
+}
+
+pub(super) fn information_diag(sx: f64, sth: f64) -> [[f64; 3]; 3] {
     [[1.0 / (sx * sx), 0.0, 0.0], [0.0, 1.0 / (sx * sx), 0.0], [0.0, 0.0, 1.0 / (sth * sth)]]
 }
 
@@ -133,12 +166,12 @@ impl Slam {
     /// An empty run.
     pub fn new(p: SlamParams) -> Self {
         Self {
-            submaps: Submaps::new(p.resolution, p.scans_per_submap, p.hit_probability, p.miss_probability),
+            submaps: Submaps::new(p.resolution, p.submap, p.hit_probability, p.miss_probability, p.field_sigma_m),
             p,
             submap_graph: Vec::new(),
             finished: Vec::new(),
             grids: GridCache::new(p.loop_closure_grid_cache_mib.saturating_mul(1 << 20), p.branch_and_bound_depth),
-            node_sampler: 0.0,
+            loops: Loops::new(),
             graph: PoseGraph::new(),
             nodes: Vec::new(),
             scans: Vec::new(),
@@ -147,8 +180,9 @@ impl Slam {
             global_from_local: Pose2::IDENTITY,
             typical_score: None,
             since_optimisation: 0,
-            closures_since_optimisation: 0,
+            optimised_at_m: 0.0,
             fixes: FixPriors::new(),
+            odometry: OdometryAgreement::default(),
             report: SlamReport::default(),
         }
     }
@@ -204,6 +238,11 @@ impl Slam {
         if held {
             self.report.held_readings += 1;
         }
+        // The track's own motion since the last scan, when it has one.
+        let track_motion = match (self.last, scan.track) {
+            (Some((_, Some(before))), Some(now)) if !held => Some(before.inverse().compose(now)),
+            _ => None,
+        };
         let predicted = match (self.last, scan.track) {
             _ if held => self.recent[1].map_or(Pose2::IDENTITY, |r| r.1),
             (Some((local, Some(before))), Some(now)) => local.compose(before.inverse().compose(now)),
@@ -227,7 +266,15 @@ impl Slam {
             _ => None,
         };
         let t0 = Instant::now();
-        let (local, outcome, information) = on_worker(|| self.match_local(&hits, predicted, moving));
+        let (local, outcome, information) = on_worker(|| self.match_local(&hits, predicted, moving, track_motion));
+        // The track is judged only by matches that pin the scan down in every direction: along
+        // a corridor the match's position is the track's own, and would flatter it.
+        let well_posed = information.is_some_and(|i| translation_conditioning(&i) >= WELL_POSED);
+        if let (Some(d), Some((before, _)), ScanOutcome::Matched, true) = (track_motion, self.last, outcome, well_posed)
+        {
+            self.odometry.observe(&self.p, d, before.inverse().compose(local));
+            self.report.odometry_samples += 1;
+        }
         self.recent = [self.recent[1], Some((scan.stamp, local))];
         self.report.matching_s += t0.elapsed().as_secs_f64();
         match outcome {
@@ -262,7 +309,18 @@ impl Slam {
         hits: &[Point2],
         predicted: Pose2,
         moving: Option<Pose2>,
+        track_motion: Option<Pose2>,
     ) -> (Pose2, ScanOutcome, Option<[[f64; 3]; 3]>) {
+        // A rescue (a wide search) may not put the scan where the track's motion makes it
+        // implausible (beyond 5 σ of what the track has shown, never tighter than the
+        // model): a good track outweighs one far match found in a wide window. An
+        // ordinary match is not gated: odometry that has agreed for minutes still slips,
+        // and on Freiburg 079 overriding weak matches with it moved the track by metres.
+        let p = self.p;
+        let odometry = self.odometry;
+        let plausible = |pose: Pose2| {
+            track_motion.is_none_or(|d| odometry.plausible(&p, d, d.compose(predicted.inverse().compose(pose)), 5.0))
+        };
         let Some((_, submap)) = self.submaps.matching() else {
             return (predicted, ScanOutcome::Predicted, None);
         };
@@ -279,7 +337,8 @@ impl Slam {
             let d = predicted.inverse().compose(*alt);
             d.x.hypot(d.y) > 0.5 * local.linear_window_m || d.theta.abs() > 0.5 * local.angular_window_rad
         });
-        let search = |at: Pose2| super::local_match::match_scan(&submap.grid, hits, at, local);
+        let g = &submap.grid;
+        let search = |at: Pose2| super::local_match::match_scan(g, hits, at, local);
         let (mut m, m2) = match alt {
             Some(alt) => {
                 let (m, m2) = join(|| search(predicted), || search(alt));
@@ -288,6 +347,8 @@ impl Slam {
             None => (search(predicted), None),
         };
         let mut predicted = predicted;
+        // The constant-velocity prediction, clearly better, is the odometry's failure (a jump,
+        // a stall).
         if let Some((m2, alt)) = m2 {
             self.report.moving_prediction_searched += 1;
             if f64::from(m2.score) > f64::from(m.score) + self.p.moving_prediction_margin {
@@ -305,9 +366,9 @@ impl Slam {
                 angular_window_rad: self.p.rescue_angular_window_rad,
                 ..*local
             };
-            let r = super::local_match::match_scan(&submap.grid, hits, predicted, &wide);
+            let r = super::local_match::match_scan(g, hits, predicted, &wide);
             self.report.rescue_searched += 1;
-            if f64::from(r.score) > f64::from(m.score) + self.p.moving_prediction_margin {
+            if f64::from(r.score) > f64::from(m.score) + self.p.moving_prediction_margin && plausible(r.pose) {
                 m = r;
                 self.report.rescued += 1;
             }
@@ -321,7 +382,7 @@ impl Slam {
                 rotation_weight: self.p.local.rotation_weight,
                 ..self.p.local
             };
-            let pose = refine(&submap.grid, hits, predicted, predicted, &strong);
+            let pose = refine(g, hits, predicted, predicted, &strong);
             return (pose, ScanOutcome::Degenerate, Some(m.information));
         }
         (m.pose, ScanOutcome::Matched, Some(m.information))
@@ -332,7 +393,7 @@ impl Slam {
     /// direction is as good as the odometry, not infinitely bad — and scaled down as a
     /// whole if it claims more than a few millimetres, which stays positive definite.
     fn match_information(&self, info: Option<[[f64; 3]; 3]>) -> [[f64; 3]; 3] {
-        let floor = information_diag(0.5, 10f64.to_radians());
+        let floor = information_diag(FLOOR_M, FLOOR_DEG.to_radians());
         let cap = information_diag(0.005, 0.05f64.to_radians());
         let mut out = info.unwrap_or([[0.0; 3]; 3]);
         for (i, f) in floor.iter().enumerate() {
@@ -368,20 +429,28 @@ impl Slam {
             self.submap_graph.push(g);
             self.finished.push(false);
             self.grids.add_submap();
+            self.loops.footprints.push(Default::default());
         }
         let g = self.graph.add_node(self.global_from_local.compose(local));
         if self.nodes.is_empty() {
             self.graph.set_fixed(g, true);
         }
+        // Every node is tied to the submaps it went into by its match's information, a
+        // submap's first node too: tied rigidly, it carried the odometry's stretch along a
+        // corridor (where the match says nothing) into the whole submap (a 27 cm error at
+        // each submap's start on the corridor of `fixes_tests.rs`, 11 cm without). Only a
+        // first node that was not matched (the run's first) defines its submap's frame: its
+        // heading stiffly (a turn on the spot has nothing else to hold the submap's
+        // rotation), its position to 5 cm.
         let info = self.match_information(information);
         for &s in &into {
             let sm = &self.submaps.all()[s];
-            let first = sm.scans == 1;
+            let defines = sm.scans == 1 && information.is_none();
             let e = Edge {
                 from: self.submap_graph[s],
                 to: g,
                 measurement: sm.local_pose.inverse().compose(local),
-                information: if first { information_diag(0.001, 0.01f64.to_radians()) } else { info },
+                information: if defines { information_diag(0.05, 0.01f64.to_radians()) } else { info },
                 loss: Loss::Trivial,
                 kind: EdgeKind::Match,
             };
@@ -389,13 +458,13 @@ impl Slam {
         }
         if let Some((prev, before, now)) = self.nodes.last().and_then(|p| Some((p, p.track?, track?))) {
             let d = before.inverse().compose(now);
-            let st = self.p.odometry_floor_m + self.p.odometry_translation_per_m * d.x.hypot(d.y);
-            let sr = self.p.odometry_floor_rad + self.p.odometry_rotation_per_rad * d.theta.abs();
+            let (st, sr) = self.odometry.sigmas(&self.p, d);
             // Odometry that disagrees with the matched motion by more than 5 σ (a jump, a
             // stall, a slip) is left out of the graph and counted, not averaged in.
             let m = prev.local.inverse().compose(local);
-            let consistent =
-                (d.x - m.x).hypot(d.y - m.y) <= 5.0 * st && normalize_angle(d.theta - m.theta).abs() <= 5.0 * sr;
+            // The test is never tighter than the configured model: learnt-stiff odometry
+            // still agrees with the matches only to their own noise.
+            let consistent = self.odometry.plausible(&self.p, d, m, 5.0);
             if !consistent {
                 self.report.odometry_edges_rejected += 1;
             }
@@ -425,112 +494,25 @@ impl Slam {
         // … and at most `loop_closure_max_points` of them, evenly spread over the scan.
         let stride = near.len().div_ceil(self.p.loop_closure_max_points.max(1)).max(1);
         let search_points = near.into_iter().step_by(stride).collect();
-        self.nodes.push(Node { stamp, local, track, graph: g, points: hits, search_points, submaps: into });
+        let path_m = self.nodes.last().map_or(0.0, |n| n.path_m + n.local.translation().distance(local.translation()));
+        for &s in &into {
+            let origin = self.submaps.all()[s].local_pose.translation();
+            self.loops.footprints[s].add(Point2::new(local.x - origin.x, local.y - origin.y), path_m);
+        }
+        self.nodes.push(Node { stamp, local, track, graph: g, points: hits, search_points, submaps: into, path_m });
         self.report.nodes += 1;
         self.attach_fixes(stamp, self.nodes.len() - 1);
         self.report.submaps = self.submaps.all().len();
         if self.p.loop_closure {
-            let t0 = Instant::now();
-            if let Some(f) = finished {
-                self.finished[f] = true;
-                self.grids.get(f, &self.submaps.all()[f].grid);
-                self.search_nodes_against(f);
-            }
-            self.search_submaps_for(self.nodes.len() - 1);
-            self.report.loop_search_s += t0.elapsed().as_secs_f64();
+            self.loop_closure_after_node(finished);
         }
         self.since_optimisation += 1;
-        let news = self.closures_since_optimisation + self.fixes.since_optimisation;
-        if self.since_optimisation >= self.p.optimize_every_n_nodes && news > 0 {
+        let news = self.loops.since_optimisation + self.fixes.since_optimisation;
+        let travelled = self.nodes.last().map_or(0.0, |n| n.path_m) - self.optimised_at_m;
+        let due = self.since_optimisation >= self.p.optimize_every_n_nodes && travelled >= self.p.optimize_every_m;
+        if self.loops.optimise_now || (due && news > 0) {
             self.optimise();
         }
-    }
-
-    /// True when finished submap `s` is a candidate for node `n`: not one the node went
-    /// into, and near it in the current estimate.
-    fn candidate(&self, n: usize, s: usize) -> Option<f64> {
-        let node = &self.nodes[n];
-        if !self.finished[s] || node.submaps.contains(&s) {
-            return None;
-        }
-        let (gn, gs) = (self.graph.nodes()[node.graph], self.graph.nodes()[self.submap_graph[s]]);
-        let d = (gn.x - gs.x).hypot(gn.y - gs.y);
-        (d <= self.p.loop_closure_max_distance_m).then_some(d)
-    }
-
-    /// A sampled new node against the nearest finished submaps (Hess et al. 2016 search
-    /// every node against every submap in reach, sampled; offline, a few nearest per node
-    /// are enough and bound the cost).
-    fn search_submaps_for(&mut self, n: usize) {
-        self.node_sampler += self.p.loop_closure_sampling_ratio;
-        if self.node_sampler < 1.0 {
-            return;
-        }
-        self.node_sampler -= 1.0;
-        let mut near: Vec<(f64, usize)> =
-            (0..self.submaps.all().len()).filter_map(|s| self.candidate(n, s).map(|d| (d, s))).collect();
-        near.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for &(_, s) in near.iter().take(self.p.loop_closure_submaps_per_node) {
-            self.search(n, s);
-        }
-    }
-
-    /// Earlier nodes, evenly sampled, against a submap just finished: a place revisited
-    /// later is found from both ends.
-    fn search_nodes_against(&mut self, s: usize) {
-        let near: Vec<usize> = (0..self.nodes.len()).filter(|&n| self.candidate(n, s).is_some()).collect();
-        let budget = self.p.loop_closure_nodes_per_submap;
-        let stride = near.len().div_ceil(budget.max(1)).max(1);
-        for &n in near.iter().step_by(stride) {
-            self.search(n, s);
-        }
-    }
-
-    /// Searches node `n` against finished submap `s` for a loop closure.
-    fn search(&mut self, n: usize, s: usize) {
-        let node = &self.nodes[n];
-        let (gn, gs) = (self.graph.nodes()[node.graph], self.graph.nodes()[self.submap_graph[s]]);
-        if !self.finished[s] {
-            return;
-        }
-        let sm = &self.submaps.all()[s];
-        let pre = self.grids.get(s, &sm.grid);
-        let initial = sm.local_pose.compose(gs.inverse().compose(gn));
-        let search = GlobalSearch {
-            linear_window_m: self.p.loop_closure_linear_window_m,
-            angular_window_rad: self.p.loop_closure_angular_window_rad,
-            min_score: self.p.loop_closure_min_score,
-            depth: self.p.branch_and_bound_depth,
-        };
-        self.report.loop_searches += 1;
-        let Some(found) = match_branch_and_bound(pre, &node.search_points, initial, &search) else {
-            self.report.loop_rejected += 1;
-            return;
-        };
-        let pose = refine(&sm.grid, &node.points, found.pose, found.pose, &self.p.local);
-        let score = mean_probability(&sm.grid, &node.points, pose);
-        if score < self.p.loop_closure_min_score {
-            self.report.loop_rejected += 1;
-            return;
-        }
-        // A closure along a corridor fits anywhere in the window: it would hold the node
-        // wherever the search happened to stop, against the odometry and the fixes.
-        if match_information(&sm.grid, &node.points, pose, &self.p.local).1 {
-            self.report.loop_rejected += 1;
-            self.report.loop_degenerate += 1;
-            return;
-        }
-        let e = Edge {
-            from: self.submap_graph[s],
-            to: node.graph,
-            measurement: sm.local_pose.inverse().compose(pose),
-            information: information_diag(self.p.loop_closure_sigma_m, self.p.loop_closure_sigma_rad),
-            loss: Loss::Huber(self.p.loop_closure_huber),
-            kind: EdgeKind::LoopClosure,
-        };
-        self.graph.add_edge(e).expect("valid loop-closure edge");
-        self.report.loop_accepted += 1;
-        self.closures_since_optimisation += 1;
     }
 
     fn optimise(&mut self) {
@@ -541,30 +523,46 @@ impl Slam {
             self.graph.set_fixed(first.graph, false);
         }
         let opts = OptimizeOptions::default();
-        match self.graph.optimize(&opts) {
-            Ok(r) => {
-                self.report.optimisations += 1;
-                self.report.last_optimisation = Some(r);
+        // Huber first, from wherever the graph stands: closures pull with a bounded force,
+        // so the right ones (the many that agree) bring the graph to them. Then dynamic
+        // covariance scaling from there: a closure the rest of the graph disagrees with
+        // stops pulling at all (Agarwal et al. 2013). Odometry and matches stay least
+        // squares: they are the inliers everything is judged by.
+        let huber = Loss::Huber(self.p.loop_closure_huber);
+        let schedule = [huber, Loss::Dcs(self.p.loop_closure_dcs)];
+        for loss in schedule {
+            self.graph.set_loss_of(EdgeKind::LoopClosure, loss).expect("valid loss");
+            match self.graph.optimize(&opts) {
+                Ok(r) => {
+                    self.report.optimisations += 1;
+                    self.report.last_optimisation = Some(r);
+                }
+                Err(e) => self.report.optimisation_failures.push(e.to_string()),
             }
-            Err(e) => self.report.optimisation_failures.push(e.to_string()),
         }
         if let Some(n) = self.nodes.last() {
             self.global_from_local = self.graph.nodes()[n.graph].compose(n.local.inverse());
         }
         self.since_optimisation = 0;
-        self.closures_since_optimisation = 0;
+        self.optimised_at_m = self.nodes.last().map_or(0.0, |n| n.path_m);
+        self.loops.since_optimisation = 0;
+        self.loops.optimise_now = false;
         self.fixes.since_optimisation = 0;
+        self.reindex();
+        self.update_drift();
         self.report.optimisation_s += t0.elapsed().as_secs_f64();
     }
 
     /// Optimises once more and returns every scan's pose.
     pub fn finish(mut self) -> SlamResult {
-        self.report.grids_built = self.grids.built;
-        self.report.grids_peak_bytes = self.grids.peak_bytes;
+        self.finish_loops();
         if let Some(last) = self.nodes.len().checked_sub(1) {
             self.attach_fixes(Stamp(i64::MAX), last + 1);
             self.optimise();
         }
+        self.report.grids_built = self.grids.built;
+        self.report.grids_peak_bytes = self.grids.peak_bytes;
+        self.report.odometry_scale = self.odometry.scales();
         // Without a node (no scan), every fix is left unplaced, and counted.
         self.report.fixes_unplaced += self.fixes.pending() as u64;
         let trajectory = self
@@ -584,6 +582,7 @@ impl Slam {
             submap_nodes: self.submap_graph,
             graph: self.graph,
             report: self.report,
+            open_loops: self.loops.open,
         }
     }
 }

@@ -3,24 +3,29 @@
 //! | step | module |
 //! |---|---|
 //! | a submap's probability grid | `grid.rs` |
+//! | the likelihood field scans are matched against | `field.rs` |
 //! | its smooth (bicubic) interpolation | `interpolation.rs` |
 //! | correlative search + Gauss–Newton refinement + information | `local_match.rs` |
 //! | two active submaps, finished ones kept | `submap.rs` |
 //! | branch-and-bound loop-closure search | `global_match.rs` |
 //! | its precomputed grids within a memory budget | `grid_cache.rs` |
+//! | which pairs are searched, in parallel batches, and which matches are kept | `loop_closure.rs` |
 //! | sparse pose-graph optimisation | `pose_graph.rs` |
 //! | GNSS fixes as position priors on nodes | `fixes.rs` |
 //! | the loop over scans | `mapper.rs` |
 //! | the corrected pose track | `corrected_track.rs` |
 //! | the matcher's exact two-way parallelism | `parallel.rs` |
 mod corrected_track;
+pub mod field;
 mod fixes;
 pub mod global_match;
 pub mod grid;
 mod grid_cache;
 pub mod interpolation;
 pub mod local_match;
+mod loop_closure;
 mod mapper;
+mod odometry;
 mod parallel;
 mod params;
 pub mod pose_graph;
@@ -32,7 +37,9 @@ mod test_world;
 pub use corrected_track::CorrectedTrack;
 pub use fixes::PositionFix;
 pub use local_match::LocalMatchParams;
+pub use loop_closure::{OpenReason, OpenSearch};
 pub use mapper::{ScanInput, ScanOutcome, Slam, SlamResult};
 pub use parallel::adopt_calling_thread;
 pub use params::SlamParams;
 pub use report::SlamReport;
+pub use submap::SubmapBounds;

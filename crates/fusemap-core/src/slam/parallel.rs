@@ -51,6 +51,20 @@ pub fn adopt_calling_thread() {
     }
 }
 
+/// `items.iter().map(f)` collected in order, the items spread over every thread of the
+/// pool (rayon's indexed parallel iterator keeps the order whatever the split).
+pub fn map_all<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync + Send) -> Vec<R> {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        items.par_iter().map(f).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        items.iter().map(f).collect()
+    }
+}
+
 /// `items.iter().map(f)` collected in order, the two halves computed by [`join`].
 pub fn map_halves<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
     let (left, right) = items.split_at(items.len() / 2);
@@ -70,5 +84,6 @@ mod tests {
         assert!(map_halves(&[] as &[u32], |x| *x).is_empty());
         assert_eq!(join(|| 1, || "b"), (1, "b"));
         assert_eq!(on_worker(|| join(|| 2, || 3)), (2, 3));
+        assert_eq!(map_all(&v, |x| x + 1), (1..12).collect::<Vec<_>>());
     }
 }

@@ -1,6 +1,7 @@
 //! Parameters of the SLAM back end, with the reasons for their defaults.
 
 use super::local_match::LocalMatchParams;
+use super::submap::SubmapBounds;
 
 /// Everything [`Slam`](super::Slam) can be tuned by. The `[slam]` config section maps onto
 /// it key by key.
@@ -8,13 +9,17 @@ use super::local_match::LocalMatchParams;
 pub struct SlamParams {
     /// Submap cell size, metres. 5 cm, as Hess et al. 2016 use for 2D.
     pub resolution: f64,
-    /// Scans each submap takes before the next starts (the older active submap then holds
-    /// twice as many when it is finished).
-    pub scans_per_submap: usize,
+    /// When a submap is full and the next starts (the older active submap then holds twice
+    /// as much when it is finished): metres driven, radians turned, scans taken.
+    pub submap: SubmapBounds,
     /// Probability of a return's cell being occupied (one update).
     pub hit_probability: f32,
     /// Probability of a crossed cell being occupied (one update).
     pub miss_probability: f32,
+    /// σ of the likelihood field scans are matched against (`field.rs`), metres: the
+    /// spread of a return around the wall it came from (range noise, the cell, the scan's
+    /// own pose error).
+    pub field_sigma_m: f64,
     /// Returns farther than this are not used for matching or submaps, metres: far returns
     /// grow the submaps and their angular error is largest.
     pub max_range_m: f64,
@@ -54,10 +59,16 @@ pub struct SlamParams {
     pub loop_closure: bool,
     /// Share of nodes searched for a loop closure against the finished submaps near them.
     pub loop_closure_sampling_ratio: f64,
+    /// … and only once this much travel separates it from the last node searched, metres:
+    /// the rate follows the distance driven, not the scan rate.
+    pub loop_closure_node_spacing_m: f64,
     /// A sampled node is searched against at most this many nearest finished submaps.
     pub loop_closure_submaps_per_node: usize,
     /// A submap just finished is searched by at most this many earlier nodes near it.
     pub loop_closure_nodes_per_submap: usize,
+    /// Two submaps already tied by this many accepted closures are not searched against
+    /// each other again (0: no limit): more matches of the same overlap add little.
+    pub loop_closure_links_per_pair: usize,
     /// Returns farther than this are left out of the branch-and-bound search (its angular
     /// step, hence its cost, follows the farthest point), metres.
     pub loop_closure_max_range_m: f64,
@@ -74,14 +85,52 @@ pub struct SlamParams {
     pub loop_closure_angular_window_rad: f64,
     /// Minimum mean probability of a loop closure's points.
     pub loop_closure_min_score: f32,
-    /// Huber scale of loop-closure edges (whitened units).
+    /// Huber scale of loop-closure edges (whitened units), in the first pass of every
+    /// optimisation.
     pub loop_closure_huber: f64,
+    /// Φ of the dynamic covariance scaling of loop-closure edges in the second pass
+    /// (whitened units): a closure whose χ² exceeds it pulls less, and one far beyond it
+    /// not at all.
+    pub loop_closure_dcs: f64,
+    /// The search window grows by this many metres per metre driven since the last
+    /// accepted closure (the drift the estimate may have gathered) …
+    pub loop_closure_window_growth: f64,
+    /// … and by this many radians per metre …
+    pub loop_closure_angular_growth_rad_per_m: f64,
+    /// … up to this half-width, metres.
+    pub loop_closure_max_linear_window_m: f64,
+    /// A closure moving its node by at most this much (metres) …
+    pub loop_closure_accept_shift_m: f64,
+    /// … and this much (radians) from where the graph has it becomes an edge at once.
+    pub loop_closure_accept_shift_rad: f64,
+    /// A closure moving the node by more is a hypothesis until a later node, searched
+    /// within this half-width (metres) …
+    pub loop_closure_confirm_linear_window_m: f64,
+    /// … and this (radians) around where the hypothesis puts it, agrees …
+    pub loop_closure_confirm_angular_window_rad: f64,
+    /// … within this much travel, metres.
+    pub loop_closure_confirm_within_m: f64,
+    /// After this much travel without a closure, metres, every batch also searches the
+    /// newest node against finished submaps with no heading and no position …
+    pub loop_closure_global_after_m: f64,
+    /// … this many of them a batch (round robin) …
+    pub loop_closure_global_submaps_per_batch: usize,
+    /// … and needs this score.
+    pub loop_closure_global_min_score: f32,
+    /// Searches are run together every this many nodes …
+    pub loop_closure_batch_nodes: usize,
+    /// … within this much work a batch (grid lookups at the coarsest level of branch and
+    /// bound: angles × coarsest nodes × points).
+    pub loop_closure_work_per_batch: f64,
     /// σ of a loop closure (translation, metres).
     pub loop_closure_sigma_m: f64,
     /// σ of a loop closure (rotation, radians).
     pub loop_closure_sigma_rad: f64,
     /// Optimise the pose graph every this many new nodes (and once at the end).
     pub optimize_every_n_nodes: usize,
+    /// … and this much travel, metres (a log with a node every few centimetres would
+    /// otherwise optimise every few metres, most of its run time).
+    pub optimize_every_m: f64,
     /// Levels of the branch-and-bound precomputation.
     pub branch_and_bound_depth: usize,
     /// GNSS fixes given with [`Slam::add_fixes`](super::Slam::add_fixes) become position
@@ -97,9 +146,13 @@ impl Default for SlamParams {
     fn default() -> Self {
         Self {
             resolution: 0.05,
-            scans_per_submap: 60,
+            // About what 60 nodes made on the SLAM-benchmark logs (a node every 10 cm), now
+            // in metres: a log with a scan every metre gets submaps as large, not ten
+            // times larger. A full turn on the spot also fills one.
+            submap: SubmapBounds { distance_m: 6.0, rotation_rad: std::f64::consts::TAU, max_scans: 200 },
             hit_probability: 0.55,
             miss_probability: 0.49,
+            field_sigma_m: 0.05,
             max_range_m: 30.0,
             min_points: 20,
             node_distance_m: 0.1,
@@ -118,9 +171,11 @@ impl Default for SlamParams {
             odometry_rotation_per_rad: 0.1,
             odometry_floor_rad: 1f64.to_radians(),
             loop_closure: true,
-            loop_closure_sampling_ratio: 0.3,
+            loop_closure_sampling_ratio: 1.0,
+            loop_closure_node_spacing_m: 1.0,
             loop_closure_submaps_per_node: 6,
             loop_closure_nodes_per_submap: 20,
+            loop_closure_links_per_pair: 4,
             loop_closure_max_range_m: 12.0,
             loop_closure_max_points: 120,
             loop_closure_grid_cache_mib: 64,
@@ -129,6 +184,21 @@ impl Default for SlamParams {
             loop_closure_angular_window_rad: 20f64.to_radians(),
             loop_closure_min_score: 0.55,
             loop_closure_huber: 1.0,
+            loop_closure_dcs: 25.0,
+            loop_closure_window_growth: 0.05,
+            loop_closure_angular_growth_rad_per_m: 0.02f64.to_radians(),
+            loop_closure_max_linear_window_m: 50.0,
+            loop_closure_accept_shift_m: 1.0,
+            loop_closure_accept_shift_rad: 5f64.to_radians(),
+            loop_closure_confirm_linear_window_m: 0.3,
+            loop_closure_confirm_angular_window_rad: 3f64.to_radians(),
+            loop_closure_confirm_within_m: 10.0,
+            loop_closure_global_after_m: 50.0,
+            loop_closure_global_submaps_per_batch: 2,
+            loop_closure_global_min_score: 0.65,
+            loop_closure_batch_nodes: 10,
+            // About two hundred searches of the base window, or three of the widest.
+            loop_closure_work_per_batch: 5e7,
             // A closure is refined to a fraction of a cell like a local match (whose own σ
             // is capped at 5 mm, 0.05°): a fifth of a 5 cm cell, and the angle that moves a
             // point 3 m away by about that much. Beyond one σ the Huber loss makes a closure
@@ -136,7 +206,9 @@ impl Default for SlamParams {
             loop_closure_sigma_m: 0.01,
             loop_closure_sigma_rad: 0.2f64.to_radians(),
             optimize_every_n_nodes: 90,
-            branch_and_bound_depth: 7,
+            optimize_every_m: 10.0,
+            // Wide windows start at the coarsest level (levels_for); narrow ones lower.
+            branch_and_bound_depth: 9,
             fixes: true,
             // Nodes come every 10 cm or 5 s; the track's motion over half a second moves the
             // lever arm by far less than a fix's σ.

@@ -32,6 +32,11 @@ pub struct SlamReport {
     /// Scans whose track reading repeated the previous scan's bit for bit (a held reading:
     /// no motion information, not made a node).
     pub held_readings: u64,
+    /// Matched scans the track's motion was judged by (`odometry.rs`).
+    pub odometry_samples: u64,
+    /// What they made of the odometry model's σ at the end: the factors of its
+    /// translation and rotation (below 1: the track was better than the model).
+    pub odometry_scale: [f64; 2],
     /// Odometry edges left out: the odometry disagreed with the matched motion by > 5 σ.
     pub odometry_edges_rejected: u64,
     /// GNSS fixes given.
@@ -57,6 +62,18 @@ pub struct SlamReport {
     pub loop_rejected: u64,
     /// … of which degenerate: a match that fits anywhere along one direction (a corridor).
     pub loop_degenerate: u64,
+    /// … of which large corrections no later node confirmed.
+    pub loop_unconfirmed: u64,
+    /// … of which confirming searches that found nothing where the hypothesis put the node.
+    pub loop_disagreeing: u64,
+    /// Large corrections (a widened window or the global search) held as hypotheses.
+    pub loop_hypotheses: u64,
+    /// … confirmed by a second, agreeing match (both become edges).
+    pub loop_confirmed: u64,
+    /// … of which found by the global search.
+    pub loop_global_accepted: u64,
+    /// Searches left out because a batch was over its budget.
+    pub loop_over_budget: u64,
     /// Branch-and-bound grids built for finished submaps (first builds and rebuilds after
     /// the memory budget dropped them).
     pub grids_built: u64,

@@ -1,11 +1,22 @@
 //! Submaps: short-lived local maps that scans are matched against (Hess et al. 2016, §III).
 //!
-//! A submap is a probability grid built from a few dozen consecutive scans in the local
-//! SLAM frame, small enough that the drift inside it is negligible. Two are active at any
-//! time: every inserted scan goes into both, scans are matched against the older (which
-//! holds more of the surroundings), and when the newer has taken `scans_per_submap` scans
-//! the older one — now holding twice that — is finished and kept for loop closure.
+//! A submap is a probability grid built from consecutive scans in the local SLAM frame,
+//! small enough that the drift inside it is negligible. Two are active at any time: every
+//! inserted scan goes into both, scans are matched against the older (which holds more of
+//! the surroundings), and when the newer is full the older one — now holding twice that —
+//! is finished and kept for loop closure.
+//!
+//! "Full" is measured in what makes drift: metres driven and radians turned
+//! ([`SubmapBounds`]), not in scans. Hess et al. 2016 count range data (90 a submap), which
+//! suits a 40 Hz lidar at walking speed; a log with one scan per metre would then build
+//! submaps 90 m long, whose far ends disagree by the drift of 90 m. Bounded in metres, a
+//! slow keyframe log and a fast lidar get submaps of the same size.
+//!
+//! Each submap keeps two grids: its occupancy (a probability grid, updated in odds space)
+//! and the likelihood field derived from it (`field.rs`), which is what every matcher reads.
+//! A finished submap keeps only the field.
 
+use super::field::{self, Crossing, FieldKernel};
 use super::grid::{ProbabilityGrid, UpdateTable};
 use crate::geometry::{Point2, Pose2};
 
@@ -15,34 +26,63 @@ pub struct Submap {
     /// Its frame in the local SLAM frame: the position of its first scan, axes of the
     /// local frame (the grid is axis-aligned in the local frame).
     pub local_pose: Pose2,
-    /// The grid, cells in local-frame coordinates.
+    /// The likelihood field scans are matched against, cells in local-frame coordinates.
     pub grid: ProbabilityGrid,
+    /// The occupancy the field is derived from (emptied when the submap is finished).
+    pub occupancy: ProbabilityGrid,
     /// Scans inserted.
     pub scans: usize,
     /// No more scans go in.
     pub finished: bool,
 }
 
+/// When the newer active submap is full.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SubmapBounds {
+    /// Metres driven since it began.
+    pub distance_m: f64,
+    /// Radians turned since it began (the sum of the absolute turns).
+    pub rotation_rad: f64,
+    /// Scans inserted (a robot at rest still adds one every few seconds).
+    pub max_scans: usize,
+}
+
 /// The two active submaps and the finished ones.
 #[derive(Debug)]
 pub struct Submaps {
     resolution: f64,
-    scans_per_submap: usize,
+    bounds: SubmapBounds,
+    /// Distance and rotation since the newest submap began, and the last scan's pose.
+    travel: (f64, f64, Option<Pose2>),
+    /// The newest submap is full: the next scan starts another.
+    newest_full: bool,
     hit: UpdateTable,
     miss: UpdateTable,
+    kernel: FieldKernel,
+    crossings: Vec<Crossing>,
     all: Vec<Submap>,
     /// Indices of the active submaps (oldest first).
     active: Vec<usize>,
 }
 
 impl Submaps {
-    /// No submap yet.
-    pub fn new(resolution: f64, scans_per_submap: usize, hit_probability: f32, miss_probability: f32) -> Self {
+    /// No submap yet; fields of σ `field_sigma_m`.
+    pub fn new(
+        resolution: f64,
+        bounds: SubmapBounds,
+        hit_probability: f32,
+        miss_probability: f32,
+        field_sigma_m: f64,
+    ) -> Self {
         Self {
             resolution,
-            scans_per_submap: scans_per_submap.max(1),
+            bounds: SubmapBounds { max_scans: bounds.max_scans.max(1), ..bounds },
+            travel: (0.0, 0.0, None),
+            newest_full: false,
             hit: UpdateTable::new(hit_probability),
             miss: UpdateTable::new(miss_probability),
+            kernel: FieldKernel::new(field_sigma_m, resolution),
+            crossings: Vec::new(),
             all: Vec::new(),
             active: Vec::new(),
         }
@@ -68,10 +108,19 @@ impl Submaps {
         hits: &[Point2],
         misses: &[Point2],
     ) -> (Vec<usize>, Option<usize>) {
-        if self.active.is_empty() || self.all[*self.active.last().unwrap()].scans >= self.scans_per_submap {
+        if let Some(last) = self.travel.2 {
+            let d = last.inverse().compose(pose);
+            self.travel.0 += d.x.hypot(d.y);
+            self.travel.1 += d.theta.abs();
+        }
+        self.travel.2 = Some(pose);
+        if self.active.is_empty() || self.newest_full {
+            self.newest_full = false;
+            self.travel = (0.0, 0.0, Some(pose));
             self.all.push(Submap {
                 local_pose: Pose2::new(pose.x, pose.y, 0.0),
                 grid: ProbabilityGrid::new(self.resolution),
+                occupancy: ProbabilityGrid::new(self.resolution),
                 scans: 0,
                 finished: false,
             });
@@ -79,17 +128,24 @@ impl Submaps {
         }
         for &i in &self.active {
             let s = &mut self.all[i];
-            s.grid.insert(origin, hits, misses, &self.hit, &self.miss);
+            self.crossings.clear();
+            s.occupancy.insert_tracking(origin, hits, misses, &self.hit, &self.miss, &mut self.crossings);
+            let occupancy = &s.occupancy;
+            field::update(&mut s.grid, &self.kernel, &self.crossings, |x, y| occupancy.probability(x, y) > 0.5);
             s.scans += 1;
         }
         let into = self.active.clone();
+        // The newest full: the next scan starts a submap, and the older one, which now
+        // holds twice as much, is finished.
+        let (b, (d, r, _)) = (self.bounds, self.travel);
+        let newest = &self.all[*self.active.last().expect("one active at least")];
+        self.newest_full = newest.scans >= b.max_scans || d >= b.distance_m || r >= b.rotation_rad;
         let mut finished = None;
-        if self.active.len() > 2
-            || (self.active.len() == 2 && self.all[self.active[0]].scans >= 2 * self.scans_per_submap)
-        {
+        if self.newest_full && self.active.len() == 2 {
             let i = self.active.remove(0);
             self.all[i].finished = true;
             self.all[i].grid.freeze();
+            self.all[i].occupancy = ProbabilityGrid::new(self.resolution);
             finished = Some(i);
         }
         (into, finished)
@@ -102,7 +158,8 @@ mod tests {
 
     #[test]
     fn two_submaps_overlap_and_the_older_finishes_at_twice_the_size() {
-        let mut s = Submaps::new(0.05, 3, 0.55, 0.49);
+        let bounds = SubmapBounds { distance_m: 1e9, rotation_rad: 1e9, max_scans: 3 };
+        let mut s = Submaps::new(0.05, bounds, 0.55, 0.49, 0.05);
         let hit = [Point2::new(2.0, 0.3)];
         let mut finished = Vec::new();
         let mut into_counts = Vec::new();
@@ -118,5 +175,30 @@ mod tests {
         assert!(s.all()[0].finished && !s.all()[2].finished);
         assert_eq!(s.matching().map(|(i, _)| i), Some(2));
         assert!((s.all()[1].local_pose.x - 0.3).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_submap_is_full_after_so_many_metres_or_radians_whatever_the_scan_rate() {
+        let bounds = SubmapBounds { distance_m: 2.0, rotation_rad: 1.0, max_scans: 1000 };
+        let hit = [Point2::new(2.0, 0.3)];
+        // 0.1 m a scan and 1 m a scan start their second submap after the same 2 m.
+        for step in [0.1, 1.0] {
+            let mut s = Submaps::new(0.05, bounds, 0.55, 0.49, 0.05);
+            let mut k = 0;
+            while s.all().len() < 2 {
+                let x = step * k as f64;
+                s.insert(Pose2::new(x, 0.0, 0.0), Point2::new(x, 0.0), &hit, &[]);
+                k += 1;
+            }
+            // The first scan past 2 m (rounding may leave the sum a hair short of it).
+            let x = s.all()[1].local_pose.x;
+            assert!((2.0 - 1e-9..=2.0 + step + 1e-9).contains(&x), "{step}: {x}");
+        }
+        // Turning on the spot: a new submap every radian.
+        let mut s = Submaps::new(0.05, bounds, 0.55, 0.49, 0.05);
+        for k in 0..=40 {
+            s.insert(Pose2::new(0.0, 0.0, 0.1 * k as f64), Point2::new(0.0, 0.0), &hit, &[]);
+        }
+        assert_eq!(s.all().len(), 4);
     }
 }

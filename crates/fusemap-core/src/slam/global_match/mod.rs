@@ -95,6 +95,25 @@ struct Problem {
     n: usize,
 }
 
+/// The work of a search, in grid lookups at the coarsest level: every angle times every
+/// coarsest node of the window times the points. What a batch's budget counts; the descent
+/// below the coarsest level adds a share that depends on the map, not the window.
+pub fn search_work(search: &GlobalSearch, resolution: f64, d_max: f64, points: usize, levels: usize) -> f64 {
+    let step = angular_step(resolution, d_max).max(1e-6);
+    let angles = 2.0 * (search.angular_window_rad.max(0.0) / step).ceil() + 1.0;
+    let w = (search.linear_window_m.max(0.0) / resolution).ceil();
+    let top = (1u64 << levels.clamp(1, 30).saturating_sub(1)) as f64;
+    let per_axis = (2.0 * w / top).floor() + 1.0;
+    angles * per_axis * per_axis * points as f64
+}
+
+/// The number of levels that leaves about six coarsest nodes across a window of
+/// `linear_window_m`, within `[1, max]`: a wide window starts coarser.
+pub fn levels_for(linear_window_m: f64, resolution: f64, max: usize) -> usize {
+    let w = (linear_window_m.max(0.0) / resolution).ceil().max(1.0);
+    (1 + (2.0 * w / 6.0).log2().ceil().max(0.0) as usize).clamp(1, max.max(1))
+}
+
 /// The angular step of eq. (7) for a scan reaching `d_max` on a grid of cell `r`.
 fn angular_step(r: f64, d_max: f64) -> f64 {
     let d = d_max.max(r);
@@ -212,8 +231,14 @@ impl Search<'_> {
 }
 
 /// The best leaf of the discretised problem whose byte sum reaches `need`, searching from
-/// height `levels − 1` (Algorithm 3).
-fn branch_and_bound(grids: &PrecomputedGrids, problem: &Problem, levels: usize, need: u32) -> Option<Candidate> {
+/// height `levels − 1` (Algorithm 3); and the best root (the coarsest node with the highest
+/// bound), which bounds every score of the window from above.
+fn branch_and_bound(
+    grids: &PrecomputedGrids,
+    problem: &Problem,
+    levels: usize,
+    need: u32,
+) -> (Option<Candidate>, Option<Candidate>) {
     let top = levels - 1;
     let step = 1usize << top;
     let w = problem.window;
@@ -228,14 +253,28 @@ fn branch_and_bound(grids: &PrecomputedGrids, problem: &Problem, levels: usize, 
             }
         }
     }
-    roots.sort_unstable_by_key(|c| std::cmp::Reverse(c.bound));
+    // Sorted by bound, ties by position: the best root does not depend on the sort.
+    roots.sort_unstable_by_key(|c| (std::cmp::Reverse(c.bound), c.scan, c.dx, c.dy));
     for &c in &roots {
         if i64::from(c.bound) <= state.floor {
             break;
         }
         state.descend(c, top);
     }
-    state.best
+    (state.best, roots.first().copied())
+}
+
+/// What a search found, and how near it came when it found nothing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SearchOutcome {
+    /// The best pose reaching the threshold.
+    pub found: Option<GlobalMatch>,
+    /// The found match's score; without one, an upper bound of every score in the window
+    /// (the best coarsest node's bound; `P_MIN` when there was nothing to score).
+    pub best_score: f32,
+    /// The found pose, or the best coarsest node, touches the window's edge (in x, y, or in
+    /// heading when the window is not the full circle): the true pose may lie beyond it.
+    pub on_edge: bool,
 }
 
 /// Finds the pose of a scan in a submap by branch and bound over the window `search`
@@ -250,26 +289,57 @@ pub fn match_branch_and_bound(
     initial: Pose2,
     search: &GlobalSearch,
 ) -> Option<GlobalMatch> {
+    search_branch_and_bound(grids, points, initial, search).found
+}
+
+/// [`match_branch_and_bound`], with what the search saw when it found nothing.
+pub fn search_branch_and_bound(
+    grids: &PrecomputedGrids,
+    points: &[Point2],
+    initial: Pose2,
+    search: &GlobalSearch,
+) -> SearchOutcome {
+    let nothing = SearchOutcome { found: None, best_score: P_MIN, on_edge: false };
     if !initial.is_finite() {
-        return None;
+        return nothing;
     }
     let levels = search.depth.clamp(1, grids.depth());
     let problem = Problem::new(grids, points, initial, search, levels);
     if problem.n == 0 {
-        return None;
+        return nothing;
     }
-    let need = problem.threshold(search.min_score)?;
-    let best = branch_and_bound(grids, &problem, levels, need)?;
+    let full_circle = search.angular_window_rad >= std::f64::consts::PI;
+    let last = problem.scans.len() as u32 - 1;
+    let w = problem.window;
+    let edge_angle = |c: &Candidate| !full_circle && (c.scan == 0 || c.scan == last);
+    let Some(need) = problem.threshold(search.min_score) else { return nothing };
+    let (best, root) = branch_and_bound(grids, &problem, levels, need);
+    let Some(best) = best else {
+        let step = 1i32 << (levels - 1);
+        return match root {
+            Some(c) => SearchOutcome {
+                found: None,
+                best_score: problem.score(u64::from(c.bound)),
+                on_edge: edge_angle(&c) || c.dx <= -w || c.dy <= -w || c.dx + step > w || c.dy + step > w,
+            },
+            None => nothing,
+        };
+    };
     let r = grids.resolution();
     let theta = problem.scans[best.scan as usize].theta;
-    Some(GlobalMatch {
+    let found = GlobalMatch {
         pose: Pose2::new(
             initial.x + f64::from(best.dx) * r,
             initial.y + f64::from(best.dy) * r,
             normalize_angle(theta),
         ),
         score: problem.score(u64::from(best.bound)),
-    })
+    };
+    SearchOutcome {
+        found: Some(found),
+        best_score: found.score,
+        on_edge: edge_angle(&best) || best.dx.abs() == w || best.dy.abs() == w,
+    }
 }
 
 #[cfg(test)]

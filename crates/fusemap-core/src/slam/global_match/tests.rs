@@ -205,7 +205,11 @@ proptest! {
         let problem = Problem::new(&grids, &points, initial, &search, depth);
         let need = problem.threshold(min_score).expect("reachable threshold");
         let exhaustive = brute_force(&grids, &problem).expect("a non-empty window");
-        let found = branch_and_bound(&grids, &problem, depth, need);
+        let (found, root) = branch_and_bound(&grids, &problem, depth, need);
+        // The best root bounds every leaf of the window from above.
+        prop_assert!(root.expect("a non-empty window").bound >= exhaustive.bound);
+        let outcome = search_branch_and_bound(&grids, &points, initial, &search);
+        prop_assert!(outcome.best_score >= problem.score(u64::from(exhaustive.bound)));
         if exhaustive.bound >= need {
             let found = found.expect("branch and bound misses a pose the exhaustive search accepts");
             prop_assert_eq!(found.bound, exhaustive.bound);
@@ -218,6 +222,7 @@ proptest! {
         } else {
             prop_assert_eq!(found, None);
             prop_assert_eq!(match_branch_and_bound(&grids, &points, initial, &search), None);
+            prop_assert!(outcome.found.is_none());
         }
     }
 
