@@ -222,7 +222,7 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
                         }),
                     });
                 }
-                Track::ScanLine => {
+                Track::ScanLine(_) => {
                     sync = Some(Sync {
                         topic: topic.clone(),
                         scans: stamps.len() as u64,

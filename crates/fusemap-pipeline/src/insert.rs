@@ -73,6 +73,8 @@ pub(crate) struct Inserter<'a> {
     pub(crate) scan: LaserScan,
     pub(crate) last: Option<Stamp>,
     pub(crate) line_trajectory: Vec<(Stamp, Pose2)>,
+    /// Lines met so far by their key (the `k`-th line with a key takes the `k`-th pose).
+    pub(crate) lines_seen: std::collections::HashMap<crate::recording::LineKey, usize>,
     /// The next observation id: one per scan released by the merge, so that every insert
     /// is named (evidence of one instant from several sensors will share one).
     pub(crate) next_id: u64,
@@ -101,15 +103,32 @@ impl Inserter<'_> {
         let id = ObservationId(self.next_id);
         self.next_id += 1;
         match self.track {
-            Track::ScanLine => {
-                let Some(pose) = msg.pose.filter(|p| p.is_finite()) else {
+            Track::ScanLine(corrected) => {
+                let Some(line) = msg.pose.filter(|p| p.is_finite()) else {
                     l.report.scans_skipped.no_pose_on_line += 1;
                     return Ok(());
                 };
-                if l.line_glitches.contains(&line_key(stamp, pose)) {
-                    l.report.scans_skipped.pose_glitch += 1;
+                let key = line_key(stamp, line);
+                let glitch = l.line_glitches.contains(&key);
+                // A line SLAM placed takes its optimised pose; one it did not (its pose was
+                // a glitch) is interpolated between its neighbours in time, where it can be.
+                let pose = match corrected {
+                    None if glitch => None,
+                    None => Some(line),
+                    Some(c) => {
+                        let k = self.lines_seen.entry(key).or_insert(0);
+                        *k += 1;
+                        let placed = if glitch { None } else { c.pose(stamp, line, *k - 1) };
+                        placed.or_else(|| c.interpolated(stamp))
+                    }
+                };
+                let Some(pose) = pose else {
+                    match glitch {
+                        true => l.report.scans_skipped.pose_glitch += 1,
+                        false => l.report.scans_skipped.no_pose_on_line += 1,
+                    }
                     return Ok(());
-                }
+                };
                 // Line poses do not depend on the stamp: applied in file order.
                 scan.stamp = self.last.map_or(stamp, |last| last.max(stamp));
                 self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;

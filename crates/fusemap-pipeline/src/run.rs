@@ -158,6 +158,10 @@ pub fn prepare_track(plan: &Plan, inv: &Inventory) -> Result<(Bound, ChosenTrack
     Ok((bound, chosen, t0.elapsed().as_secs_f64()))
 }
 
+/// A SLAM run that leaves more than this share of its scans without an optimised pose is
+/// reported with a warning, not as a correction.
+const LOST_POSES_NOTE_SHARE: f64 = 0.01;
+
 /// [`prepare_track`], then SLAM corrects the track when [`crate::slam::applies`] says so.
 pub fn prepare(plan: &Plan, inv: &Inventory) -> Result<(Bound, ChosenTrack, f64), PipelineError> {
     prepare_with(plan, inv, &mut |_| {})
@@ -176,9 +180,23 @@ pub fn prepare_with(
     }
     let t0 = Instant::now();
     let mut run = crate::slam::run(plan, inv, &bound, &chosen, reason, progress)?;
-    let mut track = crate::slam::track(plan, chosen, &mut run);
+    let mut track = crate::slam::track(chosen, &mut run);
+    // Scans SLAM was given but left without an optimised pose: a few (a refused reading)
+    // are normal; more means the run did not correct the log (equal stamps collapsing the
+    // track did this once), and the note says so instead of "corrected".
+    let given = run.summary.counts.scans;
+    let placed = run.summary.scan_poses.len() as u64;
+    let lost = given.saturating_sub(placed);
+    let verb = if lost as f64 > LOST_POSES_NOTE_SHARE * given as f64 {
+        format!(
+            "WARNING: SLAM lost the pose of {lost} of {given} scans ({:.1} %), which keep the uncorrected track; the map may be wrong",
+            100.0 * lost as f64 / given.max(1) as f64
+        )
+    } else {
+        "SLAM corrected the poses".to_string()
+    };
     track.notes.push(format!(
-        "SLAM corrected the poses ({}): {} scans matched ({} degenerate), {} nodes, {} submaps, {} of {} loop-closure searches accepted",
+        "{verb} ({}): {} scans matched ({} degenerate), {} nodes, {} submaps, {} of {} loop-closure searches accepted",
         run.summary.reason,
         run.summary.counts.matched + run.summary.counts.degenerate,
         run.summary.counts.degenerate,
@@ -226,7 +244,7 @@ pub fn map_with_track(
     let first_stamps = &inv.scans[&bound.lidars[0].topic].stamps;
     let mode = sync_mode(cfg, first_stamps);
     let window = match chosen.track {
-        Track::ScanLine => 0,
+        Track::ScanLine(_) => 0,
         Track::Timed(_) => offset_ns(cfg.reorder_window_s),
     };
     let mut merge: OrderedMerge<RangeMessage> = OrderedMerge::new(window);
@@ -256,7 +274,7 @@ pub fn map_with_track(
         let timing = StreamTiming::analyze(&topic.stamps, &topic.receive, limits(cfg));
         let scans_reordered = match chosen.track {
             Track::Timed(_) => count_reordered(topic.stamps.iter().copied()),
-            Track::ScanLine => 0,
+            Track::ScanLine(_) => 0,
         };
         lidars.push(Mapped {
             id,
@@ -277,7 +295,7 @@ pub fn map_with_track(
                 extrinsics: ext,
             },
             line_glitches: match chosen.track {
-                Track::ScanLine => topic.line_glitches(&cfg.motion_limits()),
+                Track::ScanLine(_) => topic.line_glitches(&cfg.motion_limits()),
                 Track::Timed(_) => HashSet::new(),
             },
             bad_angles_example: None,
@@ -354,6 +372,7 @@ pub fn map_with_track(
         scan: LaserScan { stamp: Stamp::ZERO, angle_min: 0.0, angle_increment: 0.0, ranges: Vec::new() },
         last: None,
         line_trajectory: Vec::new(),
+        lines_seen: Default::default(),
         next_id: 0,
     };
     let t_map = Instant::now();
@@ -363,7 +382,7 @@ pub fn map_with_track(
             RangeMessage::Scan(scan) => {
                 let Some(l) = lidars.iter_mut().find(|l| l.report.topic == scan.topic) else { return Ok(()) };
                 let key = match chosen.track {
-                    Track::ScanLine => {
+                    Track::ScanLine(_) => {
                         seq += 1;
                         seq
                     }
@@ -408,7 +427,7 @@ pub fn map_with_track(
     let map_s = t_map.elapsed().as_secs_f64();
     let _ = read_s;
     let trajectory = match &chosen.track {
-        Track::ScanLine => std::mem::take(&mut inserter.line_trajectory),
+        Track::ScanLine(_) => std::mem::take(&mut inserter.line_trajectory),
         Track::Timed(t) => t.samples(),
     };
     drop(inserter);

@@ -18,14 +18,14 @@ use crate::merge::{OrderedMerge, Pushed};
 use crate::recording::{for_each_range_message, line_key, Inventory, RangeMessage};
 use crate::run::{sync_mode, Progress};
 use crate::sensors::Bound;
-use crate::track::{ChosenTrack, TfTrack, Track, TrackCounts};
+use crate::track::{ChosenTrack, LinePoses, TfTrack, Track};
 use crate::PipelineError;
 use fusemap_core::config::{Plan, PoseSource, SlamMode};
 use fusemap_core::estimator::{EstimatorInput, FixQuality};
 use fusemap_core::geometry::{PlanarMount, Point2, Pose2};
 use fusemap_core::slam::pose_graph::EdgeKind;
-use fusemap_core::slam::{CorrectedTrack, PositionFix, ScanInput, Slam, SlamReport, SlamResult};
-use fusemap_core::time::{PoseBuffer, Stamp, SyncMode};
+use fusemap_core::slam::{CorrectedTrack, PositionFix, ScanInput, ScanOutcome, Slam, SlamReport, SlamResult};
+use fusemap_core::time::{Stamp, SyncMode};
 use fusemap_io::log::ScanMessage;
 use serde::Serialize;
 use std::collections::HashMap;
@@ -85,6 +85,11 @@ pub struct SlamSummary {
     pub edges: Vec<GraphEdge>,
     /// Its GNSS position priors.
     pub priors: Vec<GraphPrior>,
+    /// The loop-closure searches that closed no loop: node and submap (indices into
+    /// `nodes`), the best score (or an upper bound of it when
+    /// nothing reached the threshold), the reason, and whether the best pose lay on the
+    /// window's edge.
+    pub open_loops: Vec<fusemap_core::slam::OpenSearch>,
     /// The lidar's pose in the base frame, `[x, y, yaw]` (metres, radians). The
     /// trajectory is the base frame's; the SLAM benchmark's relations are between laser
     /// poses, so `fusemap relations --sensor-in-base` composes the two.
@@ -92,6 +97,10 @@ pub struct SlamSummary {
     /// Every scan's optimised pose (in `trajectory.tum` through the track, not here).
     #[serde(skip)]
     pub scan_poses: Vec<(Stamp, Pose2)>,
+    /// With poses on the scan lines: each scan's stamp and line pose, in the order of
+    /// `scan_poses` (`None` for a line without a usable pose).
+    #[serde(skip)]
+    pub lines: Vec<Option<(Stamp, Pose2)>>,
 }
 
 /// The SLAM pass's result: the summary, with every scan's optimised pose.
@@ -169,16 +178,17 @@ pub fn run(
     let mut slam = Slam::new(plan.slam);
     slam.add_fixes(&fixes(plan, inv, bound, chosen, mode)?);
     let line_glitches = match chosen.track {
-        Track::ScanLine => inv.scans[&b.topic].line_glitches(&cfg.motion_limits()),
+        Track::ScanLine(_) => inv.scans[&b.topic].line_glitches(&cfg.motion_limits()),
         Track::Timed(_) => Default::default(),
     };
     // The track refuses to interpolate across its gaps (a map must not guess); a
     // prediction may: the match corrects it.
     let samples = match &chosen.track {
         Track::Timed(track) => track.samples(),
-        Track::ScanLine => Vec::new(),
+        Track::ScanLine(_) => Vec::new(),
     };
     let (mut without_pose, mut late) = (0u64, 0u64);
+    let mut lines: Vec<Option<(Stamp, Pose2)>> = Vec::new();
     let mut hits: Vec<Point2> = Vec::new();
     progress(Progress::Phase { name: "slam", total: stamps.len() as u64 });
     let topics = [b.topic.clone()];
@@ -194,7 +204,7 @@ pub fn run(
             return;
         }
         let pose = match &chosen.track {
-            Track::ScanLine => {
+            Track::ScanLine(_) => {
                 scan.pose.filter(|p| p.is_finite() && !line_glitches.contains(&line_key(scan.scan.stamp, *p)))
             }
             Track::Timed(track) => track.pose_at(t, mode).ok().or_else(|| across_gap(&samples, t)),
@@ -238,7 +248,10 @@ pub fn run(
                 }
             })
         }));
-        slam.add_scan(ScanInput { stamp: t, track: pose, origin, hits: &hits, misses: &[] });
+        let outcome = slam.add_scan(ScanInput { stamp: t, track: pose, origin, hits: &hits, misses: &[] });
+        if matches!(chosen.track, Track::ScanLine(_)) && outcome != ScanOutcome::Refused {
+            lines.push(pose.map(|p| (scan.scan.stamp, p)));
+        }
     };
     let mut seq = 0i64;
     for_each_range_message(&inv.path, &inv.limits, &topics, &[], |msg| {
@@ -248,7 +261,7 @@ pub fn run(
         }
         // Poses on the scan lines do not depend on the stamps: file order.
         let key = match chosen.track {
-            Track::ScanLine => {
+            Track::ScanLine(_) => {
                 seq += 1;
                 seq
             }
@@ -272,6 +285,7 @@ pub fn run(
     let mut summary = summary(&result, reason, b.topic.clone(), without_pose, late, t0.elapsed().as_secs_f64());
     let sensor = mount.base_from_sensor;
     summary.sensor_in_base = [sensor.x, sensor.y, sensor.theta];
+    summary.lines = lines;
     Ok(SlamRun { summary })
 }
 
@@ -374,8 +388,18 @@ fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, lat
         nodes,
         edges,
         priors,
+        open_loops: r
+            .open_loops
+            .iter()
+            .map(|o| fusemap_core::slam::OpenSearch {
+                node: r.scan_nodes[o.node],
+                submap: r.submap_nodes[o.submap],
+                ..*o
+            })
+            .collect(),
         sensor_in_base: [0.0; 3],
         scan_poses: r.trajectory.clone(),
+        lines: Vec::new(),
     }
 }
 
@@ -389,7 +413,7 @@ fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, lat
 /// relation error was 9.4 m against 0.02 m for the optimised poses. The graph already
 /// fuses the estimator's motion (with the fixes in it), the matches and the loop
 /// closures; the correction keeps its result exactly at every scan.
-pub fn track(plan: &Plan, chosen: ChosenTrack, run: &mut SlamRun) -> ChosenTrack {
+pub fn track(chosen: ChosenTrack, run: &mut SlamRun) -> ChosenTrack {
     match chosen.track {
         Track::Timed(base) => {
             run.summary.track = format!("{} corrected at every scan by the optimised pose graph", chosen.name);
@@ -399,17 +423,18 @@ pub fn track(plan: &Plan, chosen: ChosenTrack, run: &mut SlamRun) -> ChosenTrack
                 ..chosen
             }
         }
-        Track::ScanLine => {
-            run.summary.track = "the optimised scan poses, interpolated".into();
-            let mut counts = TrackCounts::default();
-            let buffer: PoseBuffer = crate::track::buffer_of(&plan.log, run.summary.scan_poses.clone(), &mut counts);
+        Track::ScanLine(_) => {
+            run.summary.track = "the optimised pose of every scan line, in file order".into();
+            let s = &run.summary;
+            let (lines, poses): (Vec<(Stamp, Pose2)>, Vec<Pose2>) = if s.lines.len() == s.scan_poses.len() {
+                s.lines.iter().zip(&s.scan_poses).filter_map(|(l, p)| Some(((*l)?, p.1))).unzip()
+            } else {
+                // Never expected: every scan fed to SLAM and not refused has one pose.
+                (Vec::new(), Vec::new())
+            };
             ChosenTrack {
-                source: PoseSource::Odometry,
-                track: Track::Timed(Box::new(buffer)),
+                track: Track::ScanLine(Some(LinePoses::new(&lines, &poses))),
                 name: "SLAM (scan matching + loop closure) over the odometry on the scan lines".into(),
-                counts,
-                stamps: run.summary.scan_poses.iter().map(|s| s.0).collect(),
-                receive: vec![None; run.summary.scan_poses.len()],
                 ..chosen
             }
         }

@@ -212,8 +212,13 @@ pub fn run_case(
                 format!("{k} {} {} {} {} {} {} {} {} {}\n", t.x, t.y, t.theta, o.x, o.y, o.theta, e.x, e.y, e.theta)
             })
             .collect();
-        let name = format!("{}-{}{suffix}.txt", log.name, drift.name());
-        std::fs::write(Path::new(&dir).join(name), lines).map_err(|e| PipelineError::Refused(e.to_string()))?;
+        let name = format!("{}-{}{suffix}", log.name, drift.name());
+        let write = |file: String, text: String| {
+            std::fs::write(Path::new(&dir).join(file), text).map_err(|e| PipelineError::Refused(e.to_string()))
+        };
+        write(format!("{name}.txt"), lines)?;
+        let graph = serde_json::json!({ "nodes": slam.nodes, "edges": slam.edges, "open": slam.open_loops });
+        write(format!("{name}.graph.json"), graph.to_string())?;
     }
     let path_m = truth.windows(2).map(|w| w[0].translation().distance(w[1].translation())).sum();
     let end = |v: &[Pose2]| v.last().map_or(Pose2::IDENTITY, |p| *p);

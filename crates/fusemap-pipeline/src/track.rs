@@ -40,8 +40,9 @@ pub struct TrackCounts {
 
 /// Where scans get their poses.
 pub enum Track {
-    /// From each scan line (CARMEN corrected logs).
-    ScanLine,
+    /// From each scan line (CARMEN corrected logs), or, after SLAM over them, from the
+    /// optimised pose of each line.
+    ScanLine(Option<LinePoses>),
     /// From a time-indexed track.
     Timed(Box<dyn PoseTrack>),
 }
@@ -66,6 +67,47 @@ pub struct ChosenTrack {
     pub notes: Vec<String>,
     /// What SLAM did, when it corrected the track.
     pub slam: Option<Box<crate::slam::SlamSummary>>,
+}
+
+/// SLAM's optimised poses of scan lines, found by the line's own stamp and pose: placed in
+/// file order, one per scan, whatever the stamps (some logs print every stamp as the same
+/// number, and a track by stamp would keep one pose of them all).
+#[derive(Clone, Debug, Default)]
+pub struct LinePoses {
+    by_line: std::collections::HashMap<crate::recording::LineKey, Vec<Pose2>>,
+    samples: Vec<(Stamp, Pose2)>,
+}
+
+impl LinePoses {
+    /// From the lines' `(stamp, pose on the line)` and their optimised poses, in file order.
+    pub fn new(lines: &[(Stamp, Pose2)], optimised: &[Pose2]) -> Self {
+        let mut out = Self::default();
+        for (&(t, line), &pose) in lines.iter().zip(optimised) {
+            out.by_line.entry(crate::recording::line_key(t, line)).or_default().push(pose);
+            out.samples.push((t, pose));
+        }
+        out
+    }
+
+    /// The optimised pose of the `k`-th line (0-based) with this stamp and line pose.
+    pub fn pose(&self, t: Stamp, line: Pose2, k: usize) -> Option<Pose2> {
+        self.by_line.get(&crate::recording::line_key(t, line))?.get(k).copied()
+    }
+
+    /// Every line's stamp and optimised pose, in file order.
+    pub fn samples(&self) -> &[(Stamp, Pose2)] {
+        &self.samples
+    }
+
+    /// The optimised pose at `t` interpolated between the nearest lines before and after
+    /// it in time, for a scan SLAM did not place (a line whose pose was a glitch); `None`
+    /// when no two lines with distinct stamps enclose `t` (an equal-stamp log).
+    pub fn interpolated(&self, t: Stamp) -> Option<Pose2> {
+        let before = self.samples.iter().filter(|s| s.0 < t).max_by_key(|s| s.0)?;
+        let after = self.samples.iter().filter(|s| s.0 > t).min_by_key(|s| s.0)?;
+        let f = (t.0 - before.0 .0) as f64 / (after.0 .0 - before.0 .0) as f64;
+        Some(before.1.interpolate(after.1, f))
+    }
 }
 
 /// `root_from_base` looked up in the frame tree at each stamp: the TF pose source when the
@@ -289,7 +331,7 @@ pub fn choose(
             }
             Ok(ChosenTrack {
                 source,
-                track: Track::ScanLine,
+                track: Track::ScanLine(None),
                 name: "pose on each scan line".into(),
                 notes: glitch_notes("pose on each scan line", &counts, cfg),
                 counts,

@@ -162,7 +162,7 @@ fn gyro_bias_and_odometry_scale_are_learnt() {
 fn timed(c: &ChosenTrack, t: Stamp) -> Option<Pose2> {
     match &c.track {
         Track::Timed(track) => track.pose_at(t, SyncMode::Interpolate).ok(),
-        Track::ScanLine => None,
+        Track::ScanLine(_) => None,
     }
 }
 

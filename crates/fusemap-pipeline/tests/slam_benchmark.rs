@@ -90,9 +90,16 @@ fn run(log: &str, relations: &str) -> Option<Run> {
     // the base frame's. Freiburg 079's laser sits 4 cm ahead of its base, the others' at it.
     let [x, y, yaw] = slam.sensor_in_base;
     let laser = Pose2::new(x, y, yaw);
-    let Track::Timed(track) = &chosen.track else { panic!("SLAM gives a timed track") };
-    let at = |t: &Stamp| track.pose_at(*t, SyncMode::Interpolate).ok().map(|p| (*t, p.compose(laser)));
-    let mut tracked: Vec<_> = stamps.iter().filter_map(at).collect();
+    // The track the map is built with: the corrected timed track, or the optimised pose of
+    // every scan line.
+    let mut tracked: Vec<_> = match &chosen.track {
+        Track::Timed(track) => stamps
+            .iter()
+            .filter_map(|t| track.pose_at(*t, SyncMode::Interpolate).ok().map(|p| (*t, p.compose(laser))))
+            .collect(),
+        Track::ScanLine(Some(lines)) => lines.samples().iter().map(|&(t, p)| (t, p.compose(laser))).collect(),
+        Track::ScanLine(None) => panic!("SLAM corrects the scan lines"),
+    };
     tracked.sort_by_key(|s| s.0);
     let odo_plan = {
         let mut c = Config::default();
@@ -105,7 +112,7 @@ fn run(log: &str, relations: &str) -> Option<Run> {
             .iter()
             .filter_map(|s| t.pose_at(*s, SyncMode::Interpolate).ok().map(|p| (*s, p.compose(laser))))
             .collect(),
-        Track::ScanLine => Vec::new(),
+        Track::ScanLine(_) => Vec::new(),
     };
     odometry.sort_by_key(|s| s.0);
     let scan_poses: Vec<(Stamp, Pose2)> = slam.scan_poses.iter().map(|&(t, p)| (t, p.compose(laser))).collect();
