@@ -95,6 +95,10 @@ fn wall_spread(out: &Path, w: &BoxWorld) -> (f64, usize) {
     (sum / n as f64, n)
 }
 
+/// The sync tests measure the sync alone, so SLAM is off: the odometry is the truth, and
+/// SLAM on this robot (spinning at 70°/s in a 12 m box) moves its heading by 1.3° on
+/// average (the likelihood field's heading bias on fast turns, an open issue), which
+/// would mask what the sync does to the walls.
 #[test]
 fn nearest_neighbour_sync_thickens_walls_through_the_cli() {
     let w = box_world(6.0, 3, 7);
@@ -106,7 +110,7 @@ fn nearest_neighbour_sync_thickens_walls_through_the_cli() {
             &dir,
             &format!("{sync}.toml"),
             format!(
-                "[[sensor]]\nkind = \"lidar\"\nmax_range = 20.0\n\n[log]\npose_source = \"odometry\"\nsync = \"{sync}\"\nnearest_tolerance_s = 0.05\n"
+                "[[sensor]]\nkind = \"lidar\"\nmax_range = 20.0\n\n[log]\npose_source = \"odometry\"\nsync = \"{sync}\"\nnearest_tolerance_s = 0.05\n\n[slam]\nmode = \"off\"\n"
             ),
         );
         let out = dir.join(sync);
@@ -146,7 +150,7 @@ fn de_skew_thins_walls_through_the_cli() {
         let cfg = write_file(
             &dir,
             &format!("deskew-{deskew}.toml"),
-            format!("[[sensor]]\nkind = \"lidar\"\nmax_range = 20.0\n\n[log]\ndeskew = {deskew}\n"),
+            format!("[[sensor]]\nkind = \"lidar\"\nmax_range = 20.0\n\n[log]\ndeskew = {deskew}\n\n[slam]\nmode = \"off\"\n"),
         );
         let out = dir.join(format!("deskew-{deskew}"));
         let o =
