@@ -327,10 +327,7 @@ impl SlamConfig {
             odometry_floor_rad: positive("odometry_floor_deg", self.odometry_floor_deg)?.to_radians(),
             loop_closure: self.loop_closure,
             loop_closure_sampling_ratio: ratio,
-            loop_closure_node_spacing_m: non_negative(
-                "slam.loop_closure_node_spacing_m",
-                self.loop_closure_node_spacing_m,
-            )?,
+            loop_closure_node_spacing_m: non_negative("loop_closure_node_spacing_m", self.loop_closure_node_spacing_m)?,
             loop_closure_submaps_per_node: self.loop_closure_submaps_per_node,
             loop_closure_nodes_per_submap: self.loop_closure_nodes_per_submap,
             loop_closure_links_per_pair: self.loop_closure_links_per_pair,
