@@ -9,12 +9,15 @@ use fusemap_io::testdata::dataset;
 use fusemap_pipeline::slam_bench::{run_case, table_row, CaseResult, Drift, BENCH_LOGS, TABLE_HEADER};
 use std::path::PathBuf;
 
-/// A scratch directory for the rewritten logs, removed at the end.
+/// A scratch directory for the rewritten logs, one per bench call (tests run in parallel),
+/// removed at the end.
 struct Scratch(PathBuf);
 
 impl Scratch {
     fn new(name: &str) -> Self {
-        let p = std::env::temp_dir().join(format!("fusemap-slam-bench-{name}-{}", std::process::id()));
+        static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let p = std::env::temp_dir().join(format!("fusemap-slam-bench-{name}-{}-{k}", std::process::id()));
         std::fs::create_dir_all(&p).unwrap();
         Self(p)
     }
