@@ -511,11 +511,11 @@ impl Slam {
         let travelled = self.nodes.last().map_or(0.0, |n| n.path_m) - self.optimised_at_m;
         let due = self.since_optimisation >= self.p.optimize_every_n_nodes && travelled >= self.p.optimize_every_m;
         if self.loops.optimise_now || (due && news > 0) {
-            self.optimise();
+            self.optimise(false);
         }
     }
 
-    fn optimise(&mut self) {
+    fn optimise(&mut self, last: bool) {
         let t0 = Instant::now();
         // Fixes spread widely enough hold the graph in their frame: the first node is
         // then one more node, not the anchor.
@@ -527,10 +527,13 @@ impl Slam {
         // so the right ones (the many that agree) bring the graph to them. Then dynamic
         // covariance scaling from there: a closure the rest of the graph disagrees with
         // stops pulling at all (Agarwal et al. 2013). Odometry and matches stay least
-        // squares: they are the inliers everything is judged by.
+        // squares: they are the inliers everything is judged by. The DCS pass runs after a
+        // large correction and at the end, not at every periodic optimisation: it costs as
+        // much again (on the Intel bag half of all the optimisation time), and what a
+        // wrong closure bends in between, with Huber's bounded pull, it takes back.
         let huber = Loss::Huber(self.p.loop_closure_huber);
-        let schedule = [huber, Loss::Dcs(self.p.loop_closure_dcs)];
-        for loss in schedule {
+        let dcs = (last || self.loops.optimise_now).then_some(Loss::Dcs(self.p.loop_closure_dcs));
+        for loss in std::iter::once(huber).chain(dcs) {
             self.graph.set_loss_of(EdgeKind::LoopClosure, loss).expect("valid loss");
             match self.graph.optimize(&opts) {
                 Ok(r) => {
@@ -558,7 +561,7 @@ impl Slam {
         self.finish_loops();
         if let Some(last) = self.nodes.len().checked_sub(1) {
             self.attach_fixes(Stamp(i64::MAX), last + 1);
-            self.optimise();
+            self.optimise(true);
         }
         self.report.grids_built = self.grids.built;
         self.report.grids_peak_bytes = self.grids.peak_bytes;
