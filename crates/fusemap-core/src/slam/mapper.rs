@@ -125,7 +125,7 @@ pub struct SlamResult {
     /// Counts and timings.
     pub report: SlamReport,
     /// The loop-closure searches that closed no loop, and why (at most
-    /// [`MAX_OPEN_REPORTED`](super::loop_closure::MAX_OPEN_REPORTED)).
+    /// 100,000).
     pub open_loops: Vec<OpenSearch>,
 }
 
