@@ -7,11 +7,20 @@
 //! driven since the last accepted closure, so the window grows with it
 //! (`loop_closure_window_growth`, `loop_closure_angular_growth_rad_per_m`, up to
 //! `loop_closure_max_linear_window_m`), and so does the radius in which submaps count as
-//! near. After `loop_closure_global_after_m` without a closure, every batch also searches
-//! the newest node against a few finished submaps (round robin over all of them) with no
-//! heading and a window over the whole of each submap: a place revisited after more drift
-//! than any window allows is still found. (Cartographer searches globally only across
-//! trajectories, slam_toolbox not at all.)
+//! near. After `loop_closure_global_after_m` without closing a loop with a submap left
+//! behind (one last added to at least `loop_closure_max_distance_m` of travel before),
+//! every batch also searches the newest node against a few finished submaps (round robin
+//! over all of them) with no heading and a window over the whole of each submap: a place
+//! revisited after more drift than any window allows is still found. (Cartographer
+//! searches globally only across trajectories, slam_toolbox not at all.) The graph
+//! distance is no trigger for it: once a building's loops are tied it is short
+//! everywhere, and on the Intel bag the global search then took two thirds of all the
+//! search work.
+//!
+//! **How often.** At most one node per `loop_closure_node_spacing_m` of travel is searched
+//! against the submaps near it, so a 40 Hz log and one with a scan per metre search as
+//! often per metre; two submaps already tied by `loop_closure_links_per_pair` accepted
+//! closures are not searched against each other again.
 //!
 //! **When.** Pairs are collected as nodes arrive and searched every
 //! `loop_closure_batch_nodes` nodes (and before each optimisation and at the end): the
