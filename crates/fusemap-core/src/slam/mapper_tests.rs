@@ -69,6 +69,17 @@ fn run(truth: &[Pose2], track: &[Option<Pose2>], beams: usize) -> Run {
 }
 
 fn run_with(p: SlamParams, truth: &[Pose2], track: &[Option<Pose2>], beams: usize) -> Run {
+    run_observed(p, truth, track, beams, |_, _| {})
+}
+
+/// [`run_with`], calling `after(slam, i)` after the `i`-th scan.
+fn run_observed(
+    p: SlamParams,
+    truth: &[Pose2],
+    track: &[Option<Pose2>],
+    beams: usize,
+    mut after: impl FnMut(&mut Slam, usize),
+) -> Run {
     let world = World::room();
     let mut noise = Noise(7);
     let mut slam = Slam::new(p);
@@ -85,6 +96,7 @@ fn run_with(p: SlamParams, truth: &[Pose2], track: &[Option<Pose2>], beams: usiz
             .collect();
         let stamp = Stamp(1_000_000_000 + i as i64 * 100_000_000);
         slam.add_scan(ScanInput { stamp, track: *track, origin: Point2::new(0.0, 0.0), hits: &hits, misses: &[] });
+        after(&mut slam, i);
     }
     Run { result: slam.finish(), truth: truth.to_vec() }
 }
@@ -329,35 +341,16 @@ fn inject_false_closures(slam: &mut Slam, share: f64, rng: &mut crate::sim::Spli
 fn injected_false_closures_do_not_bend_the_trajectory() {
     let truth = ring_poses(2);
     let odo = odometry(&truth, 1);
-    let world = World::room();
+    let track: Vec<Option<Pose2>> = odo.iter().map(|p| Some(*p)).collect();
     let run_injecting = |share: f64| {
-        let mut noise = Noise(7);
         let mut rng = crate::sim::SplitMix64::new(11);
-        let mut slam = Slam::new(SlamParams::default());
         let mut injected = 0;
-        for (i, (pose, track)) in truth.iter().zip(&odo).enumerate() {
-            let hits: Vec<Point2> = world
-                .scan(*pose, 360, 30.0)
-                .into_iter()
-                .map(|q| {
-                    let r = q.x.hypot(q.y);
-                    let k = (r + 0.01 * noise.next()) / r;
-                    Point2::new(q.x * k, q.y * k)
-                })
-                .collect();
-            let stamp = Stamp(1_000_000_000 + i as i64 * 100_000_000);
-            slam.add_scan(ScanInput {
-                stamp,
-                track: Some(*track),
-                origin: Point2::new(0.0, 0.0),
-                hits: &hits,
-                misses: &[],
-            });
+        let r = run_observed(SlamParams::default(), &truth, &track, 360, |slam, i| {
             if share > 0.0 && (i == truth.len() / 2 || i + 1 == truth.len()) {
-                injected += inject_false_closures(&mut slam, share, &mut rng);
+                injected += inject_false_closures(slam, share, &mut rng);
             }
-        }
-        (slam.finish(), injected)
+        });
+        (r.result, injected)
     };
     let (clean, _) = run_injecting(0.0);
     assert!(clean.report.loop_accepted > 10, "{:?}", clean.report);
