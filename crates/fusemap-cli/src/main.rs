@@ -7,6 +7,7 @@ mod progress;
 mod summary;
 
 use clap::{Parser, Subcommand};
+use fusemap_core::metrics::RelationMatching;
 use std::path::PathBuf;
 
 /// Turns a robot's sensor observations into a probabilistic occupancy-grid map.
@@ -74,13 +75,13 @@ enum Command {
         trajectory: PathBuf,
         /// How far (milliseconds) a pose's stamp may lie from a relation's stamp; the
         /// nearest pose is taken.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = RelationMatching::TOLERANCE_MS)]
         tolerance_ms: f64,
         /// A stamp with no pose within the tolerance takes the pose interpolated between
         /// the two around it when they are at most this far apart, milliseconds (a
         /// trajectory written at the odometry's rate has no pose at the scan stamps the
         /// relations name).
-        #[arg(long, default_value_t = 500.0)]
+        #[arg(long, default_value_t = RelationMatching::MAX_GAP_MS)]
         max_gap_ms: f64,
         /// `X,Y,YAW` (metres, radians): score the pose of a sensor mounted here on the
         /// trajectory's frame instead. The benchmark's relations are between laser poses and

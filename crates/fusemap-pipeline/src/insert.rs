@@ -72,7 +72,9 @@ pub(crate) struct Inserter<'a> {
     pub(crate) deskew: bool,
     pub(crate) scan: LaserScan,
     pub(crate) last: Option<Stamp>,
-    pub(crate) line_trajectory: Vec<(Stamp, Pose2)>,
+    /// The pose each scan was placed with, at its stamp, in the order inserted (what
+    /// `trajectory.tum` holds beside the track's own samples).
+    pub(crate) placed: Vec<(Stamp, Pose2)>,
     /// Lines met so far by their key (the `k`-th line with a key takes the `k`-th pose).
     pub(crate) lines_seen: std::collections::HashMap<crate::recording::LineKey, usize>,
     /// The next observation id: one per scan released by the merge, so that every insert
@@ -132,7 +134,7 @@ impl Inserter<'_> {
                 // Line poses do not depend on the stamp: applied in file order.
                 scan.stamp = self.last.map_or(stamp, |last| last.max(stamp));
                 self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;
-                self.line_trajectory.push((scan.stamp, pose));
+                self.placed.push((scan.stamp, pose));
                 self.last = Some(scan.stamp);
             }
             Track::Timed(track) => {
@@ -158,6 +160,7 @@ impl Inserter<'_> {
                 } else {
                     self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;
                 }
+                self.placed.push((t, pose));
                 self.last = Some(t);
             }
         }

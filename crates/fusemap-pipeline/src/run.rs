@@ -55,7 +55,8 @@ pub struct MapRun {
     pub format: LogFormat,
     /// The run report.
     pub report: LogReport,
-    /// The pose track used, `map_from_base` in time order (for `trajectory.tum`).
+    /// The pose track used, `map_from_base` in time order, with the pose of every mapped
+    /// scan at its stamp (for `trajectory.tum`).
     pub trajectory: Vec<(Stamp, Pose2)>,
     /// Facts a user should know.
     pub notes: Vec<String>,
@@ -64,6 +65,19 @@ pub struct MapRun {
 /// Nanoseconds of a time offset in seconds (configs bound it to ±1 h).
 pub(crate) fn offset_ns(s: f64) -> i64 {
     (s * 1e9).round() as i64
+}
+
+/// A timed track's samples with the pose every scan was placed with, by stamp (a sample
+/// and a scan at one stamp: the sample). The scans' own poses let a user score the map's
+/// track at the scan stamps (the SLAM benchmark's relations name them) without
+/// interpolating across the odometry's pauses, which the track bridges and a reader of
+/// the file could not tell apart from a gap.
+fn with_scan_poses(samples: Vec<(Stamp, Pose2)>, placed: Vec<(Stamp, Pose2)>) -> Vec<(Stamp, Pose2)> {
+    let mut all = samples;
+    all.extend(placed);
+    all.sort_by_key(|s| s.0);
+    all.dedup_by_key(|s| s.0);
+    all
 }
 
 /// Maps the log at `path` with `plan`.
@@ -371,7 +385,7 @@ pub fn map_with_track(
         deskew: cfg.deskew,
         scan: LaserScan { stamp: Stamp::ZERO, angle_min: 0.0, angle_increment: 0.0, ranges: Vec::new() },
         last: None,
-        line_trajectory: Vec::new(),
+        placed: Vec::new(),
         lines_seen: Default::default(),
         next_id: 0,
     };
@@ -426,9 +440,10 @@ pub fn map_with_track(
     progress(Progress::Done);
     let map_s = t_map.elapsed().as_secs_f64();
     let _ = read_s;
+    let placed = std::mem::take(&mut inserter.placed);
     let trajectory = match &chosen.track {
-        Track::ScanLine(_) => std::mem::take(&mut inserter.line_trajectory),
-        Track::Timed(t) => t.samples(),
+        Track::ScanLine(_) => placed,
+        Track::Timed(t) => with_scan_poses(t.samples(), placed),
     };
     drop(inserter);
 

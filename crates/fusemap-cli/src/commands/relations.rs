@@ -4,12 +4,13 @@
 
 use anyhow::{bail, Result};
 use fusemap_core::geometry::Pose2;
-use fusemap_core::metrics::{at_relation_stamps, score_relations};
+use fusemap_core::metrics::{score_trajectory, RelationMatching};
 use std::path::Path;
 
-/// `fusemap relations`: reads both files, finds the pose at each relation's stamps (the
-/// nearest within `tolerance_ms`, else interpolated across a gap of at most `max_gap_ms`),
-/// optionally moved to the sensor, and prints the table (or one JSON object).
+/// `fusemap relations`: reads both files and scores the trajectory by
+/// [`score_trajectory`] (the nearest pose within `tolerance_ms`, else interpolated across a
+/// gap of at most `max_gap_ms`, optionally moved to the sensor), the rule the SLAM-benchmark
+/// tests assert with, and prints the table (or one JSON object).
 /// Fails when no relation could be scored: a mean over nothing would look like a result.
 pub fn run(
     relations: &Path,
@@ -25,16 +26,17 @@ pub fn run(
         }
     }
     // `as` saturates: an absurdly large tolerance becomes "any sample", not a wrap-around.
-    let tolerance_ns = (tolerance_ms * 1e6).round() as i64;
-    let max_gap_ns = (max_gap_ms * 1e6).round() as i64;
-    let rel = fusemap_io::relations::read_relations(relations)?;
-    let mut traj = fusemap_io::trajectory::read_tum(trajectory)?;
+    let mut matching = RelationMatching {
+        tolerance_ns: (tolerance_ms * 1e6).round() as i64,
+        max_gap_ns: (max_gap_ms * 1e6).round() as i64,
+        ..RelationMatching::default()
+    };
     if let Some(text) = sensor {
-        let mount = parse_pose(text)?;
-        traj.iter_mut().for_each(|(_, p)| *p = p.compose(mount));
+        matching.sensor_in_base = parse_pose(text)?;
     }
-    let at_stamps = at_relation_stamps(&rel, &traj, tolerance_ns, max_gap_ns);
-    let score = score_relations(&rel, &at_stamps, tolerance_ns);
+    let rel = fusemap_io::relations::read_relations(relations)?;
+    let traj = fusemap_io::trajectory::read_tum(trajectory)?;
+    let score = score_trajectory(&rel, &traj, &matching);
     if score.scored == 0 {
         bail!(
             "{}: none of its {} relations has both stamps among the {} poses of {} (within {tolerance_ms} ms, or between two poses at most {max_gap_ms} ms apart)",
@@ -50,7 +52,10 @@ pub fn run(
     }
     println!("relations        {}", score.relations);
     println!("scored           {}", score.scored);
-    println!("unmatched        {}  (no pose within {tolerance_ms} ms of a stamp)", score.unmatched);
+    println!(
+        "unmatched        {}  (no pose within {tolerance_ms} ms of a stamp, nor two at most {max_gap_ms} ms apart around it)",
+        score.unmatched
+    );
     println!(
         "translation (m)  {:.6} ± {:.6}  (max {:.6})",
         score.translation_mean_m, score.translation_std_m, score.translation_max_m

@@ -1,7 +1,7 @@
 //! Real logs end to end: every corrected CARMEN log of the shared datasets, and the raw
 //! Intel bag, mapped by the CLI and measured.
 
-use crate::util::{assert_success, read_json, run, temp_dir};
+use crate::util::{assert_success, read_json, run, stdout, temp_dir};
 use fusemap_core::grid::{LogOddsTable, OccupancyParams, Ternary};
 use fusemap_io::testdata::dataset;
 
@@ -89,5 +89,23 @@ fn intel_raw_bag_maps() {
     for f in ["slam.png", "trajectory.tum", "map.png"] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
+    // The README's benchmark command: every relation finds its scans' poses in
+    // trajectory.tum, and the error is the one the SLAM-benchmark test asserts (within 1.5×
+    // Cartographer's 0.0229 m; the same code path, so the same figure).
+    let Some(relations) = dataset("slam-benchmark-relations/intel.relations") else { return };
+    let traj = dir.join("trajectory.tum");
+    let o = run(&[
+        "relations",
+        "--relations",
+        relations.to_str().unwrap(),
+        "--trajectory",
+        traj.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_success(&o);
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!((v["scored"].as_u64(), v["unmatched"].as_u64()), (Some(2984), Some(0)), "{v}");
+    let mean = v["translation_mean_m"].as_f64().unwrap();
+    assert!(mean <= 1.5 * 0.0229, "{mean} m");
     std::fs::remove_dir_all(&dir).unwrap();
 }

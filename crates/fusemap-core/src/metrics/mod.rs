@@ -9,8 +9,8 @@ mod trajectory;
 
 pub use entropy::{binary_entropy, map_entropy, sparse_entropy, EntropyReport};
 pub use relations::{
-    at_relation_stamps, parse_relations, relation_errors, score_relations, Relation, RelationScore, RelationsError,
-    PLANAR_TOLERANCE,
+    at_relation_stamps, parse_relations, relation_errors, score_relations, score_trajectory, Relation,
+    RelationMatching, RelationScore, RelationsError, PLANAR_TOLERANCE,
 };
 pub use scores::{Confusion, TolerantScore};
 pub use semantic::{ClassAccuracy, SemanticAccuracy};

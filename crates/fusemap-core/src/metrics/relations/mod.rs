@@ -169,6 +169,54 @@ pub fn at_relation_stamps(
         .collect()
 }
 
+/// How a trajectory's poses are found at the stamps the relations name: the one rule of
+/// `fusemap relations` and of the SLAM-benchmark tests, so that the figure a user
+/// reproduces is the figure the tests assert.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RelationMatching {
+    /// The nearest pose counts when it lies at most this far from the stamp, ns.
+    pub tolerance_ns: i64,
+    /// Else the pose interpolated between the two around the stamp, when they are at
+    /// most this far apart, ns.
+    pub max_gap_ns: i64,
+    /// The pose of the sensor the relations are between, in the trajectory's frame (the
+    /// benchmark's relations are laser poses; fusemap writes the base frame's).
+    pub sensor_in_base: Pose2,
+}
+
+impl RelationMatching {
+    /// The default tolerance, ms: relation stamps are written with microseconds and a
+    /// trajectory holding a pose at every scan has the stamp itself.
+    pub const TOLERANCE_MS: f64 = 1.0;
+    /// The default largest gap interpolated across, ms: a few odometry periods, never a
+    /// pause in which the robot may have turned.
+    pub const MAX_GAP_MS: f64 = 500.0;
+}
+
+impl Default for RelationMatching {
+    fn default() -> Self {
+        Self {
+            tolerance_ns: (Self::TOLERANCE_MS * 1e6) as i64,
+            max_gap_ns: (Self::MAX_GAP_MS * 1e6) as i64,
+            sensor_in_base: Pose2::IDENTITY,
+        }
+    }
+}
+
+/// `trajectory` (`map_from_base`, any order) scored against `relations` by `matching`:
+/// the sensor's pose at each relation stamp ([`at_relation_stamps`]), then
+/// [`score_relations`] on exactly those stamps.
+pub fn score_trajectory(
+    relations: &[Relation],
+    trajectory: &[(Stamp, Pose2)],
+    matching: &RelationMatching,
+) -> RelationScore {
+    let sensor: Vec<(Stamp, Pose2)> =
+        trajectory.iter().map(|&(t, p)| (t, p.compose(matching.sensor_in_base))).collect();
+    let at_stamps = at_relation_stamps(relations, &sensor, matching.tolerance_ns, matching.max_gap_ns);
+    score_relations(relations, &at_stamps, 0)
+}
+
 /// The error transform ε = δ*⁻¹ ∘ δ of each relation (Kümmerle et al. 2009, eq. 1), in the
 /// order of `relations`; `None` for a relation whose `t1` or `t2` has no trajectory sample
 /// within `tolerance_ns` (a negative tolerance counts as 0: exact stamps only).

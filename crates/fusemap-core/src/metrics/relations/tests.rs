@@ -276,3 +276,25 @@ fn a_trajectory_between_the_relation_stamps_is_interpolated_within_the_gap() {
     // A gap wider than allowed is not bridged.
     assert!(at_relation_stamps(&relations, &trajectory, 1_000_000, 50_000_000).is_empty());
 }
+
+#[test]
+fn score_trajectory_moves_to_the_sensor_and_bridges_short_gaps_only() {
+    // The laser 0.3 m ahead of the base; the relations are the laser's true motions.
+    let relations = varied_chain(6);
+    let laser = Pose2::new(0.3, 0.0, 0.0);
+    let base: Vec<(Stamp, Pose2)> =
+        chain_trajectory(&relations).into_iter().map(|(t, p)| (t, p.compose(laser.inverse()))).collect();
+    let at_laser = RelationMatching { sensor_in_base: laser, ..RelationMatching::default() };
+    let exact = score_trajectory(&relations, &base, &at_laser);
+    assert_eq!((exact.scored, exact.unmatched), (6, 0));
+    assert!(exact.translation_max_m < 1e-12 && exact.rotation_max_deg < 1e-9, "{exact:?}");
+    // Scored at the base instead, the turns move it: an error, so the mount matters.
+    assert!(score_trajectory(&relations, &base, &RelationMatching::default()).translation_max_m > 0.01);
+    // Stamp 3 s missing: its neighbours are 2 s apart, beyond the 500 ms gap, so the two
+    // relations naming it are unmatched; with a 2 s gap allowed they are interpolated.
+    let holed: Vec<_> = base.iter().copied().filter(|(t, _)| *t != s(3)).collect();
+    let r = score_trajectory(&relations, &holed, &at_laser);
+    assert_eq!((r.scored, r.unmatched), (4, 2));
+    let wide = RelationMatching { max_gap_ns: 2_000_000_000, ..at_laser };
+    assert_eq!(score_trajectory(&relations, &holed, &wide).unmatched, 0);
+}
