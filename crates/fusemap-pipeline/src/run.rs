@@ -219,6 +219,11 @@ pub fn prepare_with(
         run.summary.counts.loop_accepted,
         run.summary.counts.loop_searches,
     ));
+    // Why the result is what it is: no loop closed, a corridor, unmatched scans, searches
+    // the budget left out.
+    for f in run.summary.counts.findings(plan.slam.loop_closure_global_after_m) {
+        track.notes.push(format!("SLAM: {f}"));
+    }
     track.slam = Some(Box::new(run.summary));
     Ok((bound, track, track_s + t0.elapsed().as_secs_f64()))
 }

@@ -113,6 +113,9 @@ pub struct SlamConfig {
     pub loop_closure_angular_window_deg: f64,
     /// Minimum mean probability of a loop closure's points (the score threshold).
     pub loop_closure_min_score: f64,
+    /// Smallest/largest translational information ratio of a loop closure below which it
+    /// is refused as degenerate.
+    pub loop_closure_degeneracy_ratio: f64,
     /// Huber scale of loop-closure edges, in σ (the first pass of each optimisation).
     pub loop_closure_huber: f64,
     /// Φ of the dynamic covariance scaling of loop-closure edges (the second pass).
@@ -210,6 +213,7 @@ impl Default for SlamConfig {
             loop_closure_linear_window_m: p.loop_closure_linear_window_m,
             loop_closure_angular_window_deg: 20.0,
             loop_closure_min_score: p.loop_closure_min_score as f64,
+            loop_closure_degeneracy_ratio: p.loop_closure_degeneracy_ratio,
             loop_closure_huber: p.loop_closure_huber,
             loop_closure_dcs: p.loop_closure_dcs,
             loop_closure_window_growth: p.loop_closure_window_growth,
@@ -342,6 +346,10 @@ impl SlamConfig {
             .min(100.0),
             loop_closure_angular_window_rad: lc_angular.to_radians(),
             loop_closure_min_score: score as f32,
+            loop_closure_degeneracy_ratio: non_negative(
+                "loop_closure_degeneracy_ratio",
+                self.loop_closure_degeneracy_ratio,
+            )?,
             loop_closure_huber: positive("loop_closure_huber", self.loop_closure_huber)?,
             loop_closure_dcs: positive("loop_closure_dcs", self.loop_closure_dcs)?,
             loop_closure_window_growth: non_negative("loop_closure_window_growth", self.loop_closure_window_growth)?,

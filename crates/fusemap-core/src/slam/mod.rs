@@ -15,6 +15,8 @@
 //! | the loop over scans | `mapper.rs` |
 //! | the corrected pose track | `corrected_track.rs` |
 //! | the matcher's exact two-way parallelism | `parallel.rs` |
+#[cfg(test)]
+mod bad_input_tests;
 mod corrected_track;
 pub mod field;
 mod fixes;

@@ -85,6 +85,10 @@ pub struct SlamParams {
     pub loop_closure_angular_window_rad: f64,
     /// Minimum mean probability of a loop closure's points.
     pub loop_closure_min_score: f32,
+    /// A loop closure whose smallest/largest translational information ratio is below
+    /// this is refused as degenerate: stricter than a local match's, since a closure's
+    /// edge is stiff (σ 1 cm) and links places far apart along the path.
+    pub loop_closure_degeneracy_ratio: f64,
     /// Huber scale of loop-closure edges (whitened units), in the first pass of every
     /// optimisation.
     pub loop_closure_huber: f64,
@@ -183,6 +187,7 @@ impl Default for SlamParams {
             loop_closure_linear_window_m: 4.0,
             loop_closure_angular_window_rad: 20f64.to_radians(),
             loop_closure_min_score: 0.55,
+            loop_closure_degeneracy_ratio: 0.1,
             loop_closure_huber: 1.0,
             loop_closure_dcs: 25.0,
             loop_closure_window_growth: 0.05,

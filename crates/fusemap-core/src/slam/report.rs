@@ -57,6 +57,10 @@ pub struct SlamReport {
     pub loop_searches: u64,
     /// Loop closures accepted.
     pub loop_accepted: u64,
+    /// The longest loop closed: the travel between the node of an accepted closure and
+    /// the last scan of its submap, metres. A log that never comes back to a place closes
+    /// only short ones (a submap seen again from a few metres on).
+    pub longest_loop_m: f64,
     /// Loop-closure searches that found nothing above the score threshold, or only a
     /// degenerate match.
     pub loop_rejected: u64,
@@ -91,4 +95,87 @@ pub struct SlamReport {
     pub loop_search_s: f64,
     /// Wall time in pose-graph optimisation, seconds.
     pub optimisation_s: f64,
+}
+
+/// A share of the scans above which degenerate matches are worth a finding.
+const DEGENERATE_SHARE: f64 = 0.2;
+/// A share of the scans above which unmatched ones are worth a finding.
+const PREDICTED_SHARE: f64 = 0.05;
+
+impl SlamReport {
+    /// What a user should know about this run, in plain words: why no loop closed, that
+    /// a corridor left the odometry in charge along it, scans that were not matched,
+    /// searches the budget left out, failed optimisations. Empty when nothing stands out.
+    ///
+    /// `loop_m`: the travel that makes a closure a loop (`[slam]
+    /// loop_closure_global_after_m`); closures over less only tie neighbouring submaps.
+    pub fn findings(&self, loop_m: f64) -> Vec<String> {
+        let mut out = Vec::new();
+        let share = |n: u64| n as f64 / self.scans.max(1) as f64;
+        if self.longest_loop_m < loop_m && self.nodes > 1 {
+            out.push(format!(
+                "no loop closed (none over {loop_m:.0} m of travel; the longest {:.1} m): {} searches, {} accepted, {} below the score threshold or degenerate ({} degenerate), {} large corrections no later scan confirmed. If the robot did come back to a place, summary.json's open_loops give each search's best score; if it never did, the trajectory keeps the drift of scan matching",
+                self.longest_loop_m,
+                self.loop_searches,
+                self.loop_accepted,
+                self.loop_rejected,
+                self.loop_degenerate,
+                self.loop_unconfirmed
+            ));
+        }
+        if share(self.degenerate) > DEGENERATE_SHARE {
+            out.push(format!(
+                "{:.0} % of the scans matched only across a corridor (degenerate matches): along it the pose track's odometry decides the distance",
+                100.0 * share(self.degenerate)
+            ));
+        }
+        if share(self.predicted) > PREDICTED_SHARE {
+            out.push(format!(
+                "{} scans were not matched (too few returns, or no submap yet) and keep their predicted pose",
+                self.predicted
+            ));
+        }
+        if self.refused > 0 {
+            out.push(format!("{} scans refused: a non-finite track pose or sensor origin", self.refused));
+        }
+        if self.loop_over_budget > 0 {
+            out.push(format!(
+                "{} loop-closure searches left out by the per-batch work budget ([slam] loop_closure_work_per_batch)",
+                self.loop_over_budget
+            ));
+        }
+        if let Some(first) = self.optimisation_failures.first() {
+            out.push(format!(
+                "{} pose-graph optimisations failed and kept the previous poses; the first: {first}",
+                self.optimisation_failures.len()
+            ));
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_clean_run_has_no_findings_and_each_problem_one() {
+        let clean = SlamReport {
+            scans: 100,
+            matched: 100,
+            nodes: 50,
+            loop_searches: 20,
+            loop_accepted: 5,
+            longest_loop_m: 80.0,
+            ..Default::default()
+        };
+        let f = |r: &SlamReport| r.findings(50.0);
+        assert!(f(&clean).is_empty(), "{:?}", f(&clean));
+        let open = SlamReport { loop_accepted: 2, longest_loop_m: 12.0, loop_rejected: 18, ..clean.clone() };
+        assert!(f(&open)[0].contains("the longest 12.0 m): 20 searches, 2 accepted, 18 below"), "{:?}", f(&open));
+        let corridor = SlamReport { degenerate: 30, matched: 70, ..clean.clone() };
+        assert!(f(&corridor)[0].contains("30 % of the scans"), "{:?}", f(&corridor));
+        let budget = SlamReport { loop_over_budget: 3, refused: 1, ..clean };
+        assert_eq!(f(&budget).len(), 2, "{:?}", f(&budget));
+    }
 }

@@ -7,7 +7,7 @@ use super::{
 };
 use crate::geometry::{normalize_angle, Pose2};
 use crate::slam::global_match::{search_branch_and_bound, search_work, GlobalSearch};
-use crate::slam::local_match::{match_information, mean_probability, refine};
+use crate::slam::local_match::{match_information, mean_probability, refine, LocalMatchParams};
 use crate::slam::mapper::Slam;
 use crate::slam::parallel::map_all;
 use crate::slam::pose_graph::{Edge, EdgeKind, Loss};
@@ -71,7 +71,9 @@ impl Slam {
         needed.dedup();
         let submaps = self.submaps.all();
         self.grids.prepare(&needed, |s| &submaps[s].grid);
-        let (grids, nodes, local) = (&self.grids, &self.nodes, &self.p.local);
+        let (grids, nodes) = (&self.grids, &self.nodes);
+        let local = LocalMatchParams { degeneracy_ratio: self.p.loop_closure_degeneracy_ratio, ..self.p.local };
+        let local = &local;
         let outcomes: Vec<Outcome> = map_all(&planned, |pl| {
             let sm = &submaps[pl.pair.submap];
             let node = &nodes[pl.pair.node];
@@ -231,12 +233,13 @@ impl Slam {
             self.loops.links.push((a, submap));
             *self.loops.link_count.entry((a.min(submap), a.max(submap))).or_default() += 1;
         }
+        let now = self.nodes.last().map_or(0.0, |l| l.path_m);
+        let left_behind = self.nodes[node].path_m - self.loops.footprints[submap].last_path_m;
+        self.report.longest_loop_m = self.report.longest_loop_m.max(left_behind.abs());
         // A loop closed by the newest stretch, with a submap left behind long ago (not a
         // neighbour along the path): the estimate is anchored, the global search rests.
         // The graph distance (`gap`) is no test: once a building's loops are tied it is
         // short everywhere, and the global search would run all the time.
-        let now = self.nodes.last().map_or(0.0, |l| l.path_m);
-        let left_behind = self.nodes[node].path_m - self.loops.footprints[submap].last_path_m;
         if left_behind >= self.p.loop_closure_max_distance_m
             && now - self.nodes[node].path_m <= self.p.loop_closure_confirm_within_m
         {
