@@ -221,7 +221,7 @@ pub fn prepare_with(
     ));
     // Why the result is what it is: no loop closed, a corridor, unmatched scans, searches
     // the budget left out.
-    for f in run.summary.counts.findings(plan.slam.loop_closure_global_after_m) {
+    for f in run.summary.counts.findings(plan.slam.loop_closure, plan.slam.loop_closure_global_after_m) {
         track.notes.push(format!("SLAM: {f}"));
     }
     track.slam = Some(Box::new(run.summary));

@@ -259,6 +259,17 @@ fn non_negative(field: &str, v: f64) -> Result<f64, ConfigError> {
     }
 }
 
+/// A ratio of the smallest to the largest information, which lies in [0, 1]: above 1 every
+/// match would be refused.
+fn unit_ratio(field: &str, v: f64) -> Result<f64, ConfigError> {
+    let v = finite(field, v)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(err(field, format!("must be within 0..=1, got {v}")))
+    }
+}
+
 impl SlamConfig {
     /// Checks every key and builds the parameters.
     pub fn validate(&self) -> Result<SlamParams, ConfigError> {
@@ -319,7 +330,7 @@ impl SlamConfig {
                 translation_weight: non_negative("translation_weight", self.translation_weight)?,
                 rotation_weight: non_negative("rotation_weight", self.rotation_weight)?,
                 residual_sigma: positive("match_residual_sigma", self.match_residual_sigma)?,
-                degeneracy_ratio: non_negative("degeneracy_ratio", self.degeneracy_ratio)?,
+                degeneracy_ratio: unit_ratio("slam.degeneracy_ratio", self.degeneracy_ratio)?,
             },
             moving_prediction_margin: non_negative("moving_prediction_margin", self.moving_prediction_margin)?,
             rescue_score_ratio: non_negative("rescue_score_ratio", self.rescue_score_ratio)?,
@@ -346,8 +357,8 @@ impl SlamConfig {
             .min(100.0),
             loop_closure_angular_window_rad: lc_angular.to_radians(),
             loop_closure_min_score: score as f32,
-            loop_closure_degeneracy_ratio: non_negative(
-                "loop_closure_degeneracy_ratio",
+            loop_closure_degeneracy_ratio: unit_ratio(
+                "slam.loop_closure_degeneracy_ratio",
                 self.loop_closure_degeneracy_ratio,
             )?,
             loop_closure_huber: positive("loop_closure_huber", self.loop_closure_huber)?,
@@ -431,6 +442,8 @@ mod tests {
         assert!(c.validate().unwrap_err().to_string().contains("hit_probability"));
         let c = SlamConfig { loop_closure_sampling_ratio: 2.0, ..Default::default() };
         assert!(c.validate().unwrap_err().to_string().contains("slam.loop_closure_sampling_ratio"));
+        let c = SlamConfig { loop_closure_degeneracy_ratio: 1.5, ..Default::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("slam.loop_closure_degeneracy_ratio"));
         let c = SlamConfig { submap_max_scans: 0, ..Default::default() };
         assert!(c.validate().unwrap_err().to_string().contains("slam.submap_max_scans"));
     }

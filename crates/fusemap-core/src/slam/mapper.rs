@@ -575,6 +575,7 @@ impl Slam {
             self.attach_fixes(Stamp(i64::MAX), last + 1);
             self.optimise(true);
         }
+        self.report.travel_m = self.nodes.last().map_or(0.0, |n| n.path_m);
         self.report.grids_built = self.grids.built;
         self.report.grids_peak_bytes = self.grids.peak_bytes;
         self.report.odometry_scale = self.odometry.scales();

@@ -57,12 +57,15 @@ pub struct SlamReport {
     pub loop_searches: u64,
     /// Loop closures accepted.
     pub loop_accepted: u64,
+    /// Travel of the trajectory's nodes, metres.
+    pub travel_m: f64,
     /// The longest loop closed: the travel between the node of an accepted closure and
-    /// the last scan of its submap, metres. A log that never comes back to a place closes
+    /// the nearest scan of its submap, metres. A log that never comes back to a place closes
     /// only short ones (a submap seen again from a few metres on).
     pub longest_loop_m: f64,
-    /// Loop-closure searches that found nothing above the score threshold, or only a
-    /// degenerate match.
+    /// Loop-closure searches that added no edge: nothing above the score threshold, only a
+    /// degenerate match, a large correction no later node confirmed, or a confirming search
+    /// that disagreed.
     pub loop_rejected: u64,
     /// … of which degenerate: a match that fits anywhere along one direction (a corridor).
     pub loop_degenerate: u64,
@@ -107,18 +110,21 @@ impl SlamReport {
     /// a corridor left the odometry in charge along it, scans that were not matched,
     /// searches the budget left out, failed optimisations. Empty when nothing stands out.
     ///
-    /// `loop_m`: the travel that makes a closure a loop (`[slam]
-    /// loop_closure_global_after_m`); closures over less only tie neighbouring submaps.
-    pub fn findings(&self, loop_m: f64) -> Vec<String> {
+    /// `loop_closure`: whether loop closure ran (`[slam] loop_closure`); `loop_m`: the
+    /// travel that makes a closure a loop (`[slam] loop_closure_global_after_m`); closures
+    /// over less only tie neighbouring submaps. A run shorter than that is not told it
+    /// closed no loop.
+    pub fn findings(&self, loop_closure: bool, loop_m: f64) -> Vec<String> {
         let mut out = Vec::new();
         let share = |n: u64| n as f64 / self.scans.max(1) as f64;
-        if self.longest_loop_m < loop_m && self.nodes > 1 {
+        if loop_closure && self.travel_m > loop_m && self.longest_loop_m < loop_m {
+            let other = self.loop_rejected.saturating_sub(self.loop_unconfirmed + self.loop_disagreeing);
             out.push(format!(
                 "no loop closed (none over {loop_m:.0} m of travel; the longest {:.1} m): {} searches, {} accepted, {} below the score threshold or degenerate ({} degenerate), {} large corrections no later scan confirmed. If the robot did come back to a place, summary.json's open_loops give each search's best score; if it never did, the trajectory keeps the drift of scan matching",
                 self.longest_loop_m,
                 self.loop_searches,
                 self.loop_accepted,
-                self.loop_rejected,
+                other,
                 self.loop_degenerate,
                 self.loop_unconfirmed
             ));
@@ -164,17 +170,29 @@ mod tests {
             scans: 100,
             matched: 100,
             nodes: 50,
+            travel_m: 300.0,
             loop_searches: 20,
             loop_accepted: 5,
+            loop_rejected: 15,
+            loop_unconfirmed: 2,
+            loop_disagreeing: 3,
             longest_loop_m: 80.0,
             ..Default::default()
         };
-        let f = |r: &SlamReport| r.findings(50.0);
+        let f = |r: &SlamReport| r.findings(true, 50.0);
         assert!(f(&clean).is_empty(), "{:?}", f(&clean));
-        let open = SlamReport { loop_accepted: 2, longest_loop_m: 12.0, loop_rejected: 18, ..clean.clone() };
-        assert!(f(&open)[0].contains("the longest 12.0 m): 20 searches, 2 accepted, 18 below"), "{:?}", f(&open));
+        let open = SlamReport { longest_loop_m: 12.0, ..clean.clone() };
+        assert!(f(&open)[0].contains("the longest 12.0 m): 20 searches, 5 accepted, 10 below"), "{:?}", f(&open));
+        // Not when loop closure is off, nor on a run too short for a loop.
+        assert!(open.findings(false, 50.0).is_empty());
+        assert!(f(&SlamReport { travel_m: 40.0, ..open.clone() }).is_empty());
+        assert!(f(&SlamReport::default()).is_empty());
         let corridor = SlamReport { degenerate: 30, matched: 70, ..clean.clone() };
         assert!(f(&corridor)[0].contains("30 % of the scans"), "{:?}", f(&corridor));
+        let unmatched = SlamReport { predicted: 10, matched: 90, ..clean.clone() };
+        assert!(f(&unmatched)[0].contains("10 scans were not matched"), "{:?}", f(&unmatched));
+        let failed = SlamReport { optimisation_failures: vec!["singular".into()], ..clean.clone() };
+        assert!(f(&failed)[0].contains("1 pose-graph optimisations failed"), "{:?}", f(&failed));
         let budget = SlamReport { loop_over_budget: 3, refused: 1, ..clean };
         assert_eq!(f(&budget).len(), 2, "{:?}", f(&budget));
     }
