@@ -14,15 +14,7 @@ fn run(world: &World, truth: &[Pose2], odometry: &[Pose2], beams: usize, stamp: 
     let mut rng = SplitMix64::new(11);
     let mut slam = Slam::new(SlamParams::default());
     for (i, (pose, odo)) in truth.iter().zip(odometry).enumerate() {
-        let hits: Vec<Point2> = world
-            .scan(*pose, beams, 30.0)
-            .into_iter()
-            .map(|q| {
-                let r = q.x.hypot(q.y);
-                let k = (r + rng.uniform(-0.01, 0.01)) / r;
-                Point2::new(q.x * k, q.y * k)
-            })
-            .collect();
+        let hits = world.noisy_scan(*pose, beams, 30.0, || rng.uniform(-0.01, 0.01));
         slam.add_scan(ScanInput {
             stamp: Stamp(stamp(i)),
             track: Some(*odo),

@@ -84,16 +84,8 @@ fn run_observed(
     let mut noise = Noise(7);
     let mut slam = Slam::new(p);
     for (i, (pose, track)) in truth.iter().zip(track).enumerate() {
-        let hits: Vec<Point2> = world
-            .scan(*pose, beams, 30.0)
-            .into_iter()
-            .map(|q| {
-                // ±1 cm of range noise.
-                let r = q.x.hypot(q.y);
-                let k = (r + 0.01 * noise.next()) / r;
-                Point2::new(q.x * k, q.y * k)
-            })
-            .collect();
+        // ±1 cm of range noise.
+        let hits = world.noisy_scan(*pose, beams, 30.0, || 0.01 * noise.next());
         let stamp = Stamp(1_000_000_000 + i as i64 * 100_000_000);
         slam.add_scan(ScanInput { stamp, track: *track, origin: Point2::new(0.0, 0.0), hits: &hits, misses: &[] });
         after(&mut slam, i);

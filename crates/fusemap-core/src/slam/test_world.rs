@@ -61,6 +61,18 @@ impl World {
         }
         out
     }
+
+    /// [`scan`](Self::scan) with each range lengthened by `noise()` metres.
+    pub fn noisy_scan(&self, pose: Pose2, beams: usize, max_range: f64, mut noise: impl FnMut() -> f64) -> Vec<Point2> {
+        self.scan(pose, beams, max_range)
+            .into_iter()
+            .map(|q| {
+                let r = q.x.hypot(q.y);
+                let k = (r + noise()) / r;
+                Point2::new(q.x * k, q.y * k)
+            })
+            .collect()
+    }
 }
 
 fn square(cx: f64, cy: f64, half: f64) -> Vec<(Point2, Point2)> {

@@ -234,12 +234,11 @@ impl Slam {
             *self.loops.link_count.entry((a.min(submap), a.max(submap))).or_default() += 1;
         }
         let now = self.nodes.last().map_or(0.0, |l| l.path_m);
-        let left_behind = self.nodes[node].path_m - self.loops.footprints[submap].last_path_m;
+        let (path, fp) = (self.nodes[node].path_m, &self.loops.footprints[submap]);
+        let left_behind = path - fp.last_path_m;
         // The travel to the submap's nearest scan (an older node matched into a submap just
         // finished is as much a loop).
-        let fp = &self.loops.footprints[submap];
-        let path = self.nodes[node].path_m;
-        let span = if path >= fp.first_path_m { path - fp.last_path_m } else { fp.first_path_m - path };
+        let span = if path >= fp.first_path_m { left_behind } else { fp.first_path_m - path };
         self.report.longest_loop_m = self.report.longest_loop_m.max(span.max(0.0));
         // A loop closed by the newest stretch, with a submap left behind long ago (not a
         // neighbour along the path): the estimate is anchored, the global search rests.
