@@ -146,9 +146,33 @@ impl ProbabilityGrid {
         self.mirror.as_deref()
     }
 
-    /// Drops the `f32` mirror: the grid will not be matched against locally again.
+    /// Drops the `f32` mirror (the grid will not be matched against locally again) and
+    /// crops the grid to its known cells: an unknown cell reads as one outside ([`P_MIN`]),
+    /// so every lookup is unchanged, and a finished submap no longer carries the margin
+    /// it grew with (64 cells a side: a small room's submap was mostly margin).
     pub fn freeze(&mut self) {
         self.mirror = None;
+        let l = self.limits;
+        let (mut lo, mut hi) = ((usize::MAX, usize::MAX), (0, 0));
+        for (row, cells) in self.cells.chunks_exact(l.width.max(1)).enumerate() {
+            if let (Some(a), Some(b)) = (cells.iter().position(|&v| v != 0), cells.iter().rposition(|&v| v != 0)) {
+                (lo, hi) = ((lo.0.min(a), lo.1.min(row)), (hi.0.max(b), hi.1.max(row)));
+            }
+        }
+        if lo.0 == usize::MAX {
+            self.cells = Vec::new();
+            self.limits = CellLimits { min: l.min, width: 0, height: 0 };
+        } else {
+            let (w, h) = (hi.0 - lo.0 + 1, hi.1 - lo.1 + 1);
+            let mut cells = Vec::with_capacity(w * h);
+            for row in lo.1..=hi.1 {
+                cells.extend_from_slice(&self.cells[row * l.width + lo.0..row * l.width + hi.0 + 1]);
+            }
+            self.cells = cells;
+            let min = CellIndex::new(l.min.x + lo.0 as i64, l.min.y + lo.1 as i64);
+            self.limits = CellLimits { min, width: w, height: h };
+        }
+        self.marked = Vec::new();
     }
 
     /// The probability of cell `(x, y)`; [`P_MIN`] when unknown or outside.
@@ -407,6 +431,28 @@ mod tests {
         assert!(g.probabilities().is_none());
         g.insert(Point2::new(0.0, 0.0), &[Point2::new(2.0, 1.0)], &[], &hit, &miss);
         assert!(g.probabilities().is_none());
+    }
+
+    #[test]
+    fn freezing_crops_to_the_known_cells_and_keeps_every_lookup() {
+        let (hit, miss) = (UpdateTable::new(0.55), UpdateTable::new(0.49));
+        let mut g = ProbabilityGrid::new(0.1);
+        g.insert(Point2::new(0.0, 0.0), &[Point2::new(1.0, 1.0), Point2::new(-2.0, 0.5)], &[], &hit, &miss);
+        g.insert(Point2::new(0.3, 0.0), &[], &[Point2::new(0.3, -1.5)], &hit, &miss);
+        let before = g.clone();
+        g.freeze();
+        let (a, b) = (before.limits(), g.limits());
+        assert!(b.width * b.height < a.width * a.height / 4, "{a:?} → {b:?}");
+        assert_eq!(g.known_cells(), before.known_cells());
+        for y in a.min.y - 2..a.min.y + a.height as i64 + 2 {
+            for x in a.min.x - 2..a.min.x + a.width as i64 + 2 {
+                assert_eq!(g.value(x, y), before.value(x, y), "({x}, {y})");
+                assert_eq!(g.probability(x, y), before.probability(x, y), "({x}, {y})");
+            }
+        }
+        let mut empty = ProbabilityGrid::new(0.1);
+        empty.freeze();
+        assert_eq!((empty.limits().width, empty.probability(0, 0)), (0, P_MIN));
     }
 
     #[test]
