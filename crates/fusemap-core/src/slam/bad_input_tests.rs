@@ -1,6 +1,7 @@
 //! Logs SLAM cannot correct, or can only partly (issue 22's bad-input list): each must run
 //! to the end without a panic and keep a finite pose for every scan; the hallway and the
-//! corridor, which have no loop, must close none and say so in their findings.
+//! corridor, which have no loop, must close none and say so in their findings; a closure
+//! search over 10⁵ submaps must keep to its bounds and its work budget.
 
 use super::test_world::World;
 use super::{ScanInput, Slam, SlamParams, SlamResult};
@@ -188,4 +189,91 @@ fn two_scans_per_stamp_keep_a_pose_each() {
     let mean = r.trajectory.iter().zip(&truth).map(|((_, p), t)| (p.x - t.x).hypot(p.y - t.y)).sum::<f64>()
         / truth.len() as f64;
     assert!(mean < 0.05, "mean error {mean} m: {:?}", r.report);
+}
+
+/// A 2 × 1.5 m closet with a box in one corner: small submaps, every pose unique.
+fn closet() -> World {
+    let c = |x: f64, y: f64| Point2::new(x + 0.0131, y + 0.0277);
+    let ring = |pts: &[Point2]| (0..pts.len()).map(|i| (pts[i], pts[(i + 1) % pts.len()])).collect::<Vec<_>>();
+    let mut walls = ring(&[c(0.0, 0.0), c(2.0, 0.0), c(2.0, 1.5), c(0.0, 1.5)]);
+    walls.extend(ring(&[c(1.6, 1.1), c(1.8, 1.1), c(1.8, 1.3), c(1.6, 1.3)]));
+    World { walls }
+}
+
+/// SLAM after driving circles in the closet until a submap is finished, then given
+/// `copies` more finished submaps just like it (the robot stayed there for days), and the
+/// circle's next pose index. Batches run at every node, optimisations never (the copies
+/// are tied to nothing), so each batch's searches can be counted.
+fn closet_with_copies(p: SlamParams, copies: usize) -> (Slam, usize) {
+    let p = SlamParams { loop_closure_batch_nodes: 1, optimize_every_n_nodes: usize::MAX, ..p };
+    let mut slam = Slam::new(p);
+    let mut i = 0;
+    while !slam.finished.iter().any(|&f| f) {
+        assert!(i < 2000, "no submap finished: {:?}", slam.report());
+        add_circle_scan(&mut slam, i);
+        i += 1;
+    }
+    let of = slam.finished.iter().position(|&f| f).expect("one finished");
+    slam.copy_finished_submap(of, copies);
+    (slam, i)
+}
+
+/// Scan `i` of circles of 0.3 m radius about the closet's middle, 5° a scan, 10 Hz.
+fn add_circle_scan(slam: &mut Slam, i: usize) {
+    let a = (5.0 * i as f64).to_radians();
+    let pose = Pose2::new(1.0 + 0.3 * a.cos(), 0.75 + 0.3 * a.sin(), normalize_angle(a + std::f64::consts::FRAC_PI_2));
+    let hits = closet().scan(pose, 180, 30.0);
+    slam.add_scan(ScanInput {
+        stamp: Stamp(at_10_hz(i)),
+        track: Some(pose),
+        origin: Point2::new(0.0, 0.0),
+        hits: &hits,
+        misses: &[],
+    });
+}
+
+#[test]
+fn a_closure_search_over_100000_submaps_keeps_to_its_bounds() {
+    const COPIES: usize = 100_000;
+    // Defaults: a node is searched against its few nearest submaps, and a submap just
+    // finished by a few earlier nodes, however many submaps lie near.
+    let d = SlamParams::default();
+    let (mut slam, mut i) = closet_with_copies(d, COPIES);
+    let per_batch = (d.loop_closure_submaps_per_node
+        + d.loop_closure_nodes_per_submap
+        + d.loop_closure_global_submaps_per_batch
+        + 16) as u64;
+    let start = slam.report().loop_searches;
+    for _ in 0..80 {
+        let before = slam.report().loop_searches;
+        add_circle_scan(&mut slam, i);
+        i += 1;
+        let ran = slam.report().loop_searches - before;
+        assert!(ran <= per_batch, "{ran} searches in one batch: {:?}", slam.report());
+    }
+    let ran = slam.report().loop_searches - start;
+    assert!(ran > 0, "some node was searched: {:?}", slam.report());
+    assert!(slam.grids.built <= ran + 1, "grids built only for the submaps searched: {} for {ran}", slam.grids.built);
+
+    drop(slam);
+
+    // Told to search every submap near a node, the batch stops at its work budget, counts
+    // what it left out, and says so.
+    let p = SlamParams { loop_closure_submaps_per_node: usize::MAX, loop_closure_work_per_batch: 1e7, ..d };
+    let (mut slam, mut i) = closet_with_copies(p, COPIES);
+    while slam.report().loop_over_budget == 0 {
+        assert!(i < 4000, "no batch reached the budget: {:?}", slam.report());
+        let before = slam.report().loop_searches;
+        add_circle_scan(&mut slam, i);
+        i += 1;
+        let ran = slam.report().loop_searches - before;
+        // Each search of the widest window this run can have costs more than the budget
+        // over a hundred.
+        assert!(ran <= 100, "{ran} searches in one batch: {:?}", slam.report());
+    }
+    let rep = slam.report();
+    assert!(rep.loop_over_budget as usize > COPIES - 100, "{rep:?}");
+    assert!(slam.grids.built <= rep.loop_searches + 1, "{} grids for {} searches", slam.grids.built, rep.loop_searches);
+    let f = rep.findings(true, p.loop_closure_global_after_m).join("\n");
+    assert!(f.contains("work budget"), "{f}");
 }

@@ -150,6 +150,15 @@ impl Submaps {
         }
         (into, finished)
     }
+
+    /// A copy of finished submap `i`, appended (tests of the loop search's cost over very
+    /// many submaps).
+    #[cfg(test)]
+    pub(in crate::slam) fn push_copy_of_finished(&mut self, i: usize) -> usize {
+        assert!(self.all[i].finished, "only a finished submap is copied");
+        self.all.push(self.all[i].clone());
+        self.all.len() - 1
+    }
 }
 
 #[cfg(test)]

@@ -385,3 +385,21 @@ impl Slam {
         initial.is_finite().then_some(Planned { pair, initial, search, base })
     }
 }
+
+#[cfg(test)]
+impl Slam {
+    /// `count` copies of finished submap `of`, finished, where it lies: a robot that stayed
+    /// in one room for days, for tests of what a search over very many submaps costs.
+    pub(in crate::slam) fn copy_finished_submap(&mut self, of: usize, count: usize) {
+        for _ in 0..count {
+            let s = self.submaps.push_copy_of_finished(of);
+            let at = self.graph.nodes()[self.submap_graph[of]];
+            self.submap_graph.push(self.graph.add_node(at));
+            self.finished.push(true);
+            self.grids.add_submap();
+            self.loops.footprints.push(self.loops.footprints[of]);
+            let c = self.submap_centre(s);
+            self.loops.submap_index.insert(s, c);
+        }
+    }
+}
