@@ -193,35 +193,39 @@ impl PrecomputedGrids {
 }
 
 /// Level `h` from level `h − 1` (`prev`), over the span `[−2^h, size]` on each axis.
+///
+/// Both passes are a maximum of two shifted rows, slice against slice (which the compiler
+/// turns into vector instructions): each row of `prev` is first laid into a zeroed row of
+/// the new span, so the cells beyond what `prev` stores read as the `0` they are.
 fn coarser(prev: &Level, width: i32, height: i32, h: usize) -> Level {
-    let s = 1i32 << (h - 1);
+    let s = 1usize << (h - 1);
     let pad = 1i32 << h;
-    let (w, ht) = (width + pad + 1, height + pad + 1);
-    // Along x first, over the previous level's rows (relative y in [−s, height]).
-    let mut tmp = vec![0u8; w as usize * prev.height as usize];
-    for (row, out) in tmp.chunks_exact_mut(w as usize).enumerate() {
-        let y = row as i32 - prev.pad;
-        for (col, o) in out.iter_mut().enumerate() {
-            let x = col as i32 - pad;
-            *o = prev.get(x, y).max(prev.get(x + s, y));
+    let (w, ht) = ((width + pad + 1) as usize, (height + pad + 1) as usize);
+    let (pw, ph) = (prev.width as usize, prev.height as usize);
+    // Column (and row) `j` of `prev` is column (row) `j + shift` of the new span.
+    let shift = (pad - prev.pad) as usize;
+    // Along x first, over the previous level's rows.
+    let mut ext = vec![0u8; w + s];
+    let mut tmp = vec![0u8; w * ph];
+    for (src, out) in prev.cells.chunks_exact(pw).zip(tmp.chunks_exact_mut(w)) {
+        ext[shift..shift + pw].copy_from_slice(src);
+        for ((o, &a), &b) in out.iter_mut().zip(&ext[..w]).zip(&ext[s..s + w]) {
+            *o = a.max(b);
         }
     }
-    let tmp_at = |x_col: usize, y: i32| -> u8 {
-        let r = y + prev.pad;
-        if r < 0 || r >= prev.height {
-            0
-        } else {
-            tmp[r as usize * w as usize + x_col]
-        }
+    // Then along y: row `r` of the new span is the maximum of rows `r` and `r + s`.
+    let zero = vec![0u8; w];
+    let tmp_row = |r: usize| match r.checked_sub(shift) {
+        Some(k) if k < ph => &tmp[k * w..(k + 1) * w],
+        _ => &zero[..],
     };
-    let mut cells = vec![0u8; w as usize * ht as usize];
-    for (row, out) in cells.chunks_exact_mut(w as usize).enumerate() {
-        let y = row as i32 - pad;
-        for (col, o) in out.iter_mut().enumerate() {
-            *o = tmp_at(col, y).max(tmp_at(col, y + s));
+    let mut cells = vec![0u8; w * ht];
+    for (row, out) in cells.chunks_exact_mut(w).enumerate() {
+        for ((o, &a), &b) in out.iter_mut().zip(tmp_row(row)).zip(tmp_row(row + s)) {
+            *o = a.max(b);
         }
     }
-    Level { pad, width: w, height: ht, cells }
+    Level { pad, width: w as i32, height: ht as i32, cells }
 }
 
 #[cfg(test)]
