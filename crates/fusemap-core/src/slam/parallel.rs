@@ -52,12 +52,14 @@ pub fn adopt_calling_thread() {
 }
 
 /// `items.iter().map(f)` collected in order, the items spread over every thread of the
-/// pool (rayon's indexed parallel iterator keeps the order whatever the split).
+/// pool (rayon's indexed parallel iterator keeps the order whatever the split). Each item
+/// is a task of its own: the items are few and of very unequal cost (searches, grids), and
+/// a thread that finishes early takes the next one rather than waiting on a half.
 pub fn map_all<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync + Send) -> Vec<R> {
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
-        items.par_iter().map(f).collect()
+        items.par_iter().with_max_len(1).map(f).collect()
     }
     #[cfg(not(feature = "parallel"))]
     {

@@ -52,15 +52,15 @@ impl Slam {
         let budget = self.p.loop_closure_work_per_batch;
         let mut spent = 0.0;
         let total = planned.len();
-        let planned: Vec<Planned> = planned
+        let (work, planned): (Vec<f64>, Vec<Planned>) = planned
             .into_iter()
             .take_while(|(_, w, _)| {
                 let first = spent == 0.0;
                 spent += w;
                 first || spent <= budget
             })
-            .map(|(_, _, pl)| pl)
-            .collect();
+            .map(|(_, w, pl)| (w, pl))
+            .unzip();
         self.report.loop_over_budget += (total - planned.len()) as u64;
         if planned.is_empty() {
             self.report.loop_search_s += t0.elapsed().as_secs_f64();
@@ -74,7 +74,12 @@ impl Slam {
         let (grids, nodes) = (&self.grids, &self.nodes);
         let local = LocalMatchParams { degeneracy_ratio: self.p.loop_closure_degeneracy_ratio, ..self.p.local };
         let local = &local;
-        let outcomes: Vec<Outcome> = map_all(&planned, |pl| {
+        // The costliest searches start first, so the threads finish together; the results
+        // are taken in the pairs' order whatever the order they ran in.
+        let mut order: Vec<usize> = (0..planned.len()).collect();
+        order.sort_by(|&a, &b| work[b].total_cmp(&work[a]).then(a.cmp(&b)));
+        let ran: Vec<Outcome> = map_all(&order, |&k| {
+            let pl = &planned[k];
             let sm = &submaps[pl.pair.submap];
             let node = &nodes[pl.pair.node];
             let pre = grids.peek(pl.pair.submap).expect("prepared above");
@@ -86,9 +91,13 @@ impl Slam {
             });
             Outcome { found, best_score: out.best_score, on_edge: out.on_edge }
         });
+        let mut outcomes: Vec<Option<Outcome>> = (0..planned.len()).map(|_| None).collect();
+        for (k, out) in order.into_iter().zip(ran) {
+            outcomes[k] = Some(out);
+        }
         self.report.loop_searches += planned.len() as u64;
         for (pl, out) in planned.iter().zip(outcomes) {
-            self.take_outcome(pl, out);
+            self.take_outcome(pl, out.expect("every search ran"));
         }
         self.expire_hypotheses();
         self.report.loop_search_s += t0.elapsed().as_secs_f64();
