@@ -18,6 +18,7 @@
 
 use super::field::{self, Crossing, FieldKernel};
 use super::grid::{ProbabilityGrid, UpdateTable};
+use super::parallel::join;
 use crate::geometry::{Point2, Pose2};
 
 /// One submap.
@@ -59,7 +60,8 @@ pub struct Submaps {
     hit: UpdateTable,
     miss: UpdateTable,
     kernel: FieldKernel,
-    crossings: Vec<Crossing>,
+    /// Scratch for each active submap's field update.
+    crossings: [Vec<Crossing>; 2],
     all: Vec<Submap>,
     /// Indices of the active submaps (oldest first).
     active: Vec<usize>,
@@ -82,7 +84,7 @@ impl Submaps {
             hit: UpdateTable::new(hit_probability),
             miss: UpdateTable::new(miss_probability),
             kernel: FieldKernel::new(field_sigma_m, resolution),
-            crossings: Vec::new(),
+            crossings: [Vec::new(), Vec::new()],
             all: Vec::new(),
             active: Vec::new(),
         }
@@ -126,13 +128,26 @@ impl Submaps {
             });
             self.active.push(self.all.len() - 1);
         }
-        for &i in &self.active {
-            let s = &mut self.all[i];
-            self.crossings.clear();
-            s.occupancy.insert_tracking(origin, hits, misses, &self.hit, &self.miss, &mut self.crossings);
+        let (hit, miss, kernel) = (&self.hit, &self.miss, &self.kernel);
+        let into_one = |s: &mut Submap, crossings: &mut Vec<Crossing>| {
+            crossings.clear();
+            s.occupancy.insert_tracking(origin, hits, misses, hit, miss, crossings);
             let occupancy = &s.occupancy;
-            field::update(&mut s.grid, &self.kernel, &self.crossings, |x, y| occupancy.probability(x, y) > 0.5);
+            field::update(&mut s.grid, kernel, crossings, |x, y| occupancy.probability(x, y) > 0.5);
             s.scans += 1;
+        };
+        // The two active submaps share nothing: one on each thread.
+        let [c0, c1] = &mut self.crossings;
+        match self.active[..] {
+            [a, b] if a < b => {
+                let (older, newer) = self.all.split_at_mut(b);
+                join(|| into_one(&mut older[a], c0), || into_one(&mut newer[0], c1));
+            }
+            _ => {
+                for &i in &self.active {
+                    into_one(&mut self.all[i], c0);
+                }
+            }
         }
         let into = self.active.clone();
         // The newest full: the next scan starts a submap, and the older one, which now
