@@ -330,17 +330,17 @@ impl ProbabilityGrid {
         mut crossings: Option<&mut Vec<Crossing>>,
     ) {
         let o = self.to_cell_units(origin);
-        let (mut lo, mut hi) = ((o.0.floor() as i64, o.1.floor() as i64), (o.0.floor() as i64, o.1.floor() as i64));
+        let (mut lo, mut hi) = ((floor_i64(o.0), floor_i64(o.1)), (floor_i64(o.0), floor_i64(o.1)));
         for p in hits.iter().chain(misses) {
             let c = self.to_cell_units(*p);
-            let (cx, cy) = (c.0.floor() as i64, c.1.floor() as i64);
+            let (cx, cy) = (floor_i64(c.0), floor_i64(c.1));
             lo = (lo.0.min(cx), lo.1.min(cy));
             hi = (hi.0.max(cx), hi.1.max(cy));
         }
         self.grow_to(lo, hi);
         for p in hits {
             let c = self.to_cell_units(*p);
-            self.apply(c.0.floor() as i64, c.1.floor() as i64, hit, &mut crossings);
+            self.apply(floor_i64(c.0), floor_i64(c.1), hit, &mut crossings);
         }
         for (p, is_hit) in hits.iter().map(|p| (p, true)).chain(misses.iter().map(|p| (p, false))) {
             let ray = CellRay::new(o, self.to_cell_units(*p));

@@ -23,7 +23,7 @@ mod precomputed;
 pub use precomputed::PrecomputedGrids;
 
 use crate::geometry::{normalize_angle, Point2, Pose2};
-use crate::slam::grid::{ProbabilityGrid, P_MAX, P_MIN};
+use crate::slam::grid::{floor_i64, ProbabilityGrid, P_MAX, P_MIN};
 use precomputed::Level;
 
 /// The search window and acceptance threshold of [`match_branch_and_bound`].
@@ -138,13 +138,15 @@ impl Problem {
         let scans = (-n_angles..=n_angles)
             .map(|k| {
                 let theta = initial.theta + k as f64 * step;
-                let pose = Pose2::new(initial.x, initial.y, theta);
+                // `Pose2::transform_point`'s arithmetic, its sine and cosine taken once per
+                // angle rather than once per point.
+                let (sin, cos) = theta.sin_cos();
                 let cells = points
                     .iter()
                     .filter_map(|p| {
-                        let q = pose.transform_point(*p);
-                        let cx = (q.x / r).floor() as i64 - min.x;
-                        let cy = (q.y / r).floor() as i64 - min.y;
+                        let q = Point2::new(initial.x + cos * p.x - sin * p.y, initial.y + sin * p.x + cos * p.y);
+                        let cx = floor_i64(q.x / r) - min.x;
+                        let cy = floor_i64(q.y / r) - min.y;
                         (useful(cx, w) && useful(cy, h)).then_some([cx as i32, cy as i32])
                     })
                     .collect();
