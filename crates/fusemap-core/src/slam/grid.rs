@@ -330,7 +330,8 @@ impl ProbabilityGrid {
         mut crossings: Option<&mut Vec<Crossing>>,
     ) {
         let o = self.to_cell_units(origin);
-        let (mut lo, mut hi) = ((floor_i64(o.0), floor_i64(o.1)), (floor_i64(o.0), floor_i64(o.1)));
+        let start = (floor_i64(o.0), floor_i64(o.1));
+        let (mut lo, mut hi) = (start, start);
         for p in hits.iter().chain(misses) {
             let c = self.to_cell_units(*p);
             let (cx, cy) = (floor_i64(c.0), floor_i64(c.1));

@@ -426,7 +426,8 @@ impl Slam {
         misses: &[Point2],
         information: Option<[[f64; 3]; 3]>,
     ) {
-        let to_local = |q: &Point2| local.transform_point(*q);
+        let to = local.point_transform();
+        let to_local = |q: &Point2| to(*q);
         let local_hits: Vec<Point2> = hits.iter().map(to_local).collect();
         let local_misses: Vec<Point2> = misses.iter().map(to_local).collect();
         let before = self.submaps.all().len();

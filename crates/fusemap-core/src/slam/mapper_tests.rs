@@ -276,9 +276,10 @@ fn a_match_lost_by_a_bad_prediction_is_searched_again_wider() {
     assert!(lost > 5.0, "without the rescue: heading error up to {lost} deg");
 }
 
-/// Loop-closure batches and the scan matcher's halves run on every thread of the pool;
-/// their results are taken in a fixed order, so the trajectory is the same to the bit on
-/// 1, 2 and 4 threads.
+/// Loop-closure batches (each search its own task, the costliest first), the scan
+/// matcher's halves and the insertion into the two active submaps run on every thread of
+/// the pool; their results are taken in a fixed order, so the trajectory is the same to
+/// the bit on 1, 2 and 4 threads.
 #[cfg(feature = "parallel")]
 #[test]
 fn the_trajectory_is_bit_identical_on_one_two_and_four_threads() {

@@ -62,10 +62,10 @@ pub struct GlobalMatch {
 /// score the global search maximises, at full precision. Non-finite points are skipped;
 /// with no point left the score is [`P_MIN`] (nothing is explained).
 pub fn score_at(grid: &ProbabilityGrid, points: &[Point2], pose: Pose2) -> f32 {
-    let r = grid.resolution();
+    let (r, to) = (grid.resolution(), pose.point_transform());
     let (sum, n) = points.iter().filter(|p| p.is_finite()).fold((0.0f64, 0usize), |(s, n), p| {
-        let q = pose.transform_point(*p);
-        let (cx, cy) = ((q.x / r).floor() as i64, (q.y / r).floor() as i64);
+        let q = to(*p);
+        let (cx, cy) = (floor_i64(q.x / r), floor_i64(q.y / r));
         (s + f64::from(grid.probability(cx, cy)), n + 1)
     });
     if n == 0 {
@@ -138,13 +138,11 @@ impl Problem {
         let scans = (-n_angles..=n_angles)
             .map(|k| {
                 let theta = initial.theta + k as f64 * step;
-                // `Pose2::transform_point`'s arithmetic, its sine and cosine taken once per
-                // angle rather than once per point.
-                let (sin, cos) = theta.sin_cos();
+                let to = Pose2::new(initial.x, initial.y, theta).point_transform();
                 let cells = points
                     .iter()
                     .filter_map(|p| {
-                        let q = Point2::new(initial.x + cos * p.x - sin * p.y, initial.y + sin * p.x + cos * p.y);
+                        let q = to(*p);
                         let cx = floor_i64(q.x / r) - min.x;
                         let cy = floor_i64(q.y / r) - min.y;
                         (useful(cx, w) && useful(cy, h)).then_some([cx as i32, cy as i32])

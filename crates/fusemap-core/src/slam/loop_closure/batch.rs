@@ -78,7 +78,7 @@ impl Slam {
         // are taken in the pairs' order whatever the order they ran in.
         let mut order: Vec<usize> = (0..planned.len()).collect();
         order.sort_by(|&a, &b| work[b].total_cmp(&work[a]).then(a.cmp(&b)));
-        let ran: Vec<Outcome> = map_all(&order, |&k| {
+        let mut ran: Vec<(usize, Outcome)> = map_all(&order, |&k| {
             let pl = &planned[k];
             let sm = &submaps[pl.pair.submap];
             let node = &nodes[pl.pair.node];
@@ -89,15 +89,12 @@ impl Slam {
                 let score = mean_probability(&sm.grid, &node.points, pose);
                 (pose, score, match_information(&sm.grid, &node.points, pose, local).1)
             });
-            Outcome { found, best_score: out.best_score, on_edge: out.on_edge }
+            (k, Outcome { found, best_score: out.best_score, on_edge: out.on_edge })
         });
-        let mut outcomes: Vec<Option<Outcome>> = (0..planned.len()).map(|_| None).collect();
-        for (k, out) in order.into_iter().zip(ran) {
-            outcomes[k] = Some(out);
-        }
+        ran.sort_unstable_by_key(|r| r.0);
         self.report.loop_searches += planned.len() as u64;
-        for (pl, out) in planned.iter().zip(outcomes) {
-            self.take_outcome(pl, out.expect("every search ran"));
+        for (pl, (_, out)) in planned.iter().zip(ran) {
+            self.take_outcome(pl, out);
         }
         self.expire_hypotheses();
         self.report.loop_search_s += t0.elapsed().as_secs_f64();
