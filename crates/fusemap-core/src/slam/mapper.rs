@@ -23,9 +23,10 @@ use super::grid_cache::GridCache;
 use super::local_match::{refine, LocalMatchParams};
 use super::loop_closure::{Loops, OpenSearch};
 use super::odometry::OdometryAgreement;
+use super::optimisation::Pending;
 use super::parallel::{join, on_worker};
 use super::params::SlamParams;
-use super::pose_graph::{Edge, EdgeKind, Loss, OptimizeOptions, PoseGraph};
+use super::pose_graph::{Edge, EdgeKind, Loss, PoseGraph};
 use super::report::SlamReport;
 use super::submap::Submaps;
 use crate::geometry::{normalize_angle, Point2, Pose2};
@@ -103,7 +104,9 @@ pub struct Slam {
     pub(super) typical_score: Option<f64>,
     pub(super) since_optimisation: usize,
     /// Travel at the last optimisation, metres.
-    optimised_at_m: f64,
+    pub(super) optimised_at_m: f64,
+    /// The optimisation under way beside the matching.
+    pub(super) pending: Option<Pending>,
     pub(super) fixes: FixPriors,
     /// How well the track's motion has agreed with the matches.
     pub(super) odometry: OdometryAgreement,
@@ -141,13 +144,6 @@ fn same_bits(a: Pose2, b: Pose2) -> bool {
 /// scale error over its length.)
 const FLOOR_M: f64 = 10.0;
 const FLOOR_DEG: f64 = 30.0;
-
-/// The relative cost change at which an optimisation during the run stops (the last one
-/// runs to [`OptimizeOptions`]' default, 10⁻⁶). Those only place the next searches' windows
-/// and the next submaps: on the five SLAM-benchmark logs stopping there leaves the final
-/// relation error unchanged to 0.1 mm and cuts the optimisation time by half (Intel) to
-/// two thirds (MIT Killian, 519 large corrections each optimised at once).
-const STEERING_TOLERANCE: f64 = 1e-3;
 
 /// A match whose translational information is this well conditioned (smallest over largest
 /// eigenvalue) constrains both directions of the plane: a room, not a corridor.
@@ -188,6 +184,7 @@ impl Slam {
             typical_score: None,
             since_optimisation: 0,
             optimised_at_m: 0.0,
+            pending: None,
             fixes: FixPriors::new(),
             odometry: OdometryAgreement::default(),
             report: SlamReport::default(),
@@ -511,70 +508,20 @@ impl Slam {
         self.report.nodes += 1;
         self.attach_fixes(stamp, self.nodes.len() - 1);
         self.report.submaps = self.submaps.all().len();
+        self.take_optimisation_if_due();
         if self.p.loop_closure {
             self.loop_closure_after_node(finished);
         }
-        self.since_optimisation += 1;
-        let news = self.loops.since_optimisation + self.fixes.since_optimisation;
-        let travelled = self.nodes.last().map_or(0.0, |n| n.path_m) - self.optimised_at_m;
-        let due = self.since_optimisation >= self.p.optimize_every_n_nodes && travelled >= self.p.optimize_every_m;
-        if self.loops.optimise_now || (due && news > 0) {
-            self.optimise(false);
-        }
-    }
-
-    fn optimise(&mut self, last: bool) {
-        let t0 = Instant::now();
-        // Fixes spread widely enough hold the graph in their frame: the first node is
-        // then one more node, not the anchor.
-        if let Some(first) = self.nodes.first().filter(|_| self.fixes.anchor_the_graph()) {
-            self.graph.set_fixed(first.graph, false);
-        }
-        // The optimisations during the run only steer the next searches: they stop at a
-        // coarser relative cost change; the last one runs to the default tolerance.
-        let opts = OptimizeOptions {
-            function_tolerance: if last { OptimizeOptions::default().function_tolerance } else { STEERING_TOLERANCE },
-            ..OptimizeOptions::default()
-        };
-        // Huber first, from wherever the graph stands: closures pull with a bounded force,
-        // so the right ones (the many that agree) bring the graph to them. Then dynamic
-        // covariance scaling from there: a closure the rest of the graph disagrees with
-        // stops pulling at all (Agarwal et al. 2013). Odometry and matches stay least
-        // squares: they are the inliers everything is judged by. The DCS pass runs after a
-        // large correction and at the end, not at every periodic optimisation: it costs as
-        // much again (on the Intel bag half of all the optimisation time), and what a
-        // wrong closure bends in between, with Huber's bounded pull, it takes back.
-        let huber = Loss::Huber(self.p.loop_closure_huber);
-        let dcs = (last || self.loops.optimise_now).then_some(Loss::Dcs(self.p.loop_closure_dcs));
-        for loss in std::iter::once(huber).chain(dcs) {
-            self.graph.set_loss_of(EdgeKind::LoopClosure, loss).expect("valid loss");
-            match self.graph.optimize(&opts) {
-                Ok(r) => {
-                    self.report.optimisations += 1;
-                    self.report.last_optimisation = Some(r);
-                }
-                Err(e) => self.report.optimisation_failures.push(e.to_string()),
-            }
-        }
-        if let Some(n) = self.nodes.last() {
-            self.global_from_local = self.graph.nodes()[n.graph].compose(n.local.inverse());
-        }
-        self.since_optimisation = 0;
-        self.optimised_at_m = self.nodes.last().map_or(0.0, |n| n.path_m);
-        self.loops.since_optimisation = 0;
-        self.loops.optimise_now = false;
-        self.fixes.since_optimisation = 0;
-        self.reindex();
-        self.update_drift();
-        self.report.optimisation_s += t0.elapsed().as_secs_f64();
+        self.optimise_if_due();
     }
 
     /// Optimises once more and returns every scan's pose.
     pub fn finish(mut self) -> SlamResult {
+        self.take_optimisation();
         self.finish_loops();
         if let Some(last) = self.nodes.len().checked_sub(1) {
             self.attach_fixes(Stamp(i64::MAX), last + 1);
-            self.optimise(true);
+            self.optimise_last();
         }
         self.report.travel_m = self.nodes.last().map_or(0.0, |n| n.path_m);
         self.report.grids_built = self.grids.built;

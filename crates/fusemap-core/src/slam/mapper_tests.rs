@@ -278,7 +278,8 @@ fn a_match_lost_by_a_bad_prediction_is_searched_again_wider() {
 
 /// Loop-closure batches (each search its own task, the costliest first), the scan
 /// matcher's halves and the insertion into the two active submaps run on every thread of
-/// the pool; their results are taken in a fixed order, so the trajectory is the same to
+/// the pool, and the optimisations beside the matching on a thread of their own; their
+/// results are taken in a fixed order, at fixed nodes, so the trajectory is the same to
 /// the bit on 1, 2 and 4 threads.
 #[cfg(feature = "parallel")]
 #[test]
@@ -290,6 +291,7 @@ fn the_trajectory_is_bit_identical_on_one_two_and_four_threads() {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         let r = pool.install(|| run(&truth, &track, 360));
         assert!(r.result.report.loop_searches > 0, "the batches ran");
+        assert!(r.result.report.optimisations_deferred > 0, "optimisations ran beside the matching");
         r.result.trajectory.iter().map(|(_, p)| [p.x.to_bits(), p.y.to_bits(), p.theta.to_bits()]).collect::<Vec<_>>()
     };
     let one = on(1);

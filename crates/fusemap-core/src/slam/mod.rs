@@ -28,6 +28,7 @@ pub mod local_match;
 mod loop_closure;
 mod mapper;
 mod odometry;
+mod optimisation;
 mod parallel;
 mod params;
 pub mod pose_graph;

@@ -51,6 +51,19 @@ pub fn adopt_calling_thread() {
     }
 }
 
+/// The threads of the pool (1 without the `parallel` feature): with one, work that could
+/// run beside the caller runs where its result is needed instead.
+pub fn threads() -> usize {
+    #[cfg(feature = "parallel")]
+    {
+        rayon::current_num_threads()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        1
+    }
+}
+
 /// `items.iter().map(f)` collected in order, the items spread over every thread of the
 /// pool (rayon's indexed parallel iterator keeps the order whatever the split). Each item
 /// is a task of its own: the items are few and of very unequal cost (searches, grids), and

@@ -88,6 +88,9 @@ pub struct SlamReport {
     pub grids_peak_bytes: usize,
     /// Pose-graph optimisations run.
     pub optimisations: u64,
+    /// … of which taken some nodes after they started (run beside the matching when the
+    /// pool has more than one thread).
+    pub optimisations_deferred: u64,
     /// Optimisations that failed (the previous poses were kept), with the reason.
     pub optimisation_failures: Vec<String>,
     /// The last optimisation.
@@ -96,8 +99,11 @@ pub struct SlamReport {
     pub matching_s: f64,
     /// Wall time in loop-closure search (precomputation included), seconds.
     pub loop_search_s: f64,
-    /// Wall time in pose-graph optimisation, seconds.
+    /// Time the optimiser ran, seconds (periodic optimisations run beside the matching, so
+    /// this is not all waited for).
     pub optimisation_s: f64,
+    /// Wall time the scans waited for optimisations (taking their results included), seconds.
+    pub optimisation_wait_s: f64,
 }
 
 /// A share of the scans above which degenerate matches are worth a finding.

@@ -325,6 +325,29 @@ impl PoseGraph {
         self.nodes[i] = pose;
     }
 
+    /// A copy of the graph to optimise elsewhere (another thread), which takes the
+    /// solver's cached structure along: this graph will have grown by the time the copy
+    /// comes back, see [`adopt`](Self::adopt).
+    pub fn take_copy(&mut self) -> PoseGraph {
+        PoseGraph {
+            nodes: self.nodes.clone(),
+            fixed: self.fixed.clone(),
+            edges: self.edges.clone(),
+            priors: self.priors.clone(),
+            cache: self.cache.take(),
+        }
+    }
+
+    /// Takes the poses of `optimised`, a copy made by [`take_copy`](Self::take_copy), for the
+    /// nodes it has (nodes added since keep theirs), and its cached structure back.
+    ///
+    /// # Panics
+    /// When `optimised` has more nodes than this graph.
+    pub fn adopt(&mut self, optimised: PoseGraph) {
+        self.nodes[..optimised.nodes.len()].copy_from_slice(&optimised.nodes);
+        self.cache = optimised.cache;
+    }
+
     /// The edges, in insertion order.
     pub fn edges(&self) -> &[Edge] {
         &self.edges

@@ -501,3 +501,35 @@ fn timing_15000_nodes_60000_edges() {
     let warm = g.optimize(&opts).unwrap();
     eprintln!("warm start, perturbed (symbolic reused): {:?} {warm:?}", t.elapsed());
 }
+
+/// A copy optimised elsewhere gives back the poses of the nodes it had, and the nodes
+/// added to the graph meanwhile keep theirs, edges included.
+#[test]
+fn an_adopted_copy_sets_the_nodes_it_had_and_keeps_the_later_ones() {
+    let mut g = PoseGraph::new();
+    let a = g.add_node(Pose2::new(0.0, 0.0, 0.0));
+    let b = g.add_node(Pose2::new(1.3, 0.2, 0.1));
+    g.set_fixed(a, true);
+    let info = [[100.0, 0.0, 0.0], [0.0, 100.0, 0.0], [0.0, 0.0, 100.0]];
+    let edge = |from, to| Edge {
+        from,
+        to,
+        measurement: Pose2::new(1.0, 0.0, 0.0),
+        information: info,
+        loss: Loss::Trivial,
+        kind: EdgeKind::Odometry,
+    };
+    g.add_edge(edge(a, b)).unwrap();
+    let mut copy = g.take_copy();
+    let later = g.add_node(Pose2::new(5.0, 5.0, 0.5));
+    g.add_edge(edge(b, later)).unwrap();
+    copy.optimize(&OptimizeOptions::default()).unwrap();
+    let optimised = copy.nodes()[b];
+    assert!(optimised.translation().distance(Point2::new(1.0, 0.0)) < 1e-6);
+    g.adopt(copy);
+    assert_eq!(g.nodes()[b], optimised);
+    assert_eq!(g.nodes()[later], Pose2::new(5.0, 5.0, 0.5));
+    assert_eq!(g.edges().len(), 2);
+    g.optimize(&OptimizeOptions::default()).unwrap();
+    assert!(g.nodes()[later].translation().distance(Point2::new(2.0, 0.0)) < 1e-6);
+}
