@@ -211,7 +211,7 @@ impl Default for SlamConfig {
             loop_closure_grid_cache_mib: p.loop_closure_grid_cache_mib,
             loop_closure_max_distance_m: p.loop_closure_max_distance_m,
             loop_closure_linear_window_m: p.loop_closure_linear_window_m,
-            loop_closure_angular_window_deg: 20.0,
+            loop_closure_angular_window_deg: 10.0,
             loop_closure_min_score: p.loop_closure_min_score as f64,
             loop_closure_degeneracy_ratio: p.loop_closure_degeneracy_ratio,
             loop_closure_huber: p.loop_closure_huber,
