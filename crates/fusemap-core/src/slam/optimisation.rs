@@ -1,9 +1,9 @@
 //! When the pose graph is optimised, and on which thread.
 //!
 //! **When.** Every `optimize_every_n_nodes` nodes (or a thirtieth of the nodes so far, if
-//! more) and `optimize_every_m` metres, if a closure or a fix came in since the last; after a large correction (a loop closed after
-//! drift), so that the next searches look where the robot now is; and once more at the
-//! end, to the default tolerance.
+//! more) and `optimize_every_m` metres, if a closure or a fix came in since the last;
+//! after a large correction (a loop closed after drift), so that the next searches look
+//! where the robot now is; and once more at the end, to the default tolerance.
 //!
 //! **Beside local SLAM.** An optimisation during the run only steers the next searches
 //! and places the next submaps, so it need not hold up the scans that follow it. As
@@ -19,9 +19,11 @@
 //! optimisation takes the one under way, then runs at once.
 //!
 //! The optimiser's thread runs at the lowest priority: it takes the time the matcher and
-//! the searches leave idle. On the Intel bag on two cores the scans then wait 2.0 s for
-//! 3.7 s of optimisation, and the whole run takes 1.06× less time (docs/BENCHMARKS.md);
-//! the relation errors of the five benchmark logs moved by at most 0.1 mm.
+//! the searches leave idle. On the Intel bag on two cores the scans then wait 1.8 s for
+//! 3.4 s of optimisation, but the matcher loses some of that to it: over nine alternated
+//! runs the whole was 1.03× faster, within the noise (docs/BENCHMARKS.md). It pays where
+//! the matcher leaves cores idle. The relation errors of the five benchmark logs moved by
+//! at most 0.1 mm.
 
 use super::mapper::Slam;
 use super::pose_graph::{EdgeKind, Loss, OptimizeOptions, OptimizeReport, PoseGraph, PoseGraphError};
