@@ -304,6 +304,27 @@ def bag_case(name: str, src: Path, expect: str, names=(), edit=None, **extra) ->
     return d
 
 
+def _restyle_metadata(path: Path, style: str) -> None:
+    """Rewrites a metadata.yaml in block style, in flow style (as PyYAML's
+    `default_flow_style=True` writes it) or as JSON: the same document, other spellings."""
+    import io
+    import json
+
+    from ruamel.yaml import YAML  # rosbags' own YAML library
+
+    doc = YAML(typ="safe", pure=True).load(path.read_text())
+    if style == "json":
+        path.write_text(json.dumps(doc, indent=2))
+        return
+    out = YAML(typ="safe", pure=True)
+    out.default_flow_style = style == "flow"
+    buf = io.StringIO()
+    out.dump(doc, buf)
+    text = buf.getvalue()
+    assert text.lstrip().startswith("{") == (style == "flow"), text[:80]
+    path.write_text(text)
+
+
 def rosbag2_cases(tmp: Path) -> None:
     mcap_bag = rosbag2_dir(tmp, "bag-mcap", ros.StoragePlugin.MCAP)
     db3_bag = rosbag2_dir(tmp, "bag-db3", ros.StoragePlugin.SQLITE3)
@@ -334,6 +355,18 @@ def rosbag2_cases(tmp: Path) -> None:
              edit=lambda b: (b / "metadata.yaml").write_text("rosbag2_bagfile_information: [\n  {{{\n"))
     bag_case("rosbag2/yaml-empty", db3_bag, "error", names=["metadata.yaml"],
              edit=lambda b: (b / "metadata.yaml").write_text(""))
+    # One metadata.yaml in three YAML styles: each maps the bag as the block style
+    # rosbag2 writes does (the same 40 scans; crates/fusemap-cli/tests/cli/formats.rs
+    # checks the maps are bit-identical).
+    for style in ("block", "flow", "json"):
+        bag_case(f"rosbag2/metadata-{style}", mcap_bag, "map", summary={"scans": 40},
+                 edit=lambda b, style=style: _restyle_metadata(b / "metadata.yaml", style))
+    bomb = "a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]\n" for i in range(1, 10))
+    bag_case("rosbag2/yaml-alias-bomb", db3_bag, "error", names=["metadata.yaml", "alias"],
+             edit=lambda b: (b / "metadata.yaml").write_text(bomb))
+    bag_case("rosbag2/yaml-key-twice", db3_bag, "error", names=["metadata.yaml", "twice"],
+             edit=meta_edit("storage_identifier: sqlite3", "storage_identifier: sqlite3\n  storage_identifier: mcap"))
     bag_case("rosbag2/metadata-missing", db3_bag, "error", names=[],
              edit=lambda b: (b / "metadata.yaml").unlink())
     bag_case("rosbag2/message-count-huge", db3_bag, "map",

@@ -26,6 +26,7 @@ pub mod slam_picture;
 pub mod text;
 pub mod trajectory;
 pub mod world_file;
+pub mod yaml;
 
 pub use error::{Error, Location, Result};
 #[doc(hidden)]

@@ -28,7 +28,7 @@
 //! thresholds, which were already applied when the cells were turned into 0/205/254.
 
 use crate::atomic::{check_raster, write_atomic};
-use crate::{Error, Location, Result};
+use crate::{yaml, Error, Location, Result};
 use fusemap_core::geometry::Point2;
 use fusemap_core::grid::{Raster, Ternary};
 use std::io::Write;
@@ -186,14 +186,14 @@ struct Description {
 /// Reads a `map_server` pair from its YAML, decoding cells exactly as `map_server` does
 /// in trinary mode (see the module documentation).
 ///
-/// The YAML reader understands the subset map files use: one `key: value` per line,
-/// comments (`#`), plain or quoted scalars and the `origin` flow list. Required keys, as
+/// The YAML is parsed as YAML ([`crate::yaml`]): any style, comments, quoted or plain
+/// scalars, numbers quoted or not (as `map_server`'s yaml-cpp reads them). Required keys, as
 /// in `map_server`: `image`, `resolution`, `origin`, `negate`, `occupied_thresh`,
 /// `free_thresh`; `mode` defaults to `trinary`, and `raw` mode is refused. Unknown keys
 /// are ignored, as `map_server` ignores them. The image must be binary PGM (`P5`) with
 /// maxval 255. Every error names the YAML or image file and the line or field.
 pub fn read_map_server(yaml_path: &Path) -> Result<MapServerMap> {
-    let text = std::fs::read_to_string(yaml_path).map_err(|e| Error::io(yaml_path, e))?;
+    let text = yaml::read_text(yaml_path)?;
     let d = parse_description(yaml_path, &text)?;
     let missing = |key: &str| Error::format(yaml_path, Location::Field(key.into()), "missing (required)");
     let (image, image_line) = d.image.ok_or_else(|| missing("image"))?;
@@ -251,150 +251,61 @@ pub fn read_map_server(yaml_path: &Path) -> Result<MapServerMap> {
     })
 }
 
-/// Parses the YAML subset of map files into the known keys.
+/// Parses a map description (any YAML style) into the known keys.
 fn parse_description(path: &Path, text: &str) -> Result<Description> {
-    let mut d = Description::default();
-    let mut seen: Vec<String> = Vec::new();
-    for (i, raw) in text.lines().enumerate() {
-        let line = i as u64 + 1;
-        let content = strip_comment(raw);
-        let content = content.trim_end();
-        if content.trim().is_empty() || content == "---" || content == "..." {
-            continue;
-        }
-        let err = |msg: String| Error::format(path, Location::Line(line), msg);
-        if content.starts_with([' ', '\t']) {
-            return Err(err("nested YAML is not part of the map format: expected `key: value`".into()));
-        }
-        let (key, value) =
-            content.split_once(':').ok_or_else(|| err(format!("expected `key: value`, got `{}`", content.trim())))?;
-        let key = key.trim();
-        let value = value.trim();
-        if seen.iter().any(|k| k == key) {
-            return Err(err(format!("`{key}` is given twice")));
-        }
-        seen.push(key.to_string());
-        let field = |msg: String| Error::format(path, Location::LineField(line, key.into()), msg);
-        let number = |v: &str| -> Result<f64> {
-            parse_yaml_float(v).ok_or_else(|| field(format!("expected a number, got `{v}`")))
-        };
-        match key {
-            "image" => d.image = Some((unquote(value).map_err(field)?, line)),
-            "resolution" => d.resolution = Some((number(value)?, line)),
-            "occupied_thresh" => d.occupied_thresh = Some((number(value)?, line)),
-            "free_thresh" => d.free_thresh = Some((number(value)?, line)),
-            "negate" => {
-                d.negate = Some(match value {
-                    "0" | "false" | "False" | "FALSE" => false,
-                    "1" | "true" | "True" | "TRUE" => true,
-                    v => return Err(field(format!("expected 0 or 1, got `{v}`"))),
-                })
-            }
-            "mode" => {
-                d.mode = Some(match unquote(value).map_err(field)?.as_str() {
-                    "trinary" => MapMode::Trinary,
-                    "scale" => MapMode::Scale,
-                    "raw" => {
-                        return Err(field(
-                            "`raw` mode stores occupancy values, not a picture of the map: not supported".into(),
-                        ))
-                    }
-                    v => return Err(field(format!("expected `trinary`, `scale` or `raw`, got `{v}`"))),
-                })
-            }
-            "origin" => {
-                let inner = value
-                    .strip_prefix('[')
-                    .and_then(|v| v.strip_suffix(']'))
-                    .ok_or_else(|| field(format!("expected `[x, y, yaw]`, got `{value}`")))?;
-                let parts: Vec<&str> = inner.split(',').map(str::trim).collect();
-                if parts.len() != 3 {
-                    return Err(field(format!("expected three numbers `[x, y, yaw]`, got {}", parts.len())));
-                }
-                let mut o = [0.0; 3];
-                for (slot, p) in o.iter_mut().zip(&parts) {
-                    *slot = number(p)?;
-                }
-                d.origin = Some((o, line));
-            }
-            _ => {} // map_server ignores keys it does not know.
-        }
+    let root = yaml::parse(text).map_err(|(line, message)| {
+        Error::format(path, if line == 0 { Location::File } else { Location::Line(line) }, message)
+    })?;
+    if !yaml::is_mapping(&root) {
+        return Err(Error::format(
+            path,
+            Location::Line(yaml::line(&root)),
+            "expected a map description (`key: value` lines), got another YAML value",
+        ));
     }
+    let at = |key: &str, node: &yaml::Node<'_>, message: String| {
+        Error::format(path, Location::LineField(yaml::line(node), key.into()), message)
+    };
+    let number = |key: &str| -> Result<Option<(f64, u64)>> {
+        let Some(n) = yaml::get(&root, key) else { return Ok(None) };
+        Ok(Some((yaml::number(n).map_err(|m| at(key, n, m))?, yaml::line(n))))
+    };
+    let mut d = Description {
+        resolution: number("resolution")?,
+        occupied_thresh: number("occupied_thresh")?,
+        free_thresh: number("free_thresh")?,
+        ..Description::default()
+    };
+    if let Some(n) = yaml::get(&root, "image") {
+        d.image = Some((yaml::text(n).map_err(|m| at("image", n, m))?, yaml::line(n)));
+    }
+    if let Some(n) = yaml::get(&root, "negate") {
+        d.negate = Some(yaml::boolean(n).map_err(|m| at("negate", n, m))?);
+    }
+    if let Some(n) = yaml::get(&root, "mode") {
+        d.mode = Some(match yaml::text(n).map_err(|m| at("mode", n, m))?.as_str() {
+            "trinary" => MapMode::Trinary,
+            "scale" => MapMode::Scale,
+            "raw" => {
+                let why = "`raw` mode stores occupancy values, not a picture of the map: not supported";
+                return Err(at("mode", n, why.into()));
+            }
+            v => return Err(at("mode", n, format!("expected `trinary`, `scale` or `raw`, got `{v}`"))),
+        });
+    }
+    if let Some(n) = yaml::get(&root, "origin") {
+        let parts = yaml::items(n).ok_or_else(|| at("origin", n, "expected `[x, y, yaw]`".into()))?;
+        if parts.len() != 3 {
+            return Err(at("origin", n, format!("expected three numbers `[x, y, yaw]`, got {}", parts.len())));
+        }
+        let mut o = [0.0; 3];
+        for (slot, p) in o.iter_mut().zip(parts) {
+            *slot = yaml::number(p).map_err(|m| at("origin", p, m))?;
+        }
+        d.origin = Some((o, yaml::line(n)));
+    }
+    // map_server ignores keys it does not know.
     Ok(d)
-}
-
-/// The line without a trailing comment: `#` at the start or after whitespace, outside
-/// quotes (YAML's rule; `a#b` is not a comment).
-fn strip_comment(line: &str) -> &str {
-    let mut quote: Option<char> = None;
-    let mut prev_space = true;
-    for (i, c) in line.char_indices() {
-        match quote {
-            Some(q) if c == q => quote = None,
-            Some(_) => {}
-            None if c == '\'' || c == '"' => quote = Some(c),
-            None if c == '#' && prev_space => return &line[..i],
-            None => {}
-        }
-        prev_space = c == ' ' || c == '\t';
-    }
-    line
-}
-
-/// A scalar string: plain, `'single'` (with `''` for a quote) or `"double"` (with
-/// backslash escapes for `\"`, `\\`, `\n`, `\t`, `\xNN`).
-fn unquote(v: &str) -> std::result::Result<String, String> {
-    if let Some(inner) = v.strip_prefix('\'') {
-        let inner = inner.strip_suffix('\'').ok_or_else(|| format!("unterminated quoted string `{v}`"))?;
-        return Ok(inner.replace("''", "'"));
-    }
-    if let Some(inner) = v.strip_prefix('"') {
-        let inner = inner.strip_suffix('"').ok_or_else(|| format!("unterminated quoted string `{v}`"))?;
-        let mut out = String::new();
-        let mut chars = inner.chars();
-        while let Some(c) = chars.next() {
-            if c != '\\' {
-                out.push(c);
-                continue;
-            }
-            match chars.next() {
-                Some('"') => out.push('"'),
-                Some('\\') => out.push('\\'),
-                Some('/') => out.push('/'),
-                Some('n') => out.push('\n'),
-                Some('t') => out.push('\t'),
-                Some('x') => {
-                    let hex: String = chars.by_ref().take(2).collect();
-                    let code = u32::from_str_radix(&hex, 16)
-                        .ok()
-                        .and_then(char::from_u32)
-                        .ok_or_else(|| format!("bad escape `\\x{hex}`"))?;
-                    out.push(code);
-                }
-                other => return Err(format!("unsupported escape `\\{}`", other.map(String::from).unwrap_or_default())),
-            }
-        }
-        return Ok(out);
-    }
-    Ok(v.to_string())
-}
-
-/// A YAML number (integers too; `.inf`/`.nan` spellings are read so they can be
-/// refused with a clear message rather than "not a number").
-fn parse_yaml_float(v: &str) -> Option<f64> {
-    let v = v.trim();
-    match v.to_ascii_lowercase().as_str() {
-        ".inf" | "+.inf" => return Some(f64::INFINITY),
-        "-.inf" => return Some(f64::NEG_INFINITY),
-        ".nan" => return Some(f64::NAN),
-        _ => {}
-    }
-    // Rust's parser also takes `inf`/`nan`/`infinity`, which YAML does not.
-    if v.chars().all(|c| c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E')) {
-        v.parse().ok()
-    } else {
-        None
-    }
 }
 
 /// Parses a binary PGM (Netpbm `P5`, maxval 255): width, height and the pixel rows, top
@@ -563,6 +474,14 @@ mod tests {
         assert_eq!(m.origin_yaw, 0.1);
         // negate: p = v / 255, so 255 is occupied and 0 free.
         assert_eq!(m.cells, [Ternary::Occupied, Ternary::Free]);
+        // The same description in flow style and as JSON.
+        for text in [
+            "{image: my map.pgm, resolution: 1, origin: [1.5, -2, 0.1], negate: 1,\n  occupied_thresh: 0.65, free_thresh: 0.196}\n",
+            r#"{"image": "my map.pgm", "resolution": 1, "origin": [1.5, -2, 0.1], "negate": 1, "occupied_thresh": 0.65, "free_thresh": 0.196}"#,
+        ] {
+            std::fs::write(&yaml, text).unwrap();
+            assert_eq!(read_map_server(&yaml).unwrap(), m, "{text}");
+        }
         std::fs::remove_dir_all(&d).unwrap();
     }
 
@@ -585,8 +504,10 @@ mod tests {
         check(&good.replace("mode: trinary", "mode: raw"), ":2:");
         check(&good.replace("negate: 0\n", ""), "`negate`");
         check(&format!("{good}resolution: 1\n"), "twice");
-        check(&good.replace("image: map.pgm", "  nested: x"), ":1:");
-        check(&good.replace("image: map.pgm", "image: 'map.pgm"), "unterminated");
+        check(&good.replace("image: map.pgm", "  nested: x"), ":2: not valid YAML");
+        check("[1, 2]\n", "map description");
+        check(&good.replace("image: map.pgm", "image: [map.pgm]"), "expected text");
+        check(&good.replace("image: map.pgm", "image: 'map.pgm"), "not valid YAML");
         // A missing image is an I/O error naming the image.
         std::fs::write(&yaml, good.replace("map.pgm", "gone.pgm")).unwrap();
         let e = read_map_server(&yaml).unwrap_err();
@@ -626,14 +547,21 @@ mod tests {
         assert_eq!(yaml_float(-5.0), "-5.0");
         assert_eq!(yaml_float(0.05), "0.05");
         assert_eq!(yaml_float(1e-7), "0.0000001");
-        assert_eq!(parse_yaml_float(&yaml_float(0.1 + 0.2)), Some(0.1 + 0.2));
         assert_eq!(yaml_string("map.pgm"), "map.pgm");
         assert_eq!(yaml_string("my map: #1.pgm"), "\"my map: #1.pgm\"");
-        assert_eq!(unquote(&yaml_string("a\"b\\c.pgm")).unwrap(), "a\"b\\c.pgm");
-        assert_eq!(unquote("'it''s'").unwrap(), "it's");
-        assert_eq!(strip_comment("a: 'x # y' # z"), "a: 'x # y' ");
-        assert_eq!(strip_comment("a: b#c"), "a: b#c");
-        assert_eq!(parse_yaml_float("nan"), None);
-        assert!(parse_yaml_float(".nan").unwrap().is_nan());
+        // What is written reads back, through the YAML parser, as what was meant.
+        let read = |value: String| {
+            let doc = format!("v: {value}  # a comment\n");
+            let root = yaml::parse(&doc).unwrap();
+            let v = yaml::get(&root, "v").unwrap();
+            (yaml::number(v).ok(), yaml::text(v).ok())
+        };
+        assert_eq!(read(yaml_float(0.1 + 0.2)).0, Some(0.1 + 0.2));
+        for name in ["my map: #1.pgm", "a\"b\\c.pgm", "it's.pgm", "map.pgm"] {
+            assert_eq!(read(yaml_string(name)).1.as_deref(), Some(name));
+        }
+        assert_eq!(read("'it''s'".into()).1.as_deref(), Some("it's"));
+        assert_eq!(read("nan".into()).0, None);
+        assert!(read(".nan".into()).0.unwrap().is_nan());
     }
 }

@@ -150,3 +150,51 @@ fn the_same_log_in_five_formats_gives_bit_identical_maps() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The ROS 2 fixture's `metadata.yaml` rewritten in flow style and as JSON (by ruamel.yaml,
+/// the YAML library of the `rosbags` that wrote the bag) maps to the same bytes as the
+/// block style `rosbags` wrote.
+#[test]
+fn a_metadata_yaml_in_block_flow_or_json_style_maps_the_bag_identically() {
+    let Some(fixtures) = intel_fixtures() else { return };
+    let dir = temp_dir("metadata-styles");
+    let restyle = "\
+import io, json, sys
+from pathlib import Path
+from ruamel.yaml import YAML
+path, style = Path(sys.argv[1]), sys.argv[2]
+doc = YAML(typ='safe', pure=True).load(path.read_text())
+if style == 'json':
+    path.write_text(json.dumps(doc, indent=2))
+else:
+    out = YAML(typ='safe', pure=True)
+    out.default_flow_style = True
+    buf = io.StringIO()
+    out.dump(doc, buf)
+    path.write_text(buf.getvalue())
+";
+    let mut maps = Vec::new();
+    for style in ["block", "flow", "json"] {
+        let bag = dir.join(format!("bag-{style}"));
+        std::fs::create_dir_all(&bag).expect("cannot make the bag directory");
+        for entry in std::fs::read_dir(fixtures.join("rosbag2_mcap")).expect("the fixture bag") {
+            let entry = entry.expect("a directory entry");
+            std::fs::copy(entry.path(), bag.join(entry.file_name())).expect("cannot copy the bag");
+        }
+        let metadata = bag.join("metadata.yaml");
+        if style != "block" {
+            let o = Command::new(python()).args(["-c", restyle]).arg(&metadata).arg(style).output().expect("python");
+            assert!(o.status.success(), "restyling failed:\n{}", stderr(&o));
+        }
+        let text = std::fs::read_to_string(&metadata).expect("metadata.yaml");
+        assert_eq!(text.trim_start().starts_with('{'), style != "block", "{style}:\n{text}");
+        let out = dir.join(format!("out-{style}"));
+        let o = run(&["map", "--out", out.to_str().unwrap(), bag.to_str().unwrap()]);
+        assert!(o.status.success(), "{style}: fusemap map failed:\n{}\n{}", stdout(&o), stderr(&o));
+        maps.push((style, std::fs::read(out.join("map.npz")).expect("map.npz")));
+    }
+    for (style, bytes) in &maps[1..] {
+        assert!(*bytes == maps[0].1, "{style} style: map.npz differs from the block style's");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -3,12 +3,12 @@
 //!
 //! Only five keys of `metadata.yaml` matter here, all direct children of
 //! `rosbag2_bagfile_information`: `version`, `storage_identifier`,
-//! `relative_file_paths`, `compression_mode` and `compression_format`. They are read by
-//! hand (block or flow list, plain or quoted scalars) rather than with a YAML library:
-//! nested keys (topic lists, QoS profiles) are skipped by their indentation.
+//! `relative_file_paths`, `compression_mode` and `compression_format`. The file is parsed
+//! as YAML ([`crate::yaml`]), so block, flow and JSON spellings of it read the same.
 
 use super::PendingFile;
 use crate::error::{Error, Location, Result};
+use crate::yaml;
 use std::path::{Path, PathBuf};
 
 /// The file that makes a directory a rosbag2 bag.
@@ -30,158 +30,51 @@ pub struct Metadata {
 }
 
 /// A parse error: the 1-based line (0 for the file as a whole) and what is wrong.
-pub type MetadataError = (u64, String);
+pub type MetadataError = yaml::YamlError;
 
 const ROOT_KEY: &str = "rosbag2_bagfile_information";
 
-/// Reads the keys fusemap needs from the text of a `metadata.yaml`.
+/// Reads the keys fusemap needs from the text of a `metadata.yaml`, in any YAML style:
+/// block (as `ros2 bag record` writes it), flow, or JSON.
 pub fn parse_metadata(text: &str) -> std::result::Result<Metadata, MetadataError> {
-    let lines: Vec<(u64, usize, &str)> = text
-        .lines()
-        .enumerate()
-        .filter_map(|(i, line)| {
-            let line = line.trim_end_matches('\r');
-            let body = line.trim_start_matches(' ');
-            if body.is_empty() || body.starts_with('#') || line == "---" {
-                return None;
-            }
-            if body.starts_with('\t') {
-                // Tabs are not YAML indentation; let the caller see the line.
-                return Some((i as u64 + 1, usize::MAX, body));
-            }
-            Some((i as u64 + 1, line.len() - body.len(), body))
-        })
-        .collect();
-
-    let root = lines
-        .iter()
-        .position(|&(_, indent, body)| indent == 0 && key_of(body).is_some_and(|(k, _)| k == ROOT_KEY))
+    let root = yaml::parse(text)?;
+    let info = yaml::get(&root, ROOT_KEY)
         .ok_or_else(|| (0, format!("no `{ROOT_KEY}:` key at the top level; not rosbag2 metadata")))?;
-    let Some(&(_, child_indent, _)) = lines.get(root + 1) else {
-        return Err((lines[root].0, format!("`{ROOT_KEY}` is empty")));
+    if !yaml::is_mapping(info) {
+        return Err((yaml::line(info), format!("`{ROOT_KEY}` holds no keys")));
+    }
+    let text_of = |key: &str| -> std::result::Result<String, MetadataError> {
+        yaml::get(info, key)
+            .map_or(Ok(String::new()), |n| yaml::text(n).map_err(|m| (yaml::line(n), format!("`{key}`: {m}"))))
     };
-    if child_indent == 0 || child_indent == usize::MAX {
-        return Err((lines[root].0 + 1, format!("`{ROOT_KEY}` has no indented keys")));
-    }
-
-    let mut meta = Metadata::default();
-    let mut found_paths = false;
-    let mut i = root + 1;
-    while i < lines.len() {
-        let (line_no, indent, body) = lines[i];
-        i += 1;
-        if indent == usize::MAX {
-            return Err((line_no, "tab used for indentation".into()));
+    let version = match yaml::get(info, "version") {
+        None => None,
+        Some(n) => {
+            let v = yaml::text(n).unwrap_or_default();
+            Some(v.parse().map_err(|_| (yaml::line(n), format!("`version: {v}` is not a whole number")))?)
         }
-        if indent == 0 {
-            break;
-        }
-        if indent != child_indent || body.starts_with("- ") || body == "-" {
-            continue;
-        }
-        let Some((key, value)) = key_of(body) else {
-            continue;
-        };
-        match key {
-            "version" => {
-                let v = scalar(value);
-                meta.version = Some(v.parse().map_err(|_| (line_no, format!("`version: {v}` is not a whole number")))?);
-            }
-            "storage_identifier" => meta.storage_identifier = scalar(value),
-            "compression_mode" => meta.compression_mode = scalar(value),
-            "compression_format" => meta.compression_format = scalar(value),
-            "relative_file_paths" => {
-                found_paths = true;
-                let value = strip_comment(value).trim();
-                if let Some(flow) = value.strip_prefix('[') {
-                    let inner = flow
-                        .strip_suffix(']')
-                        .ok_or((line_no, "`relative_file_paths: [` without a closing `]`".to_string()))?;
-                    meta.relative_file_paths = inner.split(',').map(scalar).filter(|s| !s.is_empty()).collect();
-                } else if !value.is_empty() {
-                    return Err((line_no, format!("`relative_file_paths` should be a list, not `{value}`")));
-                } else {
-                    // Block list: `- item` lines, indented deeper or (a style some writers
-                    // use) at the key's own indentation.
-                    while let Some(&(_, item_indent, item)) = lines.get(i) {
-                        let is_item = item_indent != usize::MAX
-                            && item_indent >= child_indent
-                            && (item.starts_with("- ") || item == "-");
-                        if !is_item {
-                            break;
-                        }
-                        meta.relative_file_paths.push(scalar(&item[1..]));
-                        i += 1;
-                    }
-                }
-            }
-            _ => {}
-        }
-    }
-    if !found_paths {
-        return Err((0, format!("no `relative_file_paths` under `{ROOT_KEY}`")));
-    }
-    Ok(meta)
-}
-
-/// `key: rest` of a mapping line, with the key unquoted.
-fn key_of(body: &str) -> Option<(&str, &str)> {
-    let (key, rest) = if let Some(quoted) = body.strip_prefix('"') {
-        let end = quoted.find('"')?;
-        (&quoted[..end], quoted[end + 1..].strip_prefix(':')?)
-    } else {
-        let colon = body.find(':')?;
-        let rest = &body[colon + 1..];
-        if !(rest.is_empty() || rest.starts_with(' ')) {
-            return None;
-        }
-        (&body[..colon], rest)
     };
-    Some((key.trim(), rest))
-}
-
-/// Drops a ` # comment` outside quotes.
-fn strip_comment(value: &str) -> &str {
-    let mut quote = None;
-    let bytes = value.as_bytes();
-    for (i, &b) in bytes.iter().enumerate() {
-        match (quote, b) {
-            (None, b'"' | b'\'') => quote = Some(b),
-            (Some(q), _) if b == q => quote = None,
-            (None, b'#') if i == 0 || bytes[i - 1] == b' ' => return &value[..i],
-            _ => {}
+    let paths = yaml::get(info, "relative_file_paths")
+        .ok_or_else(|| (0, format!("no `relative_file_paths` under `{ROOT_KEY}`")))?;
+    let relative_file_paths = match yaml::items(paths) {
+        Some(items) => items
+            .iter()
+            .map(|n| yaml::text(n).map_err(|m| (yaml::line(n), format!("`relative_file_paths`: {m}"))))
+            .collect::<std::result::Result<_, _>>()?,
+        // `relative_file_paths:` with nothing after it: no files (refused by the caller).
+        None if yaml::text(paths).is_ok_and(|s| s.is_empty()) => Vec::new(),
+        None => {
+            let what = yaml::text(paths).map_or_else(|_| "a mapping".to_string(), |s| format!("`{s}`"));
+            return Err((yaml::line(paths), format!("`relative_file_paths` should be a list, not {what}")));
         }
-    }
-    value
-}
-
-/// A plain, 'single' or "double" quoted scalar.
-fn scalar(value: &str) -> String {
-    let v = strip_comment(value).trim();
-    if v.len() >= 2 && v.starts_with('"') && v.ends_with('"') {
-        let inner = &v[1..v.len() - 1];
-        let mut out = String::with_capacity(inner.len());
-        let mut chars = inner.chars();
-        while let Some(c) = chars.next() {
-            if c == '\\' {
-                match chars.next() {
-                    Some('n') => out.push('\n'),
-                    Some('t') => out.push('\t'),
-                    Some(other) => out.push(other),
-                    None => out.push('\\'),
-                }
-            } else {
-                out.push(c);
-            }
-        }
-        out
-    } else if v.len() >= 2 && v.starts_with('\'') && v.ends_with('\'') {
-        v[1..v.len() - 1].replace("''", "'")
-    } else if v == "~" || v == "null" {
-        String::new()
-    } else {
-        v.to_string()
-    }
+    };
+    Ok(Metadata {
+        version,
+        storage_identifier: text_of("storage_identifier")?,
+        relative_file_paths,
+        compression_mode: text_of("compression_mode")?,
+        compression_format: text_of("compression_format")?,
+    })
 }
 
 /// A rosbag2 directory resolved to its storage files.
@@ -193,7 +86,7 @@ pub(crate) struct Rosbag2Dir {
 impl Rosbag2Dir {
     pub(crate) fn open(dir: &Path) -> Result<Self> {
         let meta_path = dir.join(METADATA_FILE);
-        let text = std::fs::read_to_string(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
+        let text = yaml::read_text(&meta_path)?;
         let meta = parse_metadata(&text).map_err(|(line, message)| {
             let location = if line == 0 { Location::File } else { Location::Line(line) };
             Error::format(&meta_path, location, message)
@@ -409,6 +302,62 @@ rosbag2_bagfile_information:
 
         let flow = "rosbag2_bagfile_information:\n    relative_file_paths: [x.db3, \"y.db3\"]\n";
         assert_eq!(parse_metadata(flow).unwrap().relative_file_paths, ["x.db3", "y.db3"]);
+    }
+
+    /// One bag's metadata as `ros2 bag record` writes it (block style), as PyYAML writes it
+    /// with `default_flow_style=True` (flow style, wrapped over lines), and as JSON.
+    #[test]
+    fn block_flow_and_json_metadata_read_the_same() {
+        let block = "\
+rosbag2_bagfile_information:
+  version: 9
+  storage_identifier: mcap
+  duration:
+    nanoseconds: 29900000000
+  message_count: 600
+  topics_with_message_count:
+    - topic_metadata:
+        name: /scan
+        type: sensor_msgs/msg/LaserScan
+        serialization_format: cdr
+        offered_qos_profiles: []
+      message_count: 300
+  compression_format: \"\"
+  compression_mode: \"\"
+  relative_file_paths:
+    - bag_0.mcap
+    - bag_1.mcap
+  custom_data: ~
+  ros_distro: jazzy
+";
+        let flow = "\
+{rosbag2_bagfile_information: {compression_format: '', compression_mode: '', custom_data: null,
+    duration: {nanoseconds: 29900000000}, message_count: 600, relative_file_paths: [
+      bag_0.mcap, bag_1.mcap], ros_distro: jazzy, storage_identifier: mcap, topics_with_message_count: [
+      {message_count: 300, topic_metadata: {name: /scan, offered_qos_profiles: [], serialization_format: cdr,
+          type: sensor_msgs/msg/LaserScan}}], version: 9}}
+";
+        let json = r#"{
+  "rosbag2_bagfile_information": {
+    "version": 9, "storage_identifier": "mcap", "duration": {"nanoseconds": 29900000000},
+    "message_count": 600,
+    "topics_with_message_count": [{"topic_metadata": {"name": "/scan",
+      "type": "sensor_msgs/msg/LaserScan", "serialization_format": "cdr",
+      "offered_qos_profiles": []}, "message_count": 300}],
+    "compression_format": "", "compression_mode": "",
+    "relative_file_paths": ["bag_0.mcap", "bag_1.mcap"], "custom_data": null, "ros_distro": "jazzy"
+  }
+}"#;
+        let expected = Metadata {
+            version: Some(9),
+            storage_identifier: "mcap".into(),
+            relative_file_paths: vec!["bag_0.mcap".into(), "bag_1.mcap".into()],
+            compression_mode: String::new(),
+            compression_format: String::new(),
+        };
+        for (style, text) in [("block", block), ("flow", flow), ("JSON", json)] {
+            assert_eq!(parse_metadata(text).as_ref(), Ok(&expected), "{style}");
+        }
     }
 
     #[test]
