@@ -50,12 +50,16 @@ pub struct OutputSet {
     /// Held open for the lock; released on drop.
     _lock: File,
     committed: bool,
+    /// True when this set made the output directory: an uncommitted set then removes it
+    /// again (with its lock file), so a run that fails on its input leaves nothing.
+    created_dir: bool,
 }
 
 impl OutputSet {
     /// Creates `dir` if needed, takes its lock, removes staging directories of dead runs
     /// and opens a fresh staging directory.
     pub fn begin(dir: &Path) -> Result<Self> {
+        let created_dir = !dir.exists();
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         let lock_path = dir.join(LOCK_FILE);
         let lock = OpenOptions::new()
@@ -91,7 +95,7 @@ impl OutputSet {
         }
         let staging = dir.join(format!("{STAGING_PREFIX}{}", std::process::id()));
         std::fs::create_dir(&staging).map_err(|e| Error::io(&staging, e))?;
-        Ok(Self { dir: dir.to_path_buf(), staging, _lock: lock, committed: false })
+        Ok(Self { dir: dir.to_path_buf(), staging, _lock: lock, committed: false, created_dir })
     }
 
     /// The output directory.
@@ -187,6 +191,14 @@ impl Drop for OutputSet {
     fn drop(&mut self) {
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.staging);
+            // A directory this run made and wrote nothing into goes again: only its lock
+            // file is there. `remove_dir` (not `_all`) leaves it if anything else appeared.
+            let only_lock = std::fs::read_dir(&self.dir)
+                .map(|entries| entries.flatten().all(|e| e.file_name() == LOCK_FILE))
+                .unwrap_or(false);
+            if self.created_dir && only_lock && std::fs::remove_file(self.dir.join(LOCK_FILE)).is_ok() {
+                let _ = std::fs::remove_dir(&self.dir);
+            }
         }
     }
 }
@@ -365,6 +377,21 @@ mod tests {
         assert_eq!(names(&dir), [".fusemap.lock", "map.pgm", "summary.json"]);
         assert_eq!(std::fs::read(dir.join("map.pgm")).unwrap(), b"old pgm");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn an_uncommitted_set_removes_the_directory_it_made() {
+        let parent = crate::testdata::temp_dir("output-set-made");
+        let dir = parent.join("out/run");
+        drop(OutputSet::begin(&dir).unwrap());
+        // The run failed before writing anything: `run` goes, the parent it made stays.
+        assert!(!dir.exists() && parent.join("out").is_dir());
+        // Something else written there meanwhile keeps the directory.
+        let set = OutputSet::begin(&dir).unwrap();
+        std::fs::write(dir.join("mine.txt"), b"the user's").unwrap();
+        drop(set);
+        assert_eq!(names(&dir), [".fusemap.lock", "mine.txt"]);
+        std::fs::remove_dir_all(&parent).unwrap();
     }
 
     #[test]

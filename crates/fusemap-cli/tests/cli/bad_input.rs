@@ -216,6 +216,7 @@ fn world_missing_file_names_the_path() {
 /// line naming the log and each of `parts`.
 fn log_errors(log: &Path, parts: &[&str]) {
     let out = log.parent().unwrap().join("out");
+    let existed = out.exists();
     let map = one_line_error(&run(&["map", "--out", path_str(&out), path_str(log)]));
     let doctor = one_line_error(&run(&["doctor", path_str(log)]));
     for line in [&map, &doctor] {
@@ -223,6 +224,8 @@ fn log_errors(log: &Path, parts: &[&str]) {
         assert_names(line, parts);
     }
     assert_no_map(&out);
+    // A run that fails on its input leaves no output directory it made (not even its lock).
+    assert!(existed || !out.exists(), "{} was left behind", out.display());
 }
 
 #[test]
