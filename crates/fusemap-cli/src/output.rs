@@ -11,7 +11,7 @@ use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::grid::{CellBox, CellIndex, CellRaster, DynamicParams, FusionGrid, Raster};
-use fusemap_core::measurement::SensorId;
+use fusemap_core::measurement::{SensorId, SensorKind};
 use fusemap_core::metrics::{map_entropy, sparse_entropy};
 use fusemap_core::sensor::ReturnCounts;
 use fusemap_core::time::Stamp;
@@ -284,12 +284,15 @@ pub fn finish(
         _ => None,
     };
     let layers = raster.and_then(|r| layers_of(engine, grid, r));
-    let st = engine.stats();
+    let st = engine.maps().primary().stats();
     let mut returns = ReturnCounts::default();
-    let mut scans = 0;
+    let (mut scans, mut camera_frames) = (0, 0);
     for s in engine.sensor_stats() {
         returns.add(&s.returns);
-        scans += s.scans;
+        match s.kind {
+            SensorKind::Lidar => scans += s.scans,
+            SensorKind::Camera => camera_frames += s.scans,
+        }
     }
     let (map, entropy) = match &view {
         MapView::Empty => (MapInfo::new(None, grid.geometry().resolution(), grid.tile_count()), None),
@@ -314,13 +317,14 @@ pub fn finish(
         source_kind: source_kind.to_string(),
         source: source.to_string(),
         scans,
+        camera_frames,
         beams: returns.total(),
         returns,
-        rays_walked: st.insert.rays,
-        rays_rejected: st.insert.rays_rejected,
-        cell_visits: st.insert.cell_visits,
-        cell_visits_attenuated: st.insert.cell_visits_attenuated,
-        cells_updated: CellsUpdated::from(&st.insert),
+        rays_walked: st.rays,
+        rays_rejected: st.rays_rejected,
+        cell_visits: st.cell_visits,
+        cell_visits_attenuated: st.cell_visits_attenuated,
+        cells_updated: CellsUpdated::from(st),
         map,
         entropy,
         wall_time_s: 0.0,

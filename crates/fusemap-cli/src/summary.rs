@@ -15,13 +15,17 @@ pub struct Summary {
     pub source_kind: String,
     /// The input file.
     pub source: String,
-    /// Scans inserted into the map.
+    /// Lidar scans inserted into the map.
     pub scans: u64,
+    /// Camera frames inserted into the map (counted apart from the scans).
+    pub camera_frames: u64,
     /// Beams in those scans.
     pub beams: u64,
     /// Beams by kind of return (invalid kinds are never evidence).
     pub returns: ReturnCounts,
-    /// Rays walked through the grid.
+    /// Rays walked through the grid. This and the counts below are the primary map's
+    /// (the one written): a run that also builds single-sensor maps beside it (`demo`)
+    /// reports the same figures as a run that builds the primary alone.
     pub rays_walked: u64,
     /// Rays the grid refused (non-finite or absurdly long).
     pub rays_rejected: u64,
@@ -95,6 +99,9 @@ impl Summary {
     pub fn print(&self) {
         println!("source        {} ({})", printable(&self.source), self.source_kind);
         println!("scans         {}", self.scans);
+        if self.camera_frames > 0 {
+            println!("camera frames {}", self.camera_frames);
+        }
         let r = &self.returns;
         println!(
             "beams         {} (valid {}, no return {}, invalid {}: nan {}, inf {}, zero {}, negative {}, below min {})",

@@ -109,13 +109,16 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     summary.print();
     print_scores(&scores, &plan);
     println!("comparison    {}", picture.display());
-    println!(
-        "outputs       {} (fused), {}/lidar, {}/camera, {}/sim",
-        out.display(),
-        out.display(),
-        out.display(),
-        out.display()
-    );
+    let others: Vec<String> = run
+        .engine
+        .maps()
+        .iter()
+        .skip(1)
+        .map(|m| m.name())
+        .chain(["sim"])
+        .map(|name| out.join(name).display().to_string())
+        .collect();
+    println!("outputs       {} (fused), {}", out.display(), others.join(", "));
     Ok(())
 }
 

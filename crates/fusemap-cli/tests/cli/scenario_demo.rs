@@ -48,12 +48,19 @@ fn the_scenario_demo_writes_three_scored_maps_and_their_layers() {
     assert!(!out.join("lidar/semantic.yaml").exists(), "a lidar-only map has no semantic layer");
     let text = stdout(&o);
     assert!(text.contains("fused") && text.contains("comparison"), "{text}");
+    assert!(text.contains(&out.join("lidar").display().to_string()) && !text.contains("//"), "{text}");
 
     let summary = read_json(&out.join("summary.json"));
     let scores = summary["log"]["scenario_scores"].as_array().unwrap();
     let f1 = |name: &str| scores.iter().find(|s| s["name"] == name).unwrap()["occupied"]["f1"].as_f64().unwrap();
     assert!(f1("fused") > f1("lidar") && f1("fused") > f1("camera"), "{scores:?}");
-    assert!(summary["log"]["cameras"][0]["frames_used"].as_u64().unwrap() > 1000);
+    let frames = summary["log"]["cameras"][0]["frames_used"].as_u64().unwrap();
+    assert!(frames > 1000);
+    // Scans are the lidar's, camera frames are counted apart (the bag has 1,800 scans).
+    assert_eq!(summary["scans"], summary["log"]["scans_used"]);
+    assert_eq!(summary["scans"], 1800);
+    assert_eq!(summary["camera_frames"], frames);
+    assert!(text.contains("scans         1800\n") && text.contains(&format!("camera frames {frames}\n")), "{text}");
 
     let yaml = std::fs::read_to_string(out.join("semantic.yaml")).unwrap();
     assert!(yaml.contains("image: semantic.png") && yaml.contains("name: wall"), "{yaml}");

@@ -344,6 +344,12 @@ mod tests {
             sum.add(m.stats());
         }
         assert_eq!(&sum, &e.stats().insert);
+        // The primary map's counters are those of a run that builds it alone (what a
+        // summary reports), not the engine's sum over every map.
+        let mut alone = rig.engine(MapSet::new("alone", SensorSelection::All, grid()));
+        rig.feed(&mut alone, &[FRONT, REAR]);
+        assert_eq!(maps.primary().stats(), &alone.stats().insert);
+        assert_ne!(maps.primary().stats(), &e.stats().insert);
     }
 
     #[test]
