@@ -29,7 +29,7 @@ use crate::track::Track;
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SyncConfig};
 use fusemap_core::geometry::quaternion_yaw;
-use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
+use fusemap_core::time::{PoseTrack, Stamp, StreamTiming, SyncMode, TimingLimits};
 use fusemap_io::text::{printable, table_cell};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -78,6 +78,48 @@ struct TrackSync {
     interpolate: Skipped,
     nearest: Skipped,
     nearest_tolerance_s: f64,
+    /// When `fusemap map` would run SLAM over the track: why, and how it poses the scans
+    /// the track alone leaves without a pose.
+    slam: Option<SlamCover>,
+}
+
+/// How SLAM poses the scans its pose track cannot (`slam.rs` does the same).
+struct SlamCover {
+    reason: String,
+    /// Scans in a pause of the track: SLAM interpolates across it for the matcher's guess.
+    in_pauses: u64,
+    /// Scans before the track's first or after its last pose: matched from the scan before.
+    outside: u64,
+}
+
+impl SlamCover {
+    fn count(reason: String, track: &dyn PoseTrack, stamps: &[Stamp], offset: i64, mode: SyncMode) -> Self {
+        let samples = track.samples();
+        let mut cover = Self { reason, in_pauses: 0, outside: 0 };
+        for s in stamps {
+            let t = Stamp(s.0.saturating_add(offset));
+            if track.pose_at(t, mode).is_err() {
+                if crate::slam::across_gap(&samples, t).is_some() {
+                    cover.in_pauses += 1;
+                } else {
+                    cover.outside += 1;
+                }
+            }
+        }
+        cover
+    }
+
+    /// The finding: every scan gets a pose, and how.
+    fn finding(&self, topic: &str, scans: u64, source: &str) -> String {
+        format!(
+            "SLAM poses all {scans} scans on {topic}, also the {} that {source} alone leaves without a pose: {} in its \
+             pauses, across which SLAM interpolates it as the scan matcher's first guess, and {} before its first or \
+             after its last pose, matched from the scan before",
+            self.in_pauses + self.outside,
+            self.in_pauses,
+            self.outside
+        )
+    }
 }
 
 /// What the doctor found.
@@ -206,11 +248,14 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
                         PoseSource::Tf => Some("/tf".to_string()),
                         _ => None,
                     };
+                    let (slam_on, reason) = crate::slam::applies(plan, &log, &bound, &chosen);
+                    let slam = slam_on.then(|| SlamCover::count(reason, track.as_ref(), stamps, offset, configured));
                     sync = Some(Sync {
                         topic: topic.clone(),
                         scans: stamps.len() as u64,
                         source: chosen.name.clone(),
                         track: Some(TrackSync {
+                            slam,
                             topic: topic_of_track,
                             configured,
                             interpolate: tally(SyncMode::Interpolate),
@@ -292,7 +337,9 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
             }
         }
         if *kind != "scan" && t.gaps > 0 {
-            let consequence = if role == Role::PoseTrack {
+            let consequence = if role == Role::PoseTrack && track.is_some_and(|tr| tr.slam.is_some()) {
+                ": SLAM poses the scans inside them (see below)".to_string()
+            } else if role == Role::PoseTrack {
                 format!(
                     ": a scan inside one gets a pose only if the robot moved at most {} m and {}° across it",
                     cfg.gap_bridge_motion_m, cfg.gap_bridge_motion_deg
@@ -320,12 +367,25 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
             )?,
             Some(tr) => {
                 let share = |k: &Skipped| 100.0 * (s.scans - k.total()) as f64 / s.scans.max(1) as f64;
-                writeln!(out, "scans on {} with a pose from {}:", printable(&s.topic), s.source)?;
+                if let Some(slam) = &tr.slam {
+                    writeln!(
+                        out,
+                        "scans on {} are posed by SLAM over {}, as `fusemap map` poses them ({}); {} alone gives a pose to:",
+                        printable(&s.topic),
+                        s.source,
+                        slam.reason,
+                        s.source
+                    )?;
+                } else {
+                    writeln!(out, "scans on {} with a pose from {}:", printable(&s.topic), s.source)?;
+                }
                 writeln!(out, "  interpolate: {:.1} %", share(&tr.interpolate))?;
                 writeln!(out, "  nearest within {:.0} ms: {:.1} %", tr.nearest_tolerance_s * 1e3, share(&tr.nearest))?;
                 let skipped = if tr.configured == SyncMode::Interpolate { &tr.interpolate } else { &tr.nearest };
                 let missing = skipped.total();
-                if missing > 0 {
+                if let Some(slam) = tr.slam.as_ref().filter(|_| missing > 0) {
+                    findings.push(slam.finding(&s.topic, s.scans, &s.source));
+                } else if missing > 0 {
                     let pct = 100.0 - share(skipped);
                     // One decimal, or two when that would print a share that is not 0 as 0.0.
                     let pct = if pct < 0.1 { format!("{pct:.2}") } else { format!("{pct:.1}") };

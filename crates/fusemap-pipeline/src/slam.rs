@@ -333,7 +333,7 @@ fn fixes(
 
 /// The track's pose at `t` interpolated between its samples whatever the gap between
 /// them; `None` outside the samples.
-fn across_gap(samples: &[(Stamp, Pose2)], t: Stamp) -> Option<Pose2> {
+pub(crate) fn across_gap(samples: &[(Stamp, Pose2)], t: Stamp) -> Option<Pose2> {
     let i = samples.partition_point(|s| s.0 < t);
     let (b, a) = (samples.get(i)?, samples.get(i.checked_sub(1)?)?);
     if b.0 == t {
