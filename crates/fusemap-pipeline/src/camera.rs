@@ -9,7 +9,7 @@
 
 use crate::extrinsics::{from_tf, resolve, ExtrinsicsReport};
 use crate::recording::Inventory;
-use crate::report::Skipped;
+use crate::sync::Skipped;
 use crate::track::Track;
 use crate::PipelineError;
 use fusemap_core::config::{ExtrinsicsSource, LogConfig, PlannedCamera};
@@ -187,10 +187,10 @@ impl MappedCamera {
     ) -> Self {
         Self {
             id,
-            offset_ns: crate::run::offset_ns(c.time_offset_s),
+            offset_ns: crate::sync::offset_ns(c.time_offset_s),
             label_stream,
             depth_stream,
-            tolerance_ns: crate::run::offset_ns(c.pair_tolerance_s),
+            tolerance_ns: crate::sync::offset_ns(c.pair_tolerance_s),
             pending_label: None,
             pending_depth: None,
             report,

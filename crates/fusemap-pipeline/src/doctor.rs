@@ -23,8 +23,8 @@
 //! pose track), so what it says is what `fusemap map` will do.
 
 use crate::recording::Inventory;
-use crate::report::Skipped;
-use crate::run::{limits, sync_mode};
+use crate::sync::Skipped;
+use crate::sync::{limits, sync_mode};
 use crate::track::Track;
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SyncConfig};

@@ -31,6 +31,7 @@ mod insert;
 mod lidar_frames;
 pub mod merge;
 pub mod pose_sensors_report;
+pub mod progress;
 pub mod recording;
 pub mod repeats;
 pub mod report;
@@ -39,11 +40,13 @@ pub mod scenario;
 pub mod sensors;
 pub mod slam;
 pub mod slam_bench;
+pub mod slam_summary;
+pub mod sync;
 pub mod track;
 
 pub use run::{map_inventory, map_log, map_with_track, MapRun, Progress};
 
-pub(crate) use run::offset_ns;
+pub(crate) use sync::offset_ns;
 
 /// Why a run could not be done.
 #[derive(Debug, thiserror::Error)]

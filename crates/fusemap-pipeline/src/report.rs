@@ -2,72 +2,11 @@
 
 use crate::extrinsics::ExtrinsicsReport;
 use crate::merge::StreamStats;
+pub use crate::sync::Skipped;
 use crate::track::TrackCounts;
-use fusemap_core::time::{NoPose, StreamTiming};
+use fusemap_core::time::StreamTiming;
 use serde::Serialize;
 use std::collections::BTreeMap;
-
-/// Scans skipped, by reason.
-#[derive(Debug, Default, Clone, Serialize)]
-pub struct Skipped {
-    /// Before the first pose.
-    pub before_first_pose: u64,
-    /// After the last pose.
-    pub after_last_pose: u64,
-    /// Inside a gap of the pose track.
-    pub in_pose_gap: u64,
-    /// No pose within the nearest-neighbour tolerance.
-    pub no_pose_within_tolerance: u64,
-    /// No pose on the scan line.
-    pub no_pose_on_line: u64,
-    /// The pose on the scan line is a glitch (`log.max_speed_m_s`, `max_turn_rate_deg_s`).
-    pub pose_glitch: u64,
-    /// Arrived later than the merge's reorder window behind the other scans.
-    pub late: u64,
-    /// Its beam angles cannot be placed (`ScanMessage::angle_fault`): a zero or non-finite
-    /// `angle_increment`, or a `ranges` count that disagrees with `angle_min … angle_max`.
-    pub bad_angles: u64,
-    /// The same scan again (same stamp and ranges as the one before it): inserted once.
-    pub repeated: u64,
-}
-
-impl Skipped {
-    /// Counts a scan that got no pose, by the reason.
-    pub fn count(&mut self, why: NoPose) {
-        match why {
-            NoPose::Empty | NoPose::BeforeStart(_) => self.before_first_pose += 1,
-            NoPose::AfterEnd(_) => self.after_last_pose += 1,
-            NoPose::Gap { .. } => self.in_pose_gap += 1,
-            NoPose::TooFar { .. } => self.no_pose_within_tolerance += 1,
-        }
-    }
-
-    /// All skipped scans.
-    pub fn total(&self) -> u64 {
-        self.before_first_pose
-            + self.after_last_pose
-            + self.in_pose_gap
-            + self.no_pose_within_tolerance
-            + self.no_pose_on_line
-            + self.pose_glitch
-            + self.late
-            + self.bad_angles
-            + self.repeated
-    }
-
-    /// Adds another lidar's counts.
-    pub fn add(&mut self, o: &Skipped) {
-        self.before_first_pose += o.before_first_pose;
-        self.after_last_pose += o.after_last_pose;
-        self.in_pose_gap += o.in_pose_gap;
-        self.no_pose_within_tolerance += o.no_pose_within_tolerance;
-        self.no_pose_on_line += o.no_pose_on_line;
-        self.pose_glitch += o.pose_glitch;
-        self.late += o.late;
-        self.bad_angles += o.bad_angles;
-        self.repeated += o.repeated;
-    }
-}
 
 /// One lidar of a run.
 #[derive(Debug, Clone, Serialize)]
@@ -130,7 +69,7 @@ pub struct LogReport {
     pub correlated_merged: u64,
     /// What SLAM did (scan matching, loop closure, the optimised pose graph), when it ran.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub slam: Option<crate::slam::SlamSummary>,
+    pub slam: Option<crate::slam_summary::SlamSummary>,
     /// The sensors that were read, by name: `kind topic`.
     pub sensors: BTreeMap<String, String>,
     /// The pose track's counters.

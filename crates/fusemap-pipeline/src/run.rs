@@ -14,38 +14,25 @@ use crate::insert::{release, Inserter, Mapped};
 use crate::lidar_frames::lidar_setup;
 use crate::lidar_frames::other_frames;
 use crate::merge::{OrderedMerge, Pushed};
+pub use crate::progress::Progress;
 use crate::recording::{for_each_range_message, Inventory, RangeMessage};
 use crate::report::{LidarReport, LogReport, Skipped};
 use crate::sensors::{bind, Bound};
+pub(crate) use crate::sync::offset_ns;
+pub use crate::sync::{limits, sync_mode};
 use crate::track::{choose, count_reordered, ChosenTrack, Track};
 use crate::PipelineError;
-use fusemap_core::config::{default_camera, LogConfig, Plan, PlannedCamera, SensorKind, SyncConfig};
+use fusemap_core::config::{default_camera, Plan, PlannedCamera, SensorKind};
 use fusemap_core::fusion::{Correlation, Engine, MapSet};
 use fusemap_core::geometry::Pose2;
 use fusemap_core::grid::FusionGrid;
 use fusemap_core::measurement::SensorId;
 use fusemap_core::sensor::LaserScan;
-use fusemap_core::time::{Stamp, StreamTiming, SyncMode, TimingLimits};
+use fusemap_core::time::{Stamp, StreamTiming, SyncMode};
 use fusemap_io::log::LogFormat;
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
 use std::time::Instant;
-
-/// What a run tells its caller as it goes (the CLI draws a progress bar from it).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Progress<'a> {
-    /// A phase starts, with the number of steps when known.
-    Phase {
-        /// What it does.
-        name: &'a str,
-        /// Steps in it.
-        total: u64,
-    },
-    /// Steps done since the last report.
-    Advance(u64),
-    /// The phase ended.
-    Done,
-}
 
 /// A finished mapping pass.
 pub struct MapRun {
@@ -60,11 +47,6 @@ pub struct MapRun {
     pub trajectory: Vec<(Stamp, Pose2)>,
     /// Facts a user should know.
     pub notes: Vec<String>,
-}
-
-/// Nanoseconds of a time offset in seconds (configs bound it to ±1 h).
-pub(crate) fn offset_ns(s: f64) -> i64 {
-    (s * 1e9).round() as i64
 }
 
 /// A timed track's samples with the pose every scan was placed with, by stamp (a sample
@@ -107,34 +89,6 @@ pub fn topics_by_kind(inv: &Inventory) -> BTreeMap<SensorKind, BTreeMap<String, 
         m.entry(SensorKind::Pose).or_default().insert(t.clone(), v.len() as u64);
     }
     m
-}
-
-/// The sync mode from the config, with the nearest tolerance resolved (half the median
-/// period of `stamps`, taken in stamp order as the scans are mapped).
-pub fn sync_mode(cfg: &LogConfig, stamps: &[Stamp]) -> SyncMode {
-    match cfg.sync {
-        SyncConfig::Interpolate => SyncMode::Interpolate,
-        SyncConfig::Nearest => {
-            let tol = if cfg.nearest_tolerance_s > 0.0 {
-                cfg.nearest_tolerance_s
-            } else {
-                let mut h = stamps.to_vec();
-                h.sort_unstable();
-                let median_period_s = StreamTiming::analyze(&h, &[], TimingLimits::default()).median_period_s;
-                if median_period_s > 0.0 {
-                    median_period_s / 2.0
-                } else {
-                    0.05
-                }
-            };
-            SyncMode::Nearest { tolerance_s: tol }
-        }
-    }
-}
-
-/// The timing limits of the config.
-pub fn limits(cfg: &LogConfig) -> TimingLimits {
-    TimingLimits { gap_s: cfg.max_pose_gap_s, far_delay_s: cfg.far_delay_s }
 }
 
 /// The cameras to map: the configured ones, else a default camera when the log carries

@@ -66,7 +66,7 @@ pub struct ChosenTrack {
     /// Facts about the track a user should know.
     pub notes: Vec<String>,
     /// What SLAM did, when it corrected the track.
-    pub slam: Option<Box<crate::slam::SlamSummary>>,
+    pub slam: Option<Box<crate::slam_summary::SlamSummary>>,
 }
 
 /// SLAM's optimised poses of scan lines, found by the line's own stamp and pose: placed in

@@ -13,4 +13,5 @@ mod relations;
 mod scenario_demo;
 mod simulate;
 mod sync;
+mod tree;
 mod util;
