@@ -138,8 +138,10 @@ pub struct ClassConfig {
     pub id: u16,
     /// Its name (unique).
     pub name: String,
-    /// Its colour in the semantic picture, `[r, g, b]`.
-    pub color: [u8; 3],
+    /// Its colour in the semantic picture, `[r, g, b]`; left out, one chosen from its id
+    /// ([`default_class_color`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color: Option<[u8; 3]>,
     /// The occupancy probability its label suggests, in (0, 1).
     pub p_occupied: f64,
     /// Its update weight, ≥ 0 (default 1).
@@ -157,12 +159,32 @@ fn one() -> f64 {
     1.0
 }
 
+/// The colour of a class whose table gives none: hues a golden angle (137.5°) apart by
+/// id, so any few ids get clearly different colours, at a saturation and brightness that
+/// stay apart from the map's greys.
+pub fn default_class_color(id: u16) -> [u8; 3] {
+    let hue = (f64::from(id) * 137.507_764_050_037_85).rem_euclid(360.0) / 60.0;
+    let (s, v) = (0.7, 0.9);
+    let c = v * s;
+    let x = c * (1.0 - (hue.rem_euclid(2.0) - 1.0).abs());
+    let (r, g, b) = match hue as u8 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = v - c;
+    [r, g, b].map(|u| ((u + m) * 255.0).round() as u8)
+}
+
 impl From<&ClassConfig> for ClassSpec {
     fn from(c: &ClassConfig) -> ClassSpec {
         ClassSpec {
             id: c.id,
             name: c.name.clone(),
-            color: c.color,
+            color: c.color.unwrap_or_else(|| default_class_color(c.id)),
             p_occupied: c.p_occupied,
             weight: c.weight,
             dynamic: c.dynamic,
@@ -176,7 +198,7 @@ impl From<&ClassSpec> for ClassConfig {
         ClassConfig {
             id: c.id,
             name: c.name.clone(),
-            color: c.color,
+            color: Some(c.color),
             p_occupied: c.p_occupied,
             weight: c.weight,
             dynamic: c.dynamic,
@@ -308,7 +330,7 @@ mod tests {
         ClassConfig {
             id,
             name: name.into(),
-            color: [1, 2, 3],
+            color: Some([1, 2, 3]),
             p_occupied: p,
             weight: 1.0,
             dynamic: false,
@@ -337,5 +359,26 @@ mod tests {
         assert_eq!(bad(vec![ClassConfig { weight: -1.0, ..class(1, "a", 0.5) }]).field, "class[0].weight");
         let many: Vec<ClassConfig> = (0..65).map(|i| class(i, &format!("c{i}"), 0.5)).collect();
         assert_eq!(bad(many).field, "class");
+    }
+
+    #[test]
+    fn a_class_without_a_colour_gets_one() {
+        let c = Config {
+            class: vec![ClassConfig { color: None, ..class(3, "rack", 0.8) }, class(4, "pallet", 0.7)],
+            ..Default::default()
+        };
+        let t = c.validate().unwrap().classes;
+        assert_eq!(t.get(0).color, default_class_color(3));
+        assert_eq!(t.get(1).color, [1, 2, 3]);
+        // Neighbouring ids get clearly different colours, none of them grey.
+        let colors: Vec<[u8; 3]> = (0..16).map(default_class_color).collect();
+        for (i, a) in colors.iter().enumerate() {
+            let spread = a.iter().max().unwrap() - a.iter().min().unwrap();
+            assert!(spread > 100, "id {i}: {a:?} is nearly grey");
+            for b in &colors[i + 1..i + 2.min(colors.len() - i)] {
+                let d: i32 = a.iter().zip(b).map(|(x, y)| (*x as i32 - *y as i32).abs()).sum();
+                assert!(d > 120, "ids {i} and {}: {a:?} {b:?}", i + 1);
+            }
+        }
     }
 }

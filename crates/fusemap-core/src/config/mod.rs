@@ -12,7 +12,7 @@ mod limits;
 mod sensor;
 mod slam;
 
-pub use camera::{default_camera, ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
+pub use camera::{default_camera, default_class_color, ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
 pub use fusion::FusionConfig;
 pub use limits::LimitsConfig;
 pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
