@@ -206,6 +206,14 @@ mod tests {
     }
 
     #[test]
+    fn a_class_table_may_leave_out_its_colour() {
+        let c = parse("[[class]]\nid = 3\nname = \"rack\"\np_occupied = 0.8\n").unwrap();
+        assert_eq!(c.class[0].color, None);
+        let classes = c.validate().unwrap().classes;
+        assert_eq!(classes.get(0).color, fusemap_core::config::default_class_color(3));
+    }
+
+    #[test]
     fn unknown_key_names_key_and_line() {
         let e = parse("[map]\nresolution = 0.05\n\n[[sensor]]\nkind = \"lidar\"\np_ocupied = 0.9\n").unwrap_err();
         let text = e.to_string();
@@ -304,6 +312,17 @@ mod tests {
         assert_eq!(plan.lidars[0].name, default.lidars[0].name);
         assert_eq!(plan.lidars[0].model.params(), default.lidars[0].model.params());
         assert_eq!(plan.lidars[0].topic, None);
+        // Every other section: [fusion], [limits], and the [[class]] tables, which write
+        // out the default class table.
+        assert_eq!(format!("{:?}", c.fusion), format!("{:?}", d.fusion));
+        assert_eq!(format!("{:?}", c.limits), format!("{:?}", d.limits));
+        assert_eq!(plan.classes, default.classes);
+        assert_eq!(c.class.len(), default.classes.len());
+        // The whole plan but how its lidar came to be (the example lists it; the default
+        // plans it): every section's validated form, with what each derives from the others.
+        let mut listed = plan.clone();
+        listed.lidars[0].explicit = default.lidars[0].explicit;
+        assert_eq!(format!("{listed:?}"), format!("{default:?}"));
         // Every line that sets a value carries its own comment block above it: no bare keys.
         let text = std::fs::read_to_string(&p).unwrap();
         let lines: Vec<&str> = text.lines().collect();
