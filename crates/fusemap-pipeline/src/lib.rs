@@ -29,6 +29,7 @@ pub mod estimation;
 pub mod extrinsics;
 mod insert;
 mod lidar_frames;
+mod map_pass;
 pub mod merge;
 pub mod pose_sensors_report;
 pub mod progress;

@@ -1,0 +1,509 @@
+//! The second pass: every lidar's scans and every camera's images, merged in stamp order
+//! (file order for poses on the scan lines, which do not depend on the stamps: some
+//! corrected CARMEN logs have broken or all-zero stamps), each placed with the pose track
+//! at its own stamp and inserted into the engine's maps; then the notes and the report of
+//! what happened to them.
+
+use crate::camera::{build_camera, MappedCamera};
+use crate::extrinsics::frame_tree;
+use crate::insert::{release, Inserter, Mapped};
+use crate::lidar_frames::{lidar_setup, other_frames};
+use crate::merge::{OrderedMerge, Pushed};
+use crate::progress::Progress;
+use crate::recording::{for_each_range_message, Inventory, RangeMessage};
+use crate::report::{LidarReport, LogReport};
+use crate::sensors::Bound;
+use crate::sync::{limits, offset_ns, sync_mode, Skipped};
+use crate::track::{count_reordered, ChosenTrack, Track};
+use crate::PipelineError;
+use fusemap_core::config::{default_camera, LogConfig, Plan, PlannedCamera, SensorKind};
+use fusemap_core::frames::FrameTree;
+use fusemap_core::fusion::{Correlation, Engine, MapSet};
+use fusemap_core::geometry::Pose2;
+use fusemap_core::grid::FusionGrid;
+use fusemap_core::measurement::SensorId;
+use fusemap_core::sensor::LaserScan;
+use fusemap_core::time::{Stamp, StreamTiming, SyncMode};
+use fusemap_io::log::LogFormat;
+use std::collections::HashSet;
+use std::time::Instant;
+
+/// A finished mapping pass.
+pub struct MapRun {
+    /// The engine, holding the map and its counters.
+    pub engine: Engine,
+    /// The log's format.
+    pub format: LogFormat,
+    /// The run report.
+    pub report: LogReport,
+    /// The pose track used, `map_from_base` in time order, with the pose of every mapped
+    /// scan at its stamp (for `trajectory.tum`).
+    pub trajectory: Vec<(Stamp, Pose2)>,
+    /// Facts a user should know.
+    pub notes: Vec<String>,
+}
+
+/// A timed track's samples with the pose every scan was placed with, by stamp (a sample
+/// and a scan at one stamp: the sample). The scans' own poses let a user score the map's
+/// track at the scan stamps (the SLAM benchmark's relations name them) without
+/// interpolating across the odometry's pauses, which the track bridges and a reader of
+/// the file could not tell apart from a gap.
+fn with_scan_poses(samples: Vec<(Stamp, Pose2)>, placed: Vec<(Stamp, Pose2)>) -> Vec<(Stamp, Pose2)> {
+    let mut all = samples;
+    all.extend(placed);
+    all.sort_by_key(|s| s.0);
+    all.dedup_by_key(|s| s.0);
+    all
+}
+
+/// The cameras to map: the configured ones, else a default camera when the log carries
+/// the usual camera topics (and the camera kind is not disabled).
+fn planned_cameras(plan: &Plan, inv: &Inventory, notes: &mut Vec<String>) -> Result<Vec<PlannedCamera>, PipelineError> {
+    if !plan.cameras.is_empty() || plan.disabled_kinds.contains(&SensorKind::Camera) {
+        return Ok(plan.cameras.clone());
+    }
+    let c = default_camera(plan.occupancy.prior).map_err(|e| PipelineError::Refused(e.to_string()))?;
+    let present = inv.images.contains_key(&c.topic)
+        && inv.images.contains_key(&c.depth_topic)
+        && inv.camera_info.contains_key(&c.info_topic);
+    if !present {
+        return Ok(Vec::new());
+    }
+    notes.push(format!(
+        "camera found on `{}`, `{}` and `{}` and mapped with the default camera parameters (list it as a [[sensor]] of kind \"camera\" to change them, or disable it)",
+        c.topic, c.depth_topic, c.info_topic
+    ));
+    Ok(vec![c])
+}
+
+/// What the pass reads from: the plan, the recording's inventory, the bound sensors, the
+/// pose track and the frame tree.
+struct Inputs<'a> {
+    plan: &'a Plan,
+    inv: &'a Inventory,
+    bound: &'a Bound,
+    track: &'a Track,
+    tree: &'a FrameTree,
+}
+
+/// The merge and the sensors that feed it, each with its streams and its report.
+struct Streams {
+    merge: OrderedMerge<RangeMessage>,
+    lidars: Vec<Mapped>,
+    cameras: Vec<MappedCamera>,
+    /// The cameras the plan asked for (or found), mapped or not.
+    planned: Vec<PlannedCamera>,
+}
+
+/// Maps a recording whose first pass is done with a given pose track (a calibration
+/// search, or a comparison of tracks on one log, maps the same scans with several).
+///
+/// `maps`: several maps fed in this one pass, each from its own subset of sensors (the
+/// design document's leave-one-out maps, §5.2); the lidars get sensor ids 0, 1, … in the
+/// order of `bound.lidars`. `None`: one map of every sensor.
+pub fn map_with_track(
+    plan: &Plan,
+    inv: &Inventory,
+    bound: &Bound,
+    mut chosen: ChosenTrack,
+    track_s: f64,
+    maps: Option<MapSet>,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<MapRun, PipelineError> {
+    let cfg = &plan.log;
+    let mut notes = bound.notes.clone();
+    let slam_summary = chosen.slam.take();
+    if bound.lidars.is_empty() {
+        return Err(PipelineError::Refused("no lidar to map: every [[sensor]] of kind lidar is disabled".into()));
+    }
+    let mode = sync_mode(cfg, &inv.scans[&bound.lidars[0].topic].stamps);
+    let mut engine = match maps {
+        Some(m) => Engine::with_maps(m),
+        None => Engine::new(FusionGrid::new(plan.geometry, plan.occupancy)),
+    };
+    engine.set_map_cells_limit(&plan.limits);
+    let (tree, tree_notes) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
+    notes.extend(tree_notes);
+    let input = Inputs { plan, inv, bound, track: &chosen.track, tree: &tree };
+    let mut streams = Streams::open(&input, &mut engine, &mut notes)?;
+
+    let t_map = Instant::now();
+    let placed = streams.run(&input, &mut engine, mode, progress)?;
+    let map_s = t_map.elapsed().as_secs_f64();
+    let trajectory = match &chosen.track {
+        Track::ScanLine(_) => placed,
+        Track::Timed(t) => with_scan_poses(t.samples(), placed),
+    };
+
+    let skipped = lidar_notes(&streams.lidars, cfg, &mut notes);
+    if let Some(cut) = &inv.truncated {
+        notes.push(format!("the log is cut short, and was mapped up to the cut: {cut}"));
+    }
+    if inv.stats.malformed > 0 {
+        notes.push(format!(
+            "{} malformed records skipped; first: {}",
+            inv.stats.malformed,
+            inv.stats.malformed_examples.join("; ")
+        ));
+    }
+    camera_notes(&engine, &mut streams, &mut notes);
+    let mut report = log_report(&input, &chosen, streams, mode, skipped, &tree);
+    (report.track_s, report.map_s) = (track_s, map_s);
+    report.correlated_merged = engine.stats().correlated_merged;
+    report.slam = slam_summary.map(|s| *s);
+    notes.extend(chosen.notes.iter().cloned());
+    Ok(MapRun { engine, format: inv.format, report, trajectory, notes })
+}
+
+impl Streams {
+    /// Registers every lidar (one engine sensor per frame id its topic carries) and every
+    /// camera with the engine and the merge, and the correlation groups of the plan.
+    fn open(input: &Inputs, engine: &mut Engine, notes: &mut Vec<String>) -> Result<Self, PipelineError> {
+        let window = match input.track {
+            Track::ScanLine(_) => 0,
+            Track::Timed(_) => offset_ns(input.plan.log.reorder_window_s),
+        };
+        let mut s = Streams {
+            merge: OrderedMerge::new(window),
+            lidars: Vec::new(),
+            cameras: Vec::new(),
+            planned: planned_cameras(input.plan, input.inv, notes)?,
+        };
+        for b in &input.bound.lidars {
+            s.add_lidar(input, b, engine, notes)?;
+        }
+        for c in &s.planned.clone() {
+            let built = build_camera(
+                c,
+                &input.plan.classes,
+                input.plan.geometry.resolution(),
+                input.inv,
+                input.tree,
+                &input.plan.log,
+                notes,
+            );
+            let (model, report) = match built {
+                Ok(b) => b,
+                // A camera the config did not ask for never stops a run: the log is mapped
+                // without it, and the note says why.
+                Err(e) if !c.explicit => {
+                    notes.push(format!("the camera found on `{}` is not mapped: {e}", c.topic));
+                    continue;
+                }
+                Err(e) => return Err(e),
+            };
+            let id = engine.add_camera(c.name.clone(), model);
+            let label_stream = s.merge.add_stream(c.topic.clone());
+            let depth_stream = s.merge.add_stream(c.depth_topic.clone());
+            s.cameras.push(MappedCamera::new(id, c, label_stream, depth_stream, report));
+        }
+        if !s.cameras.is_empty() {
+            engine.set_dynamic(input.plan.dynamic, input.plan.fusion.route_lidar_hits_to_dynamic);
+        }
+        s.set_correlation(input, engine, notes);
+        Ok(s)
+    }
+
+    /// One lidar: its main frame's model, a sensor for each other frame id on its topic,
+    /// its merge stream and its report.
+    fn add_lidar(
+        &mut self,
+        input: &Inputs,
+        b: &crate::sensors::BoundLidar,
+        engine: &mut Engine,
+        notes: &mut Vec<String>,
+    ) -> Result<(), PipelineError> {
+        let (inv, cfg) = (input.inv, &input.plan.log);
+        let topic = &inv.scans[&b.topic];
+        let (frame, ext, model) = lidar_setup(b, inv, input.tree, cfg, notes)?;
+        let id = engine.add_lidar(b.lidar.name.clone(), model);
+        let by_frame = other_frames(b, &frame, inv, input.tree, cfg, notes)
+            .into_iter()
+            .map(|(f, (_, model))| {
+                let sensor = engine.add_lidar(format!("{}@{f}", b.lidar.name), model);
+                (f, sensor)
+            })
+            .collect();
+        let mut other_frames = topic.frames.clone();
+        other_frames.remove(&frame);
+        other_frames.remove("");
+        let timed = matches!(input.track, Track::Timed(_));
+        self.lidars.push(Mapped {
+            id,
+            offset_ns: offset_ns(b.lidar.time_offset_s),
+            stream: self.merge.add_stream(b.topic.clone()),
+            report: LidarReport {
+                name: b.lidar.name.clone(),
+                topic: b.topic.clone(),
+                frame,
+                other_frames,
+                scans_read: topic.stamps.len() as u64,
+                scans_used: 0,
+                scans_skipped: Skipped::default(),
+                scans_deskewed: 0,
+                scans_reordered: if timed { count_reordered(topic.stamps.iter().copied()) } else { 0 },
+                time_offset_s: b.lidar.time_offset_s,
+                timing: StreamTiming::analyze(&topic.stamps, &topic.receive, limits(cfg)),
+                extrinsics: ext,
+            },
+            line_glitches: if timed { HashSet::new() } else { topic.line_glitches(&cfg.motion_limits()) },
+            bad_angles_example: None,
+            repeats: Default::default(),
+            by_frame,
+        });
+        Ok(())
+    }
+
+    /// The plan's correlation groups by sensor id (`fusion.correlated`), named sensors
+    /// this run does not map left out with a note.
+    fn set_correlation(&self, input: &Inputs, engine: &mut Engine, notes: &mut Vec<String>) {
+        let fusion = &input.plan.fusion;
+        if fusion.correlated.is_empty() {
+            return;
+        }
+        let id_of = |name: &str| {
+            self.lidars
+                .iter()
+                .zip(&input.bound.lidars)
+                .find(|(_, b)| b.lidar.name == name)
+                .map(|(l, _)| l.id)
+                .or_else(|| self.cameras.iter().find(|c| c.report.name == name).map(|c| c.id))
+        };
+        let mut groups = Vec::new();
+        for g in &fusion.correlated {
+            let ids: Vec<SensorId> = g.iter().filter_map(|n| id_of(n)).collect();
+            if ids.len() < g.len() {
+                notes.push(format!(
+                    "fusion.correlated: {} of the group [{}] are not mapped in this run; the group is used without them",
+                    g.len() - ids.len(),
+                    g.join(", ")
+                ));
+            }
+            if ids.len() >= 2 {
+                groups.push(ids);
+            }
+        }
+        engine.set_correlation(Correlation {
+            groups,
+            window_ns: offset_ns(fusion.correlation_window_s),
+            rule: fusion.merge,
+        });
+    }
+
+    /// Streams the recording's scans and images through the merge into the engine; the
+    /// pose every scan was placed with.
+    fn run(
+        &mut self,
+        input: &Inputs,
+        engine: &mut Engine,
+        mode: SyncMode,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<Vec<(Stamp, Pose2)>, PipelineError> {
+        let inv = input.inv;
+        let topics: Vec<String> = input.bound.lidars.iter().map(|b| b.topic.clone()).collect();
+        let image_topics: Vec<String> =
+            self.planned.iter().flat_map(|c| [c.topic.clone(), c.depth_topic.clone()]).collect();
+        let total: u64 = self.lidars.iter().map(|l| l.report.scans_read).sum::<u64>()
+            + image_topics.iter().map(|t| inv.images.get(t).map_or(0, |i| i.stamps.len() as u64)).sum::<u64>();
+        progress(Progress::Phase { name: "mapping", total });
+        let mut inserter = Inserter {
+            engine,
+            track: input.track,
+            mode,
+            deskew: input.plan.log.deskew,
+            scan: LaserScan { stamp: Stamp::ZERO, angle_min: 0.0, angle_increment: 0.0, ranges: Vec::new() },
+            last: None,
+            placed: Vec::new(),
+            lines_seen: Default::default(),
+            next_id: 0,
+        };
+        let mut seq = 0i64;
+        for_each_range_message(&inv.path, &inv.limits, &topics, &image_topics, |msg| {
+            let Some((stream, key)) = self.key_of(&msg, input.track, &mut seq) else { return Ok(()) };
+            if self.merge.push(stream, key, msg) == Pushed::Late {
+                self.count_late(stream);
+                progress(Progress::Advance(1));
+            }
+            while let Some((s, key, msg)) = self.merge.pop_ready() {
+                release(&mut inserter, &mut self.lidars, &mut self.cameras, s, Stamp(key), msg)?;
+                progress(Progress::Advance(1));
+            }
+            Ok(())
+        })?;
+        while let Some((s, key, msg)) = self.merge.pop_final() {
+            release(&mut inserter, &mut self.lidars, &mut self.cameras, s, Stamp(key), msg)?;
+            progress(Progress::Advance(1));
+        }
+        for c in &mut self.cameras {
+            c.finish();
+        }
+        progress(Progress::Done);
+        Ok(std::mem::take(&mut inserter.placed))
+    }
+
+    /// The merge stream of a message and its merge key (its stamp with the sensor's time
+    /// offset; for poses on the scan lines, the file order); `None` for a topic no mapped
+    /// sensor reads.
+    fn key_of(&self, msg: &RangeMessage, track: &Track, seq: &mut i64) -> Option<(usize, i64)> {
+        match msg {
+            RangeMessage::Scan(scan) => {
+                let l = self.lidars.iter().find(|l| l.report.topic == scan.topic)?;
+                let key = match track {
+                    Track::ScanLine(_) => {
+                        *seq += 1;
+                        *seq
+                    }
+                    Track::Timed(_) => scan.scan.stamp.0.saturating_add(l.offset_ns),
+                };
+                Some((l.stream, key))
+            }
+            RangeMessage::Image(image) => self.cameras.iter().find_map(|c| {
+                (c.report.topic == image.topic)
+                    .then_some(c.label_stream)
+                    .or_else(|| (c.report.depth_topic == image.topic).then_some(c.depth_stream))
+                    .map(|s| (s, image.stamp.0.saturating_add(c.offset_ns)))
+            }),
+        }
+    }
+
+    /// Counts a message the merge dropped for arriving behind its reorder window.
+    fn count_late(&mut self, stream: usize) {
+        if let Some(l) = self.lidars.iter_mut().find(|l| l.stream == stream) {
+            l.report.scans_skipped.late += 1;
+        } else if let Some(c) = self.cameras.iter_mut().find(|c| c.label_stream == stream || c.depth_stream == stream) {
+            c.report.frames_skipped.late += 1;
+        }
+    }
+}
+
+/// The lidars' notes (stamps going backwards, refused, repeated, late and unposed scans);
+/// the skipped scans of all of them.
+fn lidar_notes(lidars: &[Mapped], cfg: &LogConfig, notes: &mut Vec<String>) -> Skipped {
+    let mut skipped = Skipped::default();
+    for l in lidars {
+        let r = &l.report;
+        skipped.add(&r.scans_skipped);
+        if r.timing.regressions > 0 {
+            let order = if r.scans_reordered > 0 {
+                format!(": {} scans mapped in stamp order", r.scans_reordered)
+            } else {
+                String::new()
+            };
+            notes.push(format!("`{}` stamps go backwards {} times{order}", r.topic, r.timing.regressions));
+        }
+        if r.scans_skipped.bad_angles > 0 {
+            notes.push(format!(
+                "{} scans of `{}` refused: their beam angles cannot be placed (first: {})",
+                r.scans_skipped.bad_angles,
+                r.topic,
+                l.bad_angles_example.as_deref().unwrap_or("?")
+            ));
+        }
+        if r.scans_skipped.repeated > 0 {
+            notes.push(format!(
+                "{} scans of `{}` repeat the scan before them (same stamp, same ranges): each was inserted once",
+                r.scans_skipped.repeated, r.topic
+            ));
+        }
+        if r.scans_skipped.late > 0 {
+            notes.push(format!(
+                "{} scans of `{}` arrived more than log.reorder_window_s = {} s behind the others and were dropped",
+                r.scans_skipped.late, r.topic, cfg.reorder_window_s
+            ));
+        }
+    }
+    let read: u64 = lidars.iter().map(|l| l.report.scans_read).sum();
+    let without_pose = skipped.total() - skipped.bad_angles - skipped.repeated;
+    if without_pose > 0 {
+        notes.push(format!("{without_pose} of {read} scans skipped without a pose"));
+    }
+    skipped
+}
+
+/// The cameras' pixel counts from the engine, and a note for a camera that mapped no
+/// frame or dropped unpaired images.
+fn camera_notes(engine: &Engine, streams: &mut Streams, notes: &mut Vec<String>) {
+    for c in &mut streams.cameras {
+        if let Some(stats) = engine.sensor_stats().find(|s| s.name == c.report.name) {
+            c.report.pixels = stats.pixels;
+        }
+        let r = &c.report;
+        if r.frames_used == 0 {
+            notes.push(format!(
+                "camera `{}` mapped no frame: {} label and {} depth images read, {} pairs, {} without a pose, {} undecodable{}, {} refused{}",
+                r.name,
+                r.labels_read,
+                r.depths_read,
+                r.frames_paired,
+                r.frames_skipped.total(),
+                r.undecodable,
+                r.undecodable_example.as_ref().map_or(String::new(), |e| format!(" ({e})")),
+                r.frames_refused,
+                r.refused_example.as_ref().map_or(String::new(), |e| format!(" ({e})")),
+            ));
+        } else if r.labels_unpaired + r.depths_unpaired > 0 {
+            notes.push(format!(
+                "camera `{}`: {} label and {} depth images had no partner within {} s and were dropped",
+                r.name,
+                r.labels_unpaired,
+                r.depths_unpaired,
+                streams.planned.iter().find(|c| c.name == r.name).map_or(0.0, |c| c.pair_tolerance_s)
+            ));
+        }
+    }
+}
+
+/// The run report of the pass (its timings, the engine's counters and the SLAM summary
+/// are the caller's to fill in).
+fn log_report(
+    input: &Inputs,
+    chosen: &ChosenTrack,
+    streams: Streams,
+    mode: SyncMode,
+    skipped: Skipped,
+    tree: &FrameTree,
+) -> LogReport {
+    let (inv, bound, lidars) = (input.inv, input.bound, &streams.lidars);
+    let pose_timing = (!chosen.stamps.is_empty())
+        .then(|| StreamTiming::analyze(&chosen.stamps, &chosen.receive, limits(&input.plan.log)));
+    let first = &lidars[0].report;
+    let sensors = bound
+        .lidars
+        .iter()
+        .map(|b| (b.lidar.name.clone(), format!("lidar {}", b.topic)))
+        .chain(bound.sensors.iter().map(|b| (b.sensor.name.clone(), format!("{} {}", b.sensor.kind.as_str(), b.topic))))
+        .collect();
+    LogReport {
+        format: inv.format.to_string(),
+        scan_topic: first.topic.clone(),
+        pose_source: chosen.name.clone(),
+        sync: match mode {
+            SyncMode::Interpolate => "interpolate".into(),
+            SyncMode::Nearest { tolerance_s } => format!("nearest (tolerance {tolerance_s:.3} s)"),
+        },
+        deskew: lidars.iter().any(|l| l.report.scans_deskewed > 0),
+        scans_read: lidars.iter().map(|l| l.report.scans_read).sum(),
+        scans_used: lidars.iter().map(|l| l.report.scans_used).sum(),
+        scans_skipped: skipped,
+        scans_deskewed: lidars.iter().map(|l| l.report.scans_deskewed).sum(),
+        scans_reordered: lidars.iter().map(|l| l.report.scans_reordered).sum(),
+        sensors,
+        pose_track: chosen.counts.clone(),
+        scan_timing: first.timing,
+        pose_timing,
+        extrinsics: first.extrinsics.clone(),
+        estimator: chosen.estimator.clone(),
+        merge: streams.merge.stats().to_vec(),
+        merge_peak_queued: streams.merge.peak_queued(),
+        frames: tree.report(),
+        skipped_by_type: inv.stats.skipped_by_type.clone(),
+        malformed_records: inv.stats.malformed,
+        decode_s: inv.read_s,
+        track_s: 0.0,
+        map_s: 0.0,
+        lidars: streams.lidars.into_iter().map(|l| l.report).collect(),
+        cameras: streams.cameras.into_iter().map(|c| c.report).collect(),
+        correlated_merged: 0,
+        slam: None,
+    }
+}
