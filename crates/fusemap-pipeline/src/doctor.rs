@@ -31,6 +31,7 @@ use fusemap_core::config::{LogConfig, Plan, PoseSource, SyncConfig};
 use fusemap_core::geometry::quaternion_yaw;
 use fusemap_core::time::{PoseTrack, Stamp, StreamTiming, SyncMode, TimingLimits};
 use fusemap_io::text::{printable, table_cell};
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -141,43 +142,88 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
     let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
     writeln!(out, "log: {} ({})", printable(&name), log.format)?;
     writeln!(out)?;
+    let rows = timing_rows(&log, limits);
+    write_table(&mut out, &rows, limits)?;
+    write_frames_and_skipped(&mut out, &log)?;
 
-    let mut rows: Vec<(String, &str, StreamTiming)> = Vec::new();
+    let Posed { sync, notes, refusal } = how_posed(plan, &log);
+    let mut findings: Vec<String> = Vec::new();
+
+    if let Some(why) = &refusal {
+        findings.push(format!("cannot be mapped: {why}"));
+    }
+
+    crate::pose_sensors_report::gnss_quality(&log, &mut out, &mut findings)?;
+    crate::pose_sensors_report::odometry_vs_gyro(&log, &mut out, &mut findings)?;
+
+    if let Some(cut) = &log.truncated {
+        findings.push(format!("the log is cut short (`fusemap map` maps it up to the cut): {cut}"));
+    }
+    if log.stats.malformed > 0 {
+        // The same words as `fusemap map`'s note: the reader skipped these records.
+        findings.push(format!(
+            "{} malformed records skipped; first: {}",
+            log.stats.malformed,
+            log.stats.malformed_examples.join("; ")
+        ));
+    }
+    stream_findings(&rows, sync.as_ref(), cfg, limits, &mut findings);
+    if let Some(s) = &sync {
+        write_sync(&mut out, s, cfg, &mut findings)?;
+    }
+    findings.extend(notes);
+    writeln!(out)?;
+    writeln!(out, "findings:")?;
+    if findings.is_empty() {
+        writeln!(out, "- no clock faults found")?;
+    }
+    for f in findings {
+        writeln!(out, "- {}", printable(&f))?;
+    }
+    Ok(Report { text: out, refusal })
+}
+
+/// A row of the timing table: topic, kind and its timing.
+type Row = (String, &'static str, StreamTiming);
+
+/// Every stream's timing: the scans, each pose sensor's messages, and the dynamic TF.
+fn timing_rows(log: &Inventory, limits: TimingLimits) -> Vec<Row> {
+    fn add<T>(
+        rows: &mut Vec<Row>,
+        kind: &'static str,
+        streams: &BTreeMap<String, Vec<T>>,
+        stamps: impl Fn(&T) -> (Stamp, Option<Stamp>),
+        limits: TimingLimits,
+    ) {
+        for (topic, items) in streams {
+            let (header, receive): (Vec<Stamp>, Vec<Option<Stamp>>) = items.iter().map(&stamps).unzip();
+            rows.push((topic.clone(), kind, timing(&header, &receive, limits)));
+        }
+    }
+    let mut rows: Vec<Row> = Vec::new();
     for (topic, scans) in &log.scans {
         rows.push((topic.clone(), "scan", timing(&scans.stamps, &scans.receive, limits)));
     }
-    for (topic, odom) in &log.odom {
-        let h: Vec<Stamp> = odom.iter().map(|o| o.stamp).collect();
-        let r: Vec<Option<Stamp>> = odom.iter().map(|o| o.receive_stamp).collect();
-        rows.push((topic.clone(), "odometry", timing(&h, &r, limits)));
-    }
-    for (topic, fixes) in &log.gnss {
-        let h: Vec<Stamp> = fixes.iter().map(|o| o.stamp).collect();
-        let r: Vec<Option<Stamp>> = fixes.iter().map(|o| o.receive_stamp).collect();
-        rows.push((topic.clone(), "gnss", timing(&h, &r, limits)));
-    }
-    for (topic, poses) in &log.poses {
-        let h: Vec<Stamp> = poses.iter().map(|o| o.stamp).collect();
-        let r: Vec<Option<Stamp>> = poses.iter().map(|o| o.receive_stamp).collect();
-        rows.push((topic.clone(), "pose", timing(&h, &r, limits)));
-    }
-    for (topic, imu) in &log.imu {
-        let h: Vec<Stamp> = imu.iter().map(|o| o.stamp).collect();
-        let r: Vec<Option<Stamp>> = imu.iter().map(|o| o.receive_stamp).collect();
-        rows.push((topic.clone(), "imu", timing(&h, &r, limits)));
-    }
+    add(&mut rows, "odometry", &log.odom, |o| (o.stamp, o.receive_stamp), limits);
+    add(&mut rows, "gnss", &log.gnss, |o| (o.stamp, o.receive_stamp), limits);
+    add(&mut rows, "pose", &log.poses, |o| (o.stamp, o.receive_stamp), limits);
+    add(&mut rows, "imu", &log.imu, |o| (o.stamp, o.receive_stamp), limits);
     if !log.tf_dynamic.is_empty() {
         let h: Vec<Stamp> = log.tf_dynamic.iter().map(|t| t.stamp).collect();
         rows.push(("/tf".into(), "tf", timing(&h, &[], limits)));
     }
+    rows
+}
 
+/// The timing table, one row a stream.
+fn write_table(out: &mut String, rows: &[Row], limits: TimingLimits) -> Result<(), PipelineError> {
     writeln!(
         out,
         "| topic | kind | messages | rate Hz | period jitter ms | span s | delay min ms | delay mean ms | delay max ms | backwards | duplicates | gaps > {:.2} s |",
         limits.gap_s
     )?;
     writeln!(out, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
-    for (topic, kind, t) in &rows {
+    for (topic, kind, t) in rows {
         let ms = |s: f64| format!("{:.1}", s * 1e3);
         let (dmin, dmean, dmax) =
             t.delay.map_or(("-".into(), "-".into(), "-".into()), |d| (ms(d.min_s), ms(d.mean_s), ms(d.max_s)));
@@ -194,6 +240,11 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
             t.gaps
         )?;
     }
+    Ok(())
+}
+
+/// The static transforms and the record types the reader skipped.
+fn write_frames_and_skipped(out: &mut String, log: &Inventory) -> Result<(), PipelineError> {
     if !log.tf_static.is_empty() {
         writeln!(out)?;
         for t in &log.tf_static {
@@ -212,13 +263,24 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
     for (t, n) in &log.stats.skipped_by_type {
         writeln!(out, "skipped {n} records of type {}", printable(t))?;
     }
+    Ok(())
+}
 
-    // How the scans would be posed, as `fusemap map` does it.
+/// How `fusemap map` would pose the scans: the sync of the first lidar's scans to the
+/// pose track (and SLAM over it), the notes of binding and choosing, or why it would refuse.
+struct Posed {
+    sync: Option<Sync>,
+    notes: Vec<String>,
+    refusal: Option<String>,
+}
+
+/// Binds the sensors and chooses the pose track as `fusemap map` does.
+fn how_posed(plan: &Plan, log: &Inventory) -> Posed {
+    let cfg = &plan.log;
     let mut notes = Vec::new();
-    let mut findings: Vec<String> = Vec::new();
     let mut sync = None;
     let mut refusal = None;
-    match crate::run::prepare_track(plan, &log) {
+    match crate::run::prepare_track(plan, log) {
         Ok((bound, _, _)) if bound.lidars.is_empty() => {
             refusal = Some("every [[sensor]] of kind lidar is disabled".to_string());
         }
@@ -248,7 +310,7 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
                         PoseSource::Tf => Some("/tf".to_string()),
                         _ => None,
                     };
-                    let (slam_on, reason) = crate::slam::applies(plan, &log, &bound, &chosen);
+                    let (slam_on, reason) = crate::slam::applies(plan, log, &bound, &chosen);
                     let slam = slam_on.then(|| SlamCover::count(reason, track.as_ref(), stamps, offset, configured));
                     sync = Some(Sync {
                         topic: topic.clone(),
@@ -280,26 +342,20 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
         }
         Err(e) => refusal = Some(e.to_string()),
     }
-    if let Some(why) = &refusal {
-        findings.push(format!("cannot be mapped: {why}"));
-    }
+    Posed { sync, notes, refusal }
+}
 
-    crate::pose_sensors_report::gnss_quality(&log, &mut out, &mut findings)?;
-    crate::pose_sensors_report::odometry_vs_gyro(&log, &mut out, &mut findings)?;
-
-    if let Some(cut) = &log.truncated {
-        findings.push(format!("the log is cut short (`fusemap map` maps it up to the cut): {cut}"));
-    }
-    if log.stats.malformed > 0 {
-        // The same words as `fusemap map`'s note: the reader skipped these records.
-        findings.push(format!(
-            "{} malformed records skipped; first: {}",
-            log.stats.malformed,
-            log.stats.malformed_examples.join("; ")
-        ));
-    }
-    let track = sync.as_ref().and_then(|s| s.track.as_ref());
-    for (topic, kind, t) in &rows {
+/// Findings per stream: stamps going backwards or repeated, header stamps far from the
+/// receive time, pauses; each with what it means for the scans or the pose track.
+fn stream_findings(
+    rows: &[Row],
+    sync: Option<&Sync>,
+    cfg: &LogConfig,
+    limits: TimingLimits,
+    findings: &mut Vec<String>,
+) {
+    let track = sync.and_then(|s| s.track.as_ref());
+    for (topic, kind, t) in rows {
         let role = match (&sync, track) {
             (Some(s), Some(_)) if *topic == s.topic => Role::ScansOnTrack,
             (_, Some(tr)) if tr.topic.as_deref() == Some(topic.as_str()) => Role::PoseTrack,
@@ -355,79 +411,67 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
             ));
         }
     }
+}
 
-    if let Some(s) = &sync {
-        writeln!(out)?;
-        match &s.track {
-            None => writeln!(
-                out,
-                "scans on {} are posed by the {}: no time synchronisation needed",
-                printable(&s.topic),
-                s.source
-            )?,
-            Some(tr) => {
-                let share = |k: &Skipped| 100.0 * (s.scans - k.total()) as f64 / s.scans.max(1) as f64;
-                if let Some(slam) = &tr.slam {
-                    writeln!(
-                        out,
-                        "scans on {} are posed by SLAM over {}, as `fusemap map` poses them ({}); {} alone gives a pose to:",
-                        printable(&s.topic),
-                        s.source,
-                        slam.reason,
-                        s.source
-                    )?;
+/// How the scans get their poses: the shares each sync mode poses, and what happens to the rest.
+fn write_sync(out: &mut String, s: &Sync, cfg: &LogConfig, findings: &mut Vec<String>) -> Result<(), PipelineError> {
+    writeln!(out)?;
+    match &s.track {
+        None => writeln!(
+            out,
+            "scans on {} are posed by the {}: no time synchronisation needed",
+            printable(&s.topic),
+            s.source
+        )?,
+        Some(tr) => {
+            let share = |k: &Skipped| 100.0 * (s.scans - k.total()) as f64 / s.scans.max(1) as f64;
+            if let Some(slam) = &tr.slam {
+                writeln!(
+                    out,
+                    "scans on {} are posed by SLAM over {}, as `fusemap map` poses them ({}); {} alone gives a pose to:",
+                    printable(&s.topic),
+                    s.source,
+                    slam.reason,
+                    s.source
+                )?;
+            } else {
+                writeln!(out, "scans on {} with a pose from {}:", printable(&s.topic), s.source)?;
+            }
+            writeln!(out, "  interpolate: {:.1} %", share(&tr.interpolate))?;
+            writeln!(out, "  nearest within {:.0} ms: {:.1} %", tr.nearest_tolerance_s * 1e3, share(&tr.nearest))?;
+            let skipped = if tr.configured == SyncMode::Interpolate { &tr.interpolate } else { &tr.nearest };
+            let missing = skipped.total();
+            if let Some(slam) = tr.slam.as_ref().filter(|_| missing > 0) {
+                findings.push(slam.finding(&s.topic, s.scans, &s.source));
+            } else if missing > 0 {
+                let pct = 100.0 - share(skipped);
+                // One decimal, or two when that would print a share that is not 0 as 0.0.
+                let pct = if pct < 0.1 { format!("{pct:.2}") } else { format!("{pct:.1}") };
+                let head = format!("{pct} % of scans on {} ({missing} of {})", s.topic, s.scans);
+                if let SyncMode::Nearest { tolerance_s } = tr.configured {
+                    findings.push(format!(
+                        "{head} have no pose within {:.0} ms: raise the tolerance or use interpolation",
+                        tolerance_s * 1e3
+                    ));
                 } else {
-                    writeln!(out, "scans on {} with a pose from {}:", printable(&s.topic), s.source)?;
-                }
-                writeln!(out, "  interpolate: {:.1} %", share(&tr.interpolate))?;
-                writeln!(out, "  nearest within {:.0} ms: {:.1} %", tr.nearest_tolerance_s * 1e3, share(&tr.nearest))?;
-                let skipped = if tr.configured == SyncMode::Interpolate { &tr.interpolate } else { &tr.nearest };
-                let missing = skipped.total();
-                if let Some(slam) = tr.slam.as_ref().filter(|_| missing > 0) {
-                    findings.push(slam.finding(&s.topic, s.scans, &s.source));
-                } else if missing > 0 {
-                    let pct = 100.0 - share(skipped);
-                    // One decimal, or two when that would print a share that is not 0 as 0.0.
-                    let pct = if pct < 0.1 { format!("{pct:.2}") } else { format!("{pct:.1}") };
-                    let head = format!("{pct} % of scans on {} ({missing} of {})", s.topic, s.scans);
-                    if let SyncMode::Nearest { tolerance_s } = tr.configured {
-                        findings.push(format!(
-                            "{head} have no pose within {:.0} ms: raise the tolerance or use interpolation",
-                            tolerance_s * 1e3
-                        ));
-                    } else {
-                        let mut why = Vec::new();
-                        if skipped.before_first_pose > 0 {
-                            why.push(format!("{} before the first pose", skipped.before_first_pose));
-                        }
-                        if skipped.after_last_pose > 0 {
-                            why.push(format!("{} after the last pose", skipped.after_last_pose));
-                        }
-                        if skipped.in_pose_gap > 0 {
-                            why.push(format!(
-                                "{} in pauses of the pose track longer than {:.2} s across which the robot moved \
-                                 more than {} m or {}°",
-                                skipped.in_pose_gap,
-                                cfg.max_pose_gap_s,
-                                cfg.gap_bridge_motion_m,
-                                cfg.gap_bridge_motion_deg
-                            ));
-                        }
-                        findings.push(format!("{head} get no pose and are skipped: {}", why.join(", ")));
+                    let mut why = Vec::new();
+                    if skipped.before_first_pose > 0 {
+                        why.push(format!("{} before the first pose", skipped.before_first_pose));
                     }
+                    if skipped.after_last_pose > 0 {
+                        why.push(format!("{} after the last pose", skipped.after_last_pose));
+                    }
+                    if skipped.in_pose_gap > 0 {
+                        why.push(format!(
+                            "{} in pauses of the pose track longer than {:.2} s across which the robot moved \
+                             more than {} m or {}°",
+                            skipped.in_pose_gap, cfg.max_pose_gap_s, cfg.gap_bridge_motion_m, cfg.gap_bridge_motion_deg
+                        ));
+                    }
+                    findings.push(format!("{head} get no pose and are skipped: {}", why.join(", ")));
                 }
             }
         }
     }
-
-    findings.extend(notes);
-    writeln!(out)?;
-    writeln!(out, "findings:")?;
-    if findings.is_empty() {
-        writeln!(out, "- no clock faults found")?;
-    }
-    for f in findings {
-        writeln!(out, "- {}", printable(&f))?;
-    }
-    Ok(Report { text: out, refusal })
+    Ok(())
 }
