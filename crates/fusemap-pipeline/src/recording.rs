@@ -12,8 +12,8 @@ use fusemap_core::config::LimitsConfig;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::time::{plausible_samples, MotionLimits, Stamp};
 use fusemap_io::log::{
-    CameraInfoMessage, GnssMessage, ImageMessage, ImuMessage, LogFormat, LogMessage, OdomMessage, PoseMessage,
-    ReadOptions, ReadStats, ScanMessage, Transform,
+    CameraInfoMessage, GnssMessage, ImageHeader, ImageMessage, ImuMessage, LogFormat, LogMessage, OdomMessage,
+    PoseMessage, ReadOptions, ReadStats, ScanMessage, Transform,
 };
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -42,6 +42,27 @@ pub struct ScanTopic {
 }
 
 impl ScanTopic {
+    /// Takes a scan's stamps, frame id and line pose into the inventory.
+    fn add(&mut self, s: ScanMessage) {
+        self.stamps.push(s.scan.stamp);
+        self.receive.push(s.receive_stamp);
+        *self.frames.entry(s.frame_id).or_default() += 1;
+        if let Some(p) = s.pose {
+            self.with_pose += 1;
+            if p.is_finite() {
+                self.line_poses.push((s.scan.stamp, p));
+            }
+            if s.odom_pose == Some(p) {
+                self.pose_is_odometry += 1;
+            }
+        }
+        if self.first_laser_pose.is_none() {
+            if let (Some(r), Some(l)) = (s.pose, s.laser_pose) {
+                self.first_laser_pose = Some((r, l));
+            }
+        }
+    }
+
     /// The scan-line poses that are glitches (see [`plausible_samples`]), as
     /// `(stamp, pose)` keys of [`line_key`]. The lines are judged in file order, the order
     /// their poses are applied in (a stamp that goes backwards is taken as its
@@ -92,6 +113,15 @@ pub struct ImageTopic {
 }
 
 impl ImageTopic {
+    /// Takes an image's stamps, frame id, encoding and size into the inventory.
+    fn add(&mut self, h: ImageHeader) {
+        self.stamps.push(h.stamp);
+        self.receive.push(h.receive_stamp);
+        *self.frames.entry(h.frame_id).or_default() += 1;
+        *self.encodings.entry(h.encoding).or_default() += 1;
+        *self.sizes.entry((h.width, h.height)).or_default() += 1;
+    }
+
     /// The most common non-empty frame id.
     pub fn frame(&self) -> Option<&str> {
         self.frames.iter().filter(|(f, _)| !f.is_empty()).max_by_key(|(_, n)| **n).map(|(f, _)| f.as_str())
@@ -257,24 +287,7 @@ impl Inventory {
         let options = ReadOptions::within(limits);
         let opened = fusemap_io::log::open_log_with(path, &options)?;
         let mut reader = opened.reader;
-        let mut inv = Inventory {
-            path: path.to_path_buf(),
-            limits: options,
-            format: opened.format,
-            scans: BTreeMap::new(),
-            images: BTreeMap::new(),
-            camera_info: BTreeMap::new(),
-            odom: BTreeMap::new(),
-            imu: BTreeMap::new(),
-            frames: BTreeMap::new(),
-            gnss: BTreeMap::new(),
-            poses: BTreeMap::new(),
-            tf_static: Vec::new(),
-            tf_dynamic: Vec::new(),
-            stats: ReadStats::default(),
-            read_s: 0.0,
-            truncated: None,
-        };
+        let mut inv = Inventory::empty(path, options, opened.format);
         let mut undecodable = ReadStats::default();
         let mut tf = Vec::new();
         let mut read = 0u64;
@@ -290,26 +303,7 @@ impl Inventory {
             };
             read += 1;
             match m {
-                LogMessage::Scan(s) => {
-                    let t = inv.scans.entry(s.topic.clone()).or_default();
-                    t.stamps.push(s.scan.stamp);
-                    t.receive.push(s.receive_stamp);
-                    *t.frames.entry(s.frame_id).or_default() += 1;
-                    if let Some(p) = s.pose {
-                        t.with_pose += 1;
-                        if p.is_finite() {
-                            t.line_poses.push((s.scan.stamp, p));
-                        }
-                        if s.odom_pose == Some(p) {
-                            t.pose_is_odometry += 1;
-                        }
-                    }
-                    if t.first_laser_pose.is_none() {
-                        if let (Some(r), Some(l)) = (s.pose, s.laser_pose) {
-                            t.first_laser_pose = Some((r, l));
-                        }
-                    }
-                }
+                LogMessage::Scan(s) => inv.scans.entry(s.topic.clone()).or_default().add(s),
                 LogMessage::Odometry(o) => {
                     inv.frames.entry(o.topic.clone()).or_insert_with(|| o.frame_id.clone());
                     inv.odom.entry(o.topic.clone()).or_default().push(OdomSample::from(&o));
@@ -321,76 +315,19 @@ impl Inventory {
                 LogMessage::Gnss(g) => inv.gnss.entry(g.topic.clone()).or_default().push(g),
                 LogMessage::Pose(p) => inv.poses.entry(p.topic.clone()).or_default().push(p),
                 LogMessage::Tf(t) => tf.push(t),
-                LogMessage::ImageHeader(h) => {
-                    let t = inv.images.entry(h.topic.clone()).or_default();
-                    t.stamps.push(h.stamp);
-                    t.receive.push(h.receive_stamp);
-                    *t.frames.entry(h.frame_id).or_default() += 1;
-                    *t.encodings.entry(h.encoding).or_default() += 1;
-                    *t.sizes.entry((h.width, h.height)).or_default() += 1;
-                }
+                LogMessage::ImageHeader(h) => inv.images.entry(h.topic.clone()).or_default().add(h),
                 // The first pass asks for no pixels; a reader that gives them anyway is
                 // inventoried the same way.
-                LogMessage::Image(i) => {
-                    let t = inv.images.entry(i.topic.clone()).or_default();
-                    t.stamps.push(i.stamp);
-                    t.receive.push(i.receive_stamp);
-                    *t.frames.entry(i.frame_id).or_default() += 1;
-                    *t.encodings.entry(i.encoding).or_default() += 1;
-                    *t.sizes.entry((i.width, i.height)).or_default() += 1;
-                }
-                LogMessage::CameraInfo(c) => match inv.camera_info.get_mut(&c.topic) {
-                    Some(t) => {
-                        t.count += 1;
-                        let f = &t.first;
-                        if (f.width, f.height) != (c.width, c.height)
-                            || f.distortion_model != c.distortion_model
-                            || f.d != c.d
-                            || f.k != c.k
-                        {
-                            t.differing += 1;
-                        }
-                        if c.stamp < t.first.stamp {
-                            t.first = c;
-                        }
-                    }
-                    None => {
-                        inv.camera_info.insert(c.topic.clone(), CameraInfoTopic { first: c, count: 1, differing: 0 });
-                    }
-                },
+                LogMessage::Image(i) => inv.images.entry(i.topic.clone()).or_default().add(i.header()),
+                LogMessage::CameraInfo(c) => inv.add_camera_info(c),
             }
         }
         inv.stats = merged_stats(reader.stats(), undecodable);
         if inv.format != LogFormat::Carmen {
             // ROS containers are played back in log-time order (what `rosbag play` and
             // `ros2 bag play` do), whatever order their chunks hold the records in.
-            for v in inv.odom.values_mut() {
-                v.sort_by_key(|m| m.receive_stamp);
-            }
-            for v in inv.imu.values_mut() {
-                v.sort_by_key(|m| m.receive_stamp);
-            }
-            for v in inv.gnss.values_mut() {
-                v.sort_by_key(|m| m.receive_stamp);
-            }
-            for v in inv.poses.values_mut() {
-                v.sort_by_key(|m| m.receive_stamp);
-            }
+            inv.sort_by_log_time();
             tf.sort_by_key(|m| m.receive_stamp);
-            for t in inv.images.values_mut() {
-                let mut pairs: Vec<(Option<Stamp>, Stamp)> =
-                    t.receive.iter().copied().zip(t.stamps.iter().copied()).collect();
-                pairs.sort_by_key(|p| p.0);
-                t.receive = pairs.iter().map(|p| p.0).collect();
-                t.stamps = pairs.iter().map(|p| p.1).collect();
-            }
-            for t in inv.scans.values_mut() {
-                let mut pairs: Vec<(Option<Stamp>, Stamp)> =
-                    t.receive.iter().copied().zip(t.stamps.iter().copied()).collect();
-                pairs.sort_by_key(|p| p.0);
-                t.receive = pairs.iter().map(|p| p.0).collect();
-                t.stamps = pairs.iter().map(|p| p.1).collect();
-            }
         }
         for t in tf {
             if t.is_static {
@@ -401,6 +338,77 @@ impl Inventory {
         }
         inv.read_s = t0.elapsed().as_secs_f64();
         Ok(inv)
+    }
+
+    /// An inventory of nothing yet.
+    fn empty(path: &Path, limits: ReadOptions, format: LogFormat) -> Self {
+        Inventory {
+            path: path.to_path_buf(),
+            limits,
+            format,
+            scans: BTreeMap::new(),
+            images: BTreeMap::new(),
+            camera_info: BTreeMap::new(),
+            odom: BTreeMap::new(),
+            imu: BTreeMap::new(),
+            frames: BTreeMap::new(),
+            gnss: BTreeMap::new(),
+            poses: BTreeMap::new(),
+            tf_static: Vec::new(),
+            tf_dynamic: Vec::new(),
+            stats: ReadStats::default(),
+            read_s: 0.0,
+            truncated: None,
+        }
+    }
+
+    /// Keeps a topic's first camera info (by stamp) and counts those that differ from it.
+    fn add_camera_info(&mut self, c: CameraInfoMessage) {
+        let Some(t) = self.camera_info.get_mut(&c.topic) else {
+            self.camera_info.insert(c.topic.clone(), CameraInfoTopic { first: c, count: 1, differing: 0 });
+            return;
+        };
+        t.count += 1;
+        let f = &t.first;
+        if (f.width, f.height) != (c.width, c.height)
+            || f.distortion_model != c.distortion_model
+            || f.d != c.d
+            || f.k != c.k
+        {
+            t.differing += 1;
+        }
+        if c.stamp < t.first.stamp {
+            t.first = c;
+        }
+    }
+
+    /// Every stream in receive-stamp order (a stable sort: equal receive stamps keep their
+    /// order in the file).
+    fn sort_by_log_time(&mut self) {
+        for v in self.odom.values_mut() {
+            v.sort_by_key(|m| m.receive_stamp);
+        }
+        for v in self.imu.values_mut() {
+            v.sort_by_key(|m| m.receive_stamp);
+        }
+        for v in self.gnss.values_mut() {
+            v.sort_by_key(|m| m.receive_stamp);
+        }
+        for v in self.poses.values_mut() {
+            v.sort_by_key(|m| m.receive_stamp);
+        }
+        let by_receive = |receive: &mut Vec<Option<Stamp>>, stamps: &mut Vec<Stamp>| {
+            let mut pairs: Vec<(Option<Stamp>, Stamp)> = receive.iter().copied().zip(stamps.iter().copied()).collect();
+            pairs.sort_by_key(|p| p.0);
+            *receive = pairs.iter().map(|p| p.0).collect();
+            *stamps = pairs.iter().map(|p| p.1).collect();
+        };
+        for t in self.images.values_mut() {
+            by_receive(&mut t.receive, &mut t.stamps);
+        }
+        for t in self.scans.values_mut() {
+            by_receive(&mut t.receive, &mut t.stamps);
+        }
     }
 
     /// Total scans in the log.

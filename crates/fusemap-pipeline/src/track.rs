@@ -10,7 +10,7 @@
 //! a sample that arrives after a later-stamped one is still good data at its own stamp.
 
 use crate::recording::Inventory;
-use crate::sensors::Bound;
+use crate::sensors::{Bound, BoundSensor};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, PoseSource, SensorKind};
 use fusemap_core::frames::{FrameTree, LookupError};
@@ -270,38 +270,13 @@ pub fn choose(
 ) -> Result<ChosenTrack, PipelineError> {
     let lines_have_poses = bound.lidars.iter().any(|l| inv.scans.get(&l.topic).is_some_and(|t| t.with_pose > 0));
     let odom = bound.first(SensorKind::WheelOdometry);
-    // TF: the base frame's own dynamic edge, and every dynamic edge on its chain to the
-    // root (`odom → base_footprint → base_link` with a static last edge; a leading `/`, as
-    // ROS 1 writes frames, is not part of the name).
-    let strip = |f: &str| f.strip_prefix('/').unwrap_or(f).to_string();
-    let base = strip(&cfg.base_frame);
-    let (tree, _) = crate::extrinsics::frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
-    let mut chain = vec![base.clone()];
-    while let Some(p) = tree.parent(chain.last().map_or("", |s| s.as_str())) {
-        if chain.len() > 1000 || chain.iter().any(|c| c == p) {
-            break;
-        }
-        chain.push(p.to_string());
-    }
-    let tf_samples: Vec<(Stamp, Pose2)> = inv
-        .tf_dynamic
-        .iter()
-        .filter(|t| strip(&t.child) == base)
-        .map(|t| {
-            let m = Mount3::from_translation_quaternion(t.translation, t.rotation);
-            (t.stamp, Pose2::new(m.x, m.y, m.yaw))
-        })
-        .collect();
-    let mut chain_stamps: Vec<Stamp> =
-        inv.tf_dynamic.iter().filter(|t| chain.contains(&strip(&t.child))).map(|t| t.stamp).collect();
-    chain_stamps.sort_unstable();
-    chain_stamps.dedup();
+    let tf = TfChain::of(inv, cfg);
     let source = match cfg.pose_source {
         PoseSource::Auto if lines_have_poses => PoseSource::ScanLine,
         // The estimator's motion model is the wheel odometry: without it, TF is next.
         PoseSource::Auto if odom.is_some() && has_fusion_sensors(bound) => PoseSource::Estimator,
         PoseSource::Auto if odom.is_some() => PoseSource::Odometry,
-        PoseSource::Auto if !chain_stamps.is_empty() => PoseSource::Tf,
+        PoseSource::Auto if !tf.chain_stamps.is_empty() => PoseSource::Tf,
         PoseSource::Auto => {
             return Err(PipelineError::Refused(format!(
                 "the log has no poses: no pose on scan lines, no odometry topic, no TF to `{}`",
@@ -310,117 +285,158 @@ pub fn choose(
         }
         s => s,
     };
-    let mut counts = TrackCounts::default();
     match source {
-        PoseSource::ScanLine => {
-            if !lines_have_poses {
-                return Err(PipelineError::Refused(
-                    "log.pose_source = \"scan_line\" but the scans carry no pose".into(),
-                ));
-            }
-            // The mapping pass leaves the glitches out (`Skipped::pose_glitch`); counted here
-            // for the track's report.
-            for l in &bound.lidars {
-                let topic = &inv.scans[&l.topic];
-                counts.samples += topic.with_pose;
-                counts.used += topic.line_poses.len() as u64;
-                counts.not_finite += topic.with_pose - topic.line_poses.len() as u64;
-                let glitches = topic.line_glitches(&cfg.motion_limits()).len() as u64;
-                counts.used -= glitches;
-                counts.glitches += glitches;
-            }
-            Ok(ChosenTrack {
-                source,
-                track: Track::ScanLine(None),
-                name: "pose on each scan line".into(),
-                notes: glitch_notes("pose on each scan line", &counts, cfg),
-                counts,
-                stamps: Vec::new(),
-                receive: Vec::new(),
-                estimator: None,
-                slam: None,
-            })
+        PoseSource::ScanLine if !lines_have_poses => {
+            Err(PipelineError::Refused("log.pose_source = \"scan_line\" but the scans carry no pose".into()))
         }
+        PoseSource::ScanLine => Ok(scan_line_track(inv, cfg, bound)),
         PoseSource::Odometry => {
             let Some(o) = odom else {
                 return Err(PipelineError::Refused(
                     "log.pose_source = \"odometry\" but the log has no odometry topic".into(),
                 ));
             };
-            let msgs = &inv.odom[&o.topic];
-            let off = crate::offset_ns(o.sensor.time_offset_s);
-            let buffer = buffer_of(
-                cfg,
-                msgs.iter().map(|m| (Stamp(m.stamp.0.saturating_add(off)), m.pose)).collect(),
-                &mut counts,
-            );
-            if buffer.is_empty() {
-                return Err(PipelineError::Refused(format!("the odometry `{}` holds no usable pose", o.topic)));
-            }
-            Ok(ChosenTrack {
-                source,
-                track: Track::Timed(Box::new(buffer)),
-                name: format!("odometry `{}`", o.topic),
-                notes: glitch_notes(&format!("odometry `{}`", o.topic), &counts, cfg),
-                counts,
-                stamps: msgs.iter().map(|m| m.stamp).collect(),
-                receive: msgs.iter().map(|m| m.receive_stamp).collect(),
-                estimator: None,
-                slam: None,
-            })
+            odometry_track(inv, cfg, o)
         }
-        PoseSource::Tf => {
-            let root = TfTrack::root_of(&tree, &base);
-            let parent = tree.parent(&base).map(str::to_string);
-            let single_edge = root.is_some() && root == parent && !tf_samples.is_empty();
-            if let (Some(root), false) = (root, single_edge) {
-                // Several edges above the base, or a static one under a dynamic one: compose
-                // the chain at each stamp where one of its dynamic edges has a sample. Each
-                // dynamic edge of the chain is a pose stream of its own: its glitches are
-                // left out before the tree is built again from what remains.
-                let (kept, glitches) = without_edge_glitches(&inv.tf_dynamic, &chain, cfg);
-                counts.glitches = glitches;
-                let tree =
-                    if glitches > 0 { crate::extrinsics::frame_tree(cfg, &inv.tf_static, &kept).0 } else { tree };
-                let stamps = chain_stamps;
-                counts.samples = stamps.len() as u64;
-                let name = format!("TF `{root} → … → {base}`");
-                let notes = glitch_notes(&name, &counts, cfg);
-                let track = TfTrack { tree, root, base, stamps: stamps.clone() };
-                counts.used = track.samples().len() as u64;
-                if counts.used == 0 {
-                    return Err(PipelineError::Refused(format!("no usable TF pose of `{}`", cfg.base_frame)));
-                }
-                return Ok(ChosenTrack {
-                    source,
-                    track: Track::Timed(Box::new(track)),
-                    name,
-                    counts,
-                    receive: vec![None; stamps.len()],
-                    stamps,
-                    estimator: None,
-                    notes,
-                    slam: None,
-                });
-            }
-            let stamps: Vec<Stamp> = tf_samples.iter().map(|s| s.0).collect();
-            let buffer = buffer_of(cfg, tf_samples, &mut counts);
-            if buffer.is_empty() {
-                return Err(PipelineError::Refused(format!("no usable TF pose of `{}`", cfg.base_frame)));
-            }
-            Ok(ChosenTrack {
-                source,
-                track: Track::Timed(Box::new(buffer)),
-                name: format!("TF `… → {}`", cfg.base_frame),
-                notes: glitch_notes(&format!("TF `… → {}`", cfg.base_frame), &counts, cfg),
-                counts,
-                receive: vec![None; stamps.len()],
-                stamps,
-                estimator: None,
-                slam: None,
-            })
-        }
+        PoseSource::Tf => tf.track(inv, cfg),
         PoseSource::Estimator => estimate(),
         PoseSource::Auto => unreachable!("resolved above"),
+    }
+}
+
+impl ChosenTrack {
+    /// A track of `source` with its counts, its message stamps, and the notes of its
+    /// glitches.
+    fn of(
+        source: PoseSource,
+        track: Track,
+        name: String,
+        counts: TrackCounts,
+        (stamps, receive): (Vec<Stamp>, Vec<Option<Stamp>>),
+        cfg: &LogConfig,
+    ) -> Self {
+        let notes = glitch_notes(&name, &counts, cfg);
+        ChosenTrack { source, track, name, notes, counts, stamps, receive, estimator: None, slam: None }
+    }
+}
+
+/// The poses on the scan lines.
+fn scan_line_track(inv: &Inventory, cfg: &LogConfig, bound: &Bound) -> ChosenTrack {
+    // The mapping pass leaves the glitches out (`Skipped::pose_glitch`); counted here for
+    // the track's report.
+    let mut counts = TrackCounts::default();
+    for l in &bound.lidars {
+        let topic = &inv.scans[&l.topic];
+        counts.samples += topic.with_pose;
+        counts.used += topic.line_poses.len() as u64;
+        counts.not_finite += topic.with_pose - topic.line_poses.len() as u64;
+        let glitches = topic.line_glitches(&cfg.motion_limits()).len() as u64;
+        counts.used -= glitches;
+        counts.glitches += glitches;
+    }
+    let name = "pose on each scan line".to_string();
+    ChosenTrack::of(PoseSource::ScanLine, Track::ScanLine(None), name, counts, Default::default(), cfg)
+}
+
+/// The wheel odometry's poses, at their stamps with the sensor's time offset.
+fn odometry_track(inv: &Inventory, cfg: &LogConfig, o: &BoundSensor) -> Result<ChosenTrack, PipelineError> {
+    let mut counts = TrackCounts::default();
+    let msgs = &inv.odom[&o.topic];
+    let off = crate::offset_ns(o.sensor.time_offset_s);
+    let samples = msgs.iter().map(|m| (Stamp(m.stamp.0.saturating_add(off)), m.pose)).collect();
+    let buffer = buffer_of(cfg, samples, &mut counts);
+    if buffer.is_empty() {
+        return Err(PipelineError::Refused(format!("the odometry `{}` holds no usable pose", o.topic)));
+    }
+    let stamps = (msgs.iter().map(|m| m.stamp).collect(), msgs.iter().map(|m| m.receive_stamp).collect());
+    let name = format!("odometry `{}`", o.topic);
+    Ok(ChosenTrack::of(PoseSource::Odometry, Track::Timed(Box::new(buffer)), name, counts, stamps, cfg))
+}
+
+/// The TF edges that pose the base frame: its own dynamic edge, and every dynamic edge on
+/// its chain to the root (`odom → base_footprint → base_link` with a static last edge; a
+/// leading `/`, as ROS 1 writes frames, is not part of the name).
+struct TfChain {
+    tree: FrameTree,
+    base: String,
+    /// The base frame and its ancestors, up to the root.
+    chain: Vec<String>,
+    /// The samples of the base frame's own dynamic edge.
+    samples: Vec<(Stamp, Pose2)>,
+    /// The stamps of every dynamic edge on the chain, sorted, without repeats.
+    chain_stamps: Vec<Stamp>,
+}
+
+impl TfChain {
+    fn of(inv: &Inventory, cfg: &LogConfig) -> Self {
+        let strip = |f: &str| f.strip_prefix('/').unwrap_or(f).to_string();
+        let base = strip(&cfg.base_frame);
+        let (tree, _) = crate::extrinsics::frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
+        let mut chain = vec![base.clone()];
+        while let Some(p) = tree.parent(chain.last().map_or("", |s| s.as_str())) {
+            if chain.len() > 1000 || chain.iter().any(|c| c == p) {
+                break;
+            }
+            chain.push(p.to_string());
+        }
+        let samples = inv
+            .tf_dynamic
+            .iter()
+            .filter(|t| strip(&t.child) == base)
+            .map(|t| {
+                let m = Mount3::from_translation_quaternion(t.translation, t.rotation);
+                (t.stamp, Pose2::new(m.x, m.y, m.yaw))
+            })
+            .collect();
+        let mut chain_stamps: Vec<Stamp> =
+            inv.tf_dynamic.iter().filter(|t| chain.contains(&strip(&t.child))).map(|t| t.stamp).collect();
+        chain_stamps.sort_unstable();
+        chain_stamps.dedup();
+        TfChain { tree, base, chain, samples, chain_stamps }
+    }
+
+    /// The base frame's pose from TF: its own edge's samples when that is the one edge to
+    /// the root, else the chain composed at each stamp of its dynamic edges.
+    fn track(self, inv: &Inventory, cfg: &LogConfig) -> Result<ChosenTrack, PipelineError> {
+        let mut counts = TrackCounts::default();
+        let root = TfTrack::root_of(&self.tree, &self.base);
+        let parent = self.tree.parent(&self.base).map(str::to_string);
+        let single_edge = root.is_some() && root == parent && !self.samples.is_empty();
+        let no_pose = || PipelineError::Refused(format!("no usable TF pose of `{}`", cfg.base_frame));
+        if let (Some(root), false) = (root, single_edge) {
+            // Several edges above the base, or a static one under a dynamic one: compose
+            // the chain at each stamp where one of its dynamic edges has a sample. Each
+            // dynamic edge of the chain is a pose stream of its own: its glitches are
+            // left out before the tree is built again from what remains.
+            let (kept, glitches) = without_edge_glitches(&inv.tf_dynamic, &self.chain, cfg);
+            counts.glitches = glitches;
+            let tree =
+                if glitches > 0 { crate::extrinsics::frame_tree(cfg, &inv.tf_static, &kept).0 } else { self.tree };
+            let stamps = self.chain_stamps;
+            counts.samples = stamps.len() as u64;
+            let name = format!("TF `{root} → … → {}`", self.base);
+            let track = TfTrack { tree, root, base: self.base, stamps: stamps.clone() };
+            counts.used = track.samples().len() as u64;
+            if counts.used == 0 {
+                return Err(no_pose());
+            }
+            let receive = vec![None; stamps.len()];
+            return Ok(ChosenTrack::of(
+                PoseSource::Tf,
+                Track::Timed(Box::new(track)),
+                name,
+                counts,
+                (stamps, receive),
+                cfg,
+            ));
+        }
+        let stamps: Vec<Stamp> = self.samples.iter().map(|s| s.0).collect();
+        let buffer = buffer_of(cfg, self.samples, &mut counts);
+        if buffer.is_empty() {
+            return Err(no_pose());
+        }
+        let name = format!("TF `… → {}`", cfg.base_frame);
+        let receive = vec![None; stamps.len()];
+        Ok(ChosenTrack::of(PoseSource::Tf, Track::Timed(Box::new(buffer)), name, counts, (stamps, receive), cfg))
     }
 }
