@@ -22,7 +22,10 @@ use crate::sensors::{Bound, BoundSensor};
 use crate::track::{glitch_note, ChosenTrack, Track, TrackCounts};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SensorKind};
-use fusemap_core::estimator::{estimate, EstimatorConfig, EstimatorInput, FixQuality};
+use fusemap_core::estimator::{
+    base_yaw_rate, estimate, odometry_increment_covariance, EstimatorConfig, EstimatorInput, FixQuality,
+    GnssCovarianceKind,
+};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{geodetic::Datum, quaternion_yaw, Mount3, Point2, Pose2, Pose3};
 use fusemap_core::time::{plausible_samples, Stamp};
@@ -102,11 +105,13 @@ fn quality(f: &GnssMessage) -> FixQuality {
 pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, PipelineError> {
     let cfg = &plan.log;
     let (tree, _) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
-    let mut est = plan.estimator.clone();
-    let mut notes = Vec::new();
-    let mut out = Vec::new();
-    let mut gnss_reports = Vec::new();
-    let mut odometry_glitches = 0;
+    let mut all = Inputs {
+        inputs: Vec::new(),
+        gnss: Vec::new(),
+        config: plan.estimator.clone(),
+        notes: Vec::new(),
+        odometry_glitches: 0,
+    };
     let datum = shared_datum(inv, bound);
     let odometers: Vec<&str> =
         bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::WheelOdometry).map(|s| s.topic.as_str()).collect();
@@ -119,118 +124,27 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
     }
     for s in &bound.sensors {
         match s.sensor.kind {
-            SensorKind::WheelOdometry => {
-                let n = &s.sensor.odometry;
-                if let Some(v) = n.translation_per_sqrt_m {
-                    est.odometry_translation_noise = v;
-                }
-                if let Some(v) = n.rotation_per_sqrt_rad {
-                    est.odometry_rotation_noise_per_rad = v;
-                }
-                if let Some(v) = n.rotation_per_sqrt_m {
-                    est.odometry_rotation_noise_per_m = v;
-                }
-                // nav_msgs/Odometry carries the covariance of the pose in `odom`, which grows
-                // as the robot drives; the estimator wants the covariance of each increment.
-                // That is the growth between consecutive messages, when the driver's
-                // covariance does grow. Many drivers publish a constant one (ROS's
-                // diff_drive_controller does): its growth is zero, and the sensor's noise
-                // figures apply instead — reading a constant 0.01 m² as the noise of every
-                // 20 ms step would make the odometry a hundred times too uncertain.
-                // The growth is in `odom`; the estimator takes the increment's covariance in
-                // the base frame at the start of the increment: rotated by Rᵀ(θ_prev).
-                let mut prev: Option<([[f64; 3]; 3], f64)> = None;
-                let msgs = &inv.odom[&s.topic];
-                let samples: Vec<(Stamp, Pose2)> = msgs.iter().map(|m| (offset(m.stamp, s), m.pose)).collect();
-                let keep = plausible_samples(&samples, &cfg.motion_limits());
-                let glitches = keep.iter().filter(|k| !**k).count() as u64;
-                if glitches > 0 {
-                    notes.push(glitch_note(&format!("odometry `{}`", s.topic), glitches, cfg));
-                }
-                odometry_glitches += glitches;
-                for (m, _) in msgs.iter().zip(&keep).filter(|(_, k)| **k) {
-                    let increment = match (m.covariance, prev) {
-                        (Some(c), Some((p, yaw))) if yaw.is_finite() => {
-                            let mut d = [[0.0; 3]; 3];
-                            for (r, row) in d.iter_mut().enumerate() {
-                                for (k, v) in row.iter_mut().enumerate() {
-                                    *v = c[r][k] - p[r][k];
-                                }
-                            }
-                            let (sn, cs) = yaw.sin_cos();
-                            let rt = [[cs, sn, 0.0], [-sn, cs, 0.0], [0.0, 0.0, 1.0]];
-                            let mut b = [[0.0; 3]; 3];
-                            for (i, row) in b.iter_mut().enumerate() {
-                                for (j, v) in row.iter_mut().enumerate() {
-                                    *v = (0..3)
-                                        .map(|a| (0..3).map(|k| rt[i][a] * d[a][k] * rt[j][k]).sum::<f64>())
-                                        .sum();
-                                }
-                            }
-                            (0..3).all(|i| b[i][i] > 0.0).then_some(b)
-                        }
-                        _ => None,
-                    };
-                    prev = m.covariance.map(|c| (c, m.pose.theta));
-                    out.push(EstimatorInput::Odometry {
-                        stamp: offset(m.stamp, s),
-                        pose: m.pose,
-                        covariance: increment,
-                    });
-                }
-            }
-            SensorKind::Imu => {
-                if let Some(v) = s.sensor.gyro_noise_rad_s {
-                    est.gyro_rate_sigma = v;
-                }
-                let msgs = &inv.imu[&s.topic];
-                let frame = s.sensor.frame.clone().or_else(|| inv.frames.get(&s.topic).cloned()).unwrap_or_default();
-                let m3 = mount(s, cfg, &tree, &frame, msgs.first().map(|m| m.stamp), &mut notes)?;
-                let r = m3.rotation();
-                let q_mount = m3.quaternion();
-                for m in msgs {
-                    let stamp = offset(m.stamp, s);
-                    // `angular_velocity_covariance[0] = -1`: no rate in this message.
-                    if m.rate_covariance[0] != -1.0 {
-                        let w = m.angular_velocity;
-                        // The z component of R · ω: the yaw rate of base_link; its variance
-                        // the (z, z) entry of R Σ Rᵀ.
-                        let yaw_rate = r[2][0] * w[0] + r[2][1] * w[1] + r[2][2] * w[2];
-                        let c = &m.rate_covariance;
-                        let var: f64 =
-                            (0..3).map(|a| (0..3).map(|b| r[2][a] * c[a * 3 + b] * r[2][b]).sum::<f64>()).sum();
-                        let variance = (var.is_finite() && var > 0.0).then_some(var);
-                        out.push(EstimatorInput::Gyro { stamp, yaw_rate, variance });
-                    }
-                    if let Some((orientation, var)) = m.orientation.filter(|_| s.sensor.use_orientation) {
-                        // world_from_base = world_from_imu · (base_from_imu)⁻¹.
-                        let world_from_imu = Pose3::new([0.0; 3], orientation);
-                        let q = world_from_imu.compose(&Pose3::new([0.0; 3], q_mount).inverse()).rotation;
-                        let yaw = quaternion_yaw(q);
-                        if yaw.is_finite() && var.is_finite() && var > 0.0 {
-                            out.push(EstimatorInput::Heading { stamp, yaw, variance: var });
-                        }
-                    }
-                }
-            }
+            SensorKind::WheelOdometry => odometry_inputs(s, inv, cfg, &mut all),
+            SensorKind::Imu => imu_inputs(s, inv, cfg, &tree, &mut all)?,
             SensorKind::Gnss => {
                 let (inputs, mut report, n) = gnss_inputs(s, inv, &tree, cfg, datum)?;
-                out.extend(inputs);
-                notes.extend(n);
+                all.inputs.extend(inputs);
+                all.notes.extend(n);
                 report.topic = s.topic.clone();
-                gnss_reports.push(report);
+                all.gnss.push(report);
             }
             SensorKind::Pose => {
                 let (ps, yaw) = s.sensor.pose_noise;
                 if let Some(v) = ps {
-                    est.fallback_pose_sigma_m = v;
+                    all.config.fallback_pose_sigma_m = v;
                 }
                 if let Some(v) = yaw {
-                    est.fallback_pose_sigma_rad = v;
+                    all.config.fallback_pose_sigma_rad = v;
                 }
                 for m in &inv.poses[&s.topic] {
                     let cov = planar_covariance(&m.covariance).unwrap_or([[0.0; 3]; 3]);
-                    out.push(EstimatorInput::Pose { stamp: offset(m.stamp, s), pose: m.pose2(), covariance: cov });
+                    let (stamp, pose) = (offset(m.stamp, s), m.pose2());
+                    all.inputs.push(EstimatorInput::Pose { stamp, pose, covariance: cov });
                 }
             }
             // Lidars and cameras give the map evidence, not the estimator (cameras are
@@ -238,7 +152,77 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
             SensorKind::Lidar | SensorKind::Camera => {}
         }
     }
-    Ok(Inputs { inputs: out, gnss: gnss_reports, config: est, notes, odometry_glitches })
+    Ok(all)
+}
+
+/// The wheel odometry's poses, glitches left out, each with its increment's covariance
+/// where the driver's covariance grows ([`odometry_increment_covariance`]); the sensor's
+/// noise figures into the estimator's config.
+fn odometry_inputs(s: &BoundSensor, inv: &Inventory, cfg: &LogConfig, all: &mut Inputs) {
+    let n = &s.sensor.odometry;
+    if let Some(v) = n.translation_per_sqrt_m {
+        all.config.odometry_translation_noise = v;
+    }
+    if let Some(v) = n.rotation_per_sqrt_rad {
+        all.config.odometry_rotation_noise_per_rad = v;
+    }
+    if let Some(v) = n.rotation_per_sqrt_m {
+        all.config.odometry_rotation_noise_per_m = v;
+    }
+    let msgs = &inv.odom[&s.topic];
+    let samples: Vec<(Stamp, Pose2)> = msgs.iter().map(|m| (offset(m.stamp, s), m.pose)).collect();
+    let keep = plausible_samples(&samples, &cfg.motion_limits());
+    let glitches = keep.iter().filter(|k| !**k).count() as u64;
+    if glitches > 0 {
+        all.notes.push(glitch_note(&format!("odometry `{}`", s.topic), glitches, cfg));
+    }
+    all.odometry_glitches += glitches;
+    let mut prev: Option<([[f64; 3]; 3], f64)> = None;
+    for (m, _) in msgs.iter().zip(&keep).filter(|(_, k)| **k) {
+        let covariance = match (m.covariance, prev) {
+            (Some(c), Some((p, yaw))) => odometry_increment_covariance(&c, &p, yaw),
+            _ => None,
+        };
+        prev = m.covariance.map(|c| (c, m.pose.theta));
+        all.inputs.push(EstimatorInput::Odometry { stamp: offset(m.stamp, s), pose: m.pose, covariance });
+    }
+}
+
+/// The IMU's yaw rates in the base frame ([`base_yaw_rate`]) and, when the config asks
+/// for them, its absolute headings; its gyro noise into the estimator's config.
+fn imu_inputs(
+    s: &BoundSensor,
+    inv: &Inventory,
+    cfg: &LogConfig,
+    tree: &FrameTree,
+    all: &mut Inputs,
+) -> Result<(), PipelineError> {
+    if let Some(v) = s.sensor.gyro_noise_rad_s {
+        all.config.gyro_rate_sigma = v;
+    }
+    let msgs = &inv.imu[&s.topic];
+    let frame = s.sensor.frame.clone().or_else(|| inv.frames.get(&s.topic).cloned()).unwrap_or_default();
+    let m3 = mount(s, cfg, tree, &frame, msgs.first().map(|m| m.stamp), &mut all.notes)?;
+    let r = m3.rotation();
+    let q_mount = m3.quaternion();
+    for m in msgs {
+        let stamp = offset(m.stamp, s);
+        // `angular_velocity_covariance[0] = -1`: no rate in this message.
+        if m.rate_covariance[0] != -1.0 {
+            let (yaw_rate, variance) = base_yaw_rate(&r, m.angular_velocity, &m.rate_covariance);
+            all.inputs.push(EstimatorInput::Gyro { stamp, yaw_rate, variance });
+        }
+        if let Some((orientation, var)) = m.orientation.filter(|_| s.sensor.use_orientation) {
+            // world_from_base = world_from_imu · (base_from_imu)⁻¹.
+            let world_from_imu = Pose3::new([0.0; 3], orientation);
+            let q = world_from_imu.compose(&Pose3::new([0.0; 3], q_mount).inverse()).rotation;
+            let yaw = quaternion_yaw(q);
+            if yaw.is_finite() && var.is_finite() && var > 0.0 {
+                all.inputs.push(EstimatorInput::Heading { stamp, yaw, variance: var });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The GNSS fixes as the estimator is given them: antenna positions in its map frame
@@ -315,35 +299,20 @@ fn gnss_inputs(
         }
         let enu = datum.to_enu(f.latitude, f.longitude, f.altitude);
         let q = quality(f);
-        let floor = match q {
-            FixQuality::RtkFixed => floors.floor_rtk_m,
-            FixQuality::Sbas => floors.floor_sbas_m,
-            _ => floors.floor_fix_m,
-        };
-        let c = &f.position_covariance;
         // NavSatFix's covariance is ENU (east, north, up), m².
-        let mut cov = if f.position_covariance_type == GnssMessage::COVARIANCE_TYPE_UNKNOWN
-            || !(c[0].is_finite() && c[4].is_finite() && c[1].is_finite() && c[0] > 0.0 && c[4] > 0.0)
-        {
-            r.unknown_covariance += 1;
-            let v = floors.unknown_m.max(floor).powi(2);
-            [[v, 0.0], [0.0, v]]
-        } else if f.position_covariance_type == GnssMessage::COVARIANCE_TYPE_KNOWN {
-            [[c[0], c[1]], [c[3], c[4]]]
-        } else {
-            [[c[0], 0.0], [0.0, c[4]]]
+        let kind = match f.position_covariance_type {
+            GnssMessage::COVARIANCE_TYPE_UNKNOWN => GnssCovarianceKind::Unknown,
+            GnssMessage::COVARIANCE_TYPE_KNOWN => GnssCovarianceKind::Known,
+            _ => GnssCovarianceKind::Diagonal,
         };
-        let f2 = floor * floor;
-        if cov[0][0] < f2 || cov[1][1] < f2 {
-            r.floored += 1;
-            cov[0][0] = cov[0][0].max(f2);
-            cov[1][1] = cov[1][1].max(f2);
-        }
+        let cov = floors.covariance(&f.position_covariance, kind, q);
+        r.unknown_covariance += u64::from(cov.unknown);
+        r.floored += u64::from(cov.floored);
         r.passed += 1;
         out.push(EstimatorInput::Position {
             stamp: offset(f.stamp, s),
             enu: [enu[0], enu[1]],
-            covariance: cov,
+            covariance: cov.enu,
             antenna: Point2::new(lever.x, lever.y),
             quality: q,
         });

@@ -327,18 +327,8 @@ pub struct OdometryNoise {
     pub rotation_per_sqrt_m: Option<f64>,
 }
 
-/// GNSS σ floors by fix status.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct GnssNoise {
-    /// Floor for RTK fixes (`STATUS_GBAS_FIX`), m.
-    pub floor_rtk_m: f64,
-    /// Floor for SBAS fixes, m.
-    pub floor_sbas_m: f64,
-    /// Floor for plain fixes, m.
-    pub floor_fix_m: f64,
-    /// σ when the covariance is unknown, m.
-    pub unknown_m: f64,
-}
+/// GNSS σ floors by fix status (the estimator's measurement model).
+pub use crate::estimator::GnssNoise;
 
 /// What a sensor adds to a run, validated.
 #[derive(Clone, Debug, PartialEq)]

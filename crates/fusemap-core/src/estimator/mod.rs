@@ -63,6 +63,7 @@ mod output;
 mod report;
 mod run;
 mod second_pass;
+mod sensor_models;
 mod slip_fixes;
 mod smoother;
 mod streams;
@@ -81,6 +82,7 @@ pub use report::{
     CorrectionReport, EstimatorReport, FixQualityCount, FixRejection, GyroReport, HeadingInit, HeadingSource,
     InnovationStats, OdometryReport, RejectedFix, SlipStretch,
 };
+pub use sensor_models::{base_yaw_rate, odometry_increment_covariance, GnssCovariance, GnssCovarianceKind, GnssNoise};
 
 use crate::geometry::Pose2;
 use filter::{StepRecord, N};
