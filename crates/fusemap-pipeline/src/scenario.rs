@@ -23,8 +23,9 @@ use serde::Serialize;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
-/// The mapping configuration of the production line (`configs/production_line.toml`).
-pub const PRODUCTION_LINE_CONFIG: &str = include_str!("../../../configs/production_line.toml");
+/// The mapping configuration of the production line (`configs/production_line.toml`, a
+/// link to this crate's own copy so the crate builds from its own files).
+pub const PRODUCTION_LINE_CONFIG: &str = include_str!("../configs/production_line.toml");
 
 /// The plan of [`PRODUCTION_LINE_CONFIG`].
 pub fn production_line_plan() -> Result<Plan, PipelineError> {

@@ -16,8 +16,8 @@ use crate::extrinsics::frame_tree;
 use crate::lidar_frames::lidar_setup;
 use crate::merge::{OrderedMerge, Pushed};
 use crate::progress::Progress;
-use crate::recording::{for_each_range_message, line_key, Inventory, RangeMessage};
-use crate::sensors::Bound;
+use crate::recording::{for_each_range_message, line_key, Inventory, LineKey, RangeMessage};
+use crate::sensors::{Bound, BoundLidar};
 pub use crate::slam_summary::{GraphEdge, GraphNode, GraphPrior, SlamSummary};
 use crate::sync::sync_mode;
 use crate::track::{ChosenTrack, LinePoses, TfTrack, Track};
@@ -25,11 +25,12 @@ use crate::PipelineError;
 use fusemap_core::config::{Plan, PoseSource, SlamMode};
 use fusemap_core::estimator::{EstimatorInput, FixQuality};
 use fusemap_core::geometry::{PlanarMount, Point2, Pose2};
+use fusemap_core::sensor::LidarParams;
 use fusemap_core::slam::pose_graph::EdgeKind;
 use fusemap_core::slam::{CorrectedTrack, PositionFix, ScanInput, ScanOutcome, Slam, SlamResult};
 use fusemap_core::time::{Stamp, SyncMode};
 use fusemap_io::log::ScanMessage;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
 /// The SLAM pass's result: the summary, with every scan's optimised pose.
@@ -89,100 +90,18 @@ pub fn run(
     let t0 = Instant::now();
     let cfg = &plan.log;
     let b = &bound.lidars[0];
-    let (tree, _) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
-    let mut scratch = Vec::new();
-    let (frame, _, model) = lidar_setup(b, inv, &tree, cfg, &mut scratch)?;
-    let mount = *model.mount();
-    // Scans of the topic's other frame ids are placed from their own mounts, as the
-    // mapping pass places them.
-    let mounts: HashMap<String, PlanarMount> =
-        crate::lidar_frames::other_frames(b, &frame, inv, &tree, cfg, &mut scratch)
-            .into_iter()
-            .map(|(f, (_, m))| (f, *m.mount()))
-            .collect();
-    let params = *model.params();
     let offset = crate::offset_ns(b.lidar.time_offset_s);
     let stamps = &inv.scans[&b.topic].stamps;
     let mode = sync_mode(cfg, stamps);
-    let mut slam = Slam::new(plan.slam);
-    slam.add_fixes(&fixes(plan, inv, bound, chosen, mode)?);
-    let line_glitches = match chosen.track {
-        Track::ScanLine(_) => inv.scans[&b.topic].line_glitches(&cfg.motion_limits()),
-        Track::Timed(_) => Default::default(),
-    };
-    // The track refuses to interpolate across its gaps (a map must not guess); a
-    // prediction may: the match corrects it.
-    let samples = match &chosen.track {
-        Track::Timed(track) => track.samples(),
-        Track::ScanLine(_) => Vec::new(),
-    };
-    let (mut without_pose, mut late) = (0u64, 0u64);
-    let mut lines: Vec<Option<(Stamp, Pose2)>> = Vec::new();
-    let mut hits: Vec<Point2> = Vec::new();
+    let mut feed = ScanFeed::new(plan, inv, b, chosen, mode)?;
+    feed.slam.add_fixes(&fixes(plan, inv, bound, chosen, mode)?);
     progress(Progress::Phase { name: "slam", total: stamps.len() as u64 });
     let topics = [b.topic.clone()];
     // Scans in stamp order, as the mapping pass releases them (logs hold them in arrival
     // order; CARMEN IPC stamps go backwards now and then).
     let mut merge: OrderedMerge<ScanMessage> = OrderedMerge::new(crate::offset_ns(cfg.reorder_window_s));
     let stream = merge.add_stream(b.topic.clone());
-    let mut repeats = crate::repeats::RepeatFilter::default();
-    let mut feed = |t: Stamp, scan: ScanMessage| {
-        progress(Progress::Advance(1));
-        // A repeated message is one scan, as in the mapping pass.
-        if repeats.is_repeat(&scan) {
-            return;
-        }
-        let pose = match &chosen.track {
-            Track::ScanLine(_) => {
-                scan.pose.filter(|p| p.is_finite() && !line_glitches.contains(&line_key(scan.scan.stamp, *p)))
-            }
-            Track::Timed(track) => track.pose_at(t, mode).ok().or_else(|| across_gap(&samples, t)),
-        };
-        if pose.is_none() {
-            without_pose += 1;
-        }
-        let lo = params.min_range.max(scan.range_min as f64);
-        let hi = params.max_range.min(scan.range_max as f64);
-        let (a0, inc) = (scan.scan.angle_min as f32 as f64, scan.scan.angle_increment as f32 as f64);
-        let mount = mounts.get(scan.frame_id.as_str()).unwrap_or(&mount);
-        let origin = mount.origin_in_base();
-        // De-skew as the mapping pass does: each beam placed with the track's motion from
-        // the scan's stamp to the beam's own time, so the matcher sees the scan as it would
-        // be from one pose (a scan swept while turning is otherwise bent).
-        let n = scan.scan.ranges.len();
-        let ti = scan.time_increment as f64;
-        let sweep = match &chosen.track {
-            Track::Timed(track) if cfg.deskew && mode == SyncMode::Interpolate && ti > 0.0 && n > 1 => {
-                track.pose_at(t, SyncMode::Interpolate).ok().map(|p0| (track, p0.inverse()))
-            }
-            _ => None,
-        };
-        let motion_at = |i: usize| -> Option<Pose2> {
-            let (track, from_base) = sweep?;
-            let tb = Stamp(t.0.saturating_add((ti * i as f64 * 1e9) as i64));
-            Some(from_base.compose(track.pose_at(tb, SyncMode::Interpolate).ok()?))
-        };
-        let deskew = motion_at(n.saturating_sub(1)).is_some();
-        hits.clear();
-        // A scan whose beams cannot be placed (refused by the mapping pass too) gives no hits.
-        let beams = if scan.angle_fault().is_none() { &scan.scan.ranges[..] } else { &[] };
-        hits.extend(beams.iter().enumerate().filter_map(|(i, &r)| {
-            let r = r as f64;
-            (r.is_finite() && r >= lo && r < hi).then(|| {
-                let a = mount.beam_angle_in_base(a0 + i as f64 * inc);
-                let q = Point2::new(origin.x + r * a.cos(), origin.y + r * a.sin());
-                match deskew.then(|| motion_at(i)).flatten() {
-                    Some(m) => m.transform_point(q),
-                    None => q,
-                }
-            })
-        }));
-        let outcome = slam.add_scan(ScanInput { stamp: t, track: pose, origin, hits: &hits, misses: &[] });
-        if matches!(chosen.track, Track::ScanLine(_)) && outcome != ScanOutcome::Refused {
-            lines.push(pose.map(|p| (scan.scan.stamp, p)));
-        }
-    };
-    let mut seq = 0i64;
+    let (mut seq, mut late) = (0i64, 0u64);
     for_each_range_message(&inv.path, &inv.limits, &topics, &[], |msg| {
         let RangeMessage::Scan(scan) = msg else { return Ok(()) };
         if scan.topic != b.topic {
@@ -200,22 +119,156 @@ pub fn run(
             late += 1;
         }
         while let Some((_, _, scan)) = merge.pop_ready() {
-            let t = Stamp(scan.scan.stamp.0.saturating_add(offset));
-            feed(t, scan);
+            progress(Progress::Advance(1));
+            feed.feed(Stamp(scan.scan.stamp.0.saturating_add(offset)), scan);
         }
         Ok(())
     })?;
     while let Some((_, _, scan)) = merge.pop_final() {
-        let t = Stamp(scan.scan.stamp.0.saturating_add(offset));
-        feed(t, scan);
+        progress(Progress::Advance(1));
+        feed.feed(Stamp(scan.scan.stamp.0.saturating_add(offset)), scan);
     }
     progress(Progress::Done);
-    let result = slam.finish();
-    let mut summary = summary(&result, reason, b.topic.clone(), without_pose, late, t0.elapsed().as_secs_f64());
-    let sensor = mount.base_from_sensor;
+    let result = feed.slam.finish();
+    let seconds = t0.elapsed().as_secs_f64();
+    let mut summary = summary(&result, reason, b.topic.clone(), feed.without_pose, late, seconds);
+    let sensor = feed.mount.base_from_sensor;
     summary.sensor_in_base = [sensor.x, sensor.y, sensor.theta];
-    summary.lines = lines;
+    summary.lines = feed.lines;
     Ok(SlamRun { summary })
+}
+
+/// What turns each scan, in stamp order, into SLAM's input: its pose on the track (or
+/// across the track's pauses, or on its scan line), its beams as points in the base frame
+/// (de-skewed as the mapping pass de-skews them), and the SLAM itself.
+struct ScanFeed<'a> {
+    track: &'a Track,
+    mode: SyncMode,
+    deskew: bool,
+    /// The track's samples, to interpolate across its pauses.
+    samples: Vec<(Stamp, Pose2)>,
+    /// The glitches among the scan-line poses.
+    line_glitches: HashSet<LineKey>,
+    /// The mounts of the topic's other frame ids.
+    mounts: HashMap<String, PlanarMount>,
+    mount: PlanarMount,
+    params: LidarParams,
+    slam: Slam,
+    repeats: crate::repeats::RepeatFilter,
+    hits: Vec<Point2>,
+    /// With poses on the scan lines: each scan's stamp and line pose.
+    lines: Vec<Option<(Stamp, Pose2)>>,
+    without_pose: u64,
+}
+
+impl<'a> ScanFeed<'a> {
+    /// The first lidar's mounts (one per frame id on its topic) and range limits, the
+    /// track to predict with, and a SLAM with the plan's parameters.
+    fn new(
+        plan: &Plan,
+        inv: &Inventory,
+        b: &BoundLidar,
+        chosen: &'a ChosenTrack,
+        mode: SyncMode,
+    ) -> Result<Self, PipelineError> {
+        let cfg = &plan.log;
+        let (tree, _) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
+        let mut scratch = Vec::new();
+        let (frame, _, model) = lidar_setup(b, inv, &tree, cfg, &mut scratch)?;
+        // Scans of the topic's other frame ids are placed from their own mounts, as the
+        // mapping pass places them.
+        let mounts = crate::lidar_frames::other_frames(b, &frame, inv, &tree, cfg, &mut scratch)
+            .into_iter()
+            .map(|(f, (_, m))| (f, *m.mount()))
+            .collect();
+        let line_glitches = match chosen.track {
+            Track::ScanLine(_) => inv.scans[&b.topic].line_glitches(&cfg.motion_limits()),
+            Track::Timed(_) => Default::default(),
+        };
+        let samples = match &chosen.track {
+            Track::Timed(track) => track.samples(),
+            Track::ScanLine(_) => Vec::new(),
+        };
+        Ok(ScanFeed {
+            track: &chosen.track,
+            mode,
+            deskew: cfg.deskew,
+            samples,
+            line_glitches,
+            mounts,
+            mount: *model.mount(),
+            params: *model.params(),
+            slam: Slam::new(plan.slam),
+            repeats: Default::default(),
+            hits: Vec::new(),
+            lines: Vec::new(),
+            without_pose: 0,
+        })
+    }
+
+    fn feed(&mut self, t: Stamp, scan: ScanMessage) {
+        // A repeated message is one scan, as in the mapping pass.
+        if self.repeats.is_repeat(&scan) {
+            return;
+        }
+        // The track refuses to interpolate across its gaps (a map must not guess); a
+        // prediction may: the match corrects it.
+        let pose = match self.track {
+            Track::ScanLine(_) => {
+                scan.pose.filter(|p| p.is_finite() && !self.line_glitches.contains(&line_key(scan.scan.stamp, *p)))
+            }
+            Track::Timed(track) => track.pose_at(t, self.mode).ok().or_else(|| across_gap(&self.samples, t)),
+        };
+        if pose.is_none() {
+            self.without_pose += 1;
+        }
+        let mount = *self.mounts.get(scan.frame_id.as_str()).unwrap_or(&self.mount);
+        self.place_beams(t, &scan, &mount);
+        let origin = mount.origin_in_base();
+        let outcome = self.slam.add_scan(ScanInput { stamp: t, track: pose, origin, hits: &self.hits, misses: &[] });
+        if matches!(self.track, Track::ScanLine(_)) && outcome != ScanOutcome::Refused {
+            self.lines.push(pose.map(|p| (scan.scan.stamp, p)));
+        }
+    }
+
+    /// The scan's beams within range as points in the base frame at the scan's stamp.
+    /// De-skewed as the mapping pass does: each beam placed with the track's motion from
+    /// the scan's stamp to the beam's own time, so the matcher sees the scan as it would be
+    /// from one pose (a scan swept while turning is otherwise bent).
+    fn place_beams(&mut self, t: Stamp, scan: &ScanMessage, mount: &PlanarMount) {
+        let lo = self.params.min_range.max(scan.range_min as f64);
+        let hi = self.params.max_range.min(scan.range_max as f64);
+        let (a0, inc) = (scan.scan.angle_min as f32 as f64, scan.scan.angle_increment as f32 as f64);
+        let origin = mount.origin_in_base();
+        let n = scan.scan.ranges.len();
+        let ti = scan.time_increment as f64;
+        let sweep = match self.track {
+            Track::Timed(track) if self.deskew && self.mode == SyncMode::Interpolate && ti > 0.0 && n > 1 => {
+                track.pose_at(t, SyncMode::Interpolate).ok().map(|p0| (track, p0.inverse()))
+            }
+            _ => None,
+        };
+        let motion_at = |i: usize| -> Option<Pose2> {
+            let (track, from_base) = sweep?;
+            let tb = Stamp(t.0.saturating_add((ti * i as f64 * 1e9) as i64));
+            Some(from_base.compose(track.pose_at(tb, SyncMode::Interpolate).ok()?))
+        };
+        let deskew = motion_at(n.saturating_sub(1)).is_some();
+        self.hits.clear();
+        // A scan whose beams cannot be placed (refused by the mapping pass too) gives no hits.
+        let beams = if scan.angle_fault().is_none() { &scan.scan.ranges[..] } else { &[] };
+        self.hits.extend(beams.iter().enumerate().filter_map(|(i, &r)| {
+            let r = r as f64;
+            (r.is_finite() && r >= lo && r < hi).then(|| {
+                let a = mount.beam_angle_in_base(a0 + i as f64 * inc);
+                let q = Point2::new(origin.x + r * a.cos(), origin.y + r * a.sin());
+                match deskew.then(|| motion_at(i)).flatten() {
+                    Some(m) => m.transform_point(q),
+                    None => q,
+                }
+            })
+        }));
+    }
 }
 
 /// The GNSS fixes for the pose graph, when the track is the estimator's: its map frame is
