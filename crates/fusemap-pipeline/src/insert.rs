@@ -8,7 +8,7 @@
 use crate::camera::MappedCamera;
 use crate::recording::{line_key, LineKey, RangeMessage};
 use crate::report::LidarReport;
-use crate::track::Track;
+use crate::track::{LinePoses, Track};
 use crate::PipelineError;
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
@@ -64,6 +64,42 @@ pub(crate) fn release(
     }
 }
 
+/// The pose of a scan line: SLAM's optimised pose of the line when SLAM placed it, else
+/// (its pose was a glitch) interpolated between its neighbours in time where it can be;
+/// without SLAM, the line's own pose unless it is a glitch. `None`, counted in the lidar's
+/// report, when the line has no usable pose.
+fn line_pose(
+    corrected: Option<&LinePoses>,
+    lines_seen: &mut HashMap<LineKey, usize>,
+    l: &mut Mapped,
+    msg: &ScanMessage,
+) -> Option<Pose2> {
+    let stamp = msg.scan.stamp;
+    let Some(line) = msg.pose.filter(|p| p.is_finite()) else {
+        l.report.scans_skipped.no_pose_on_line += 1;
+        return None;
+    };
+    let key = line_key(stamp, line);
+    let glitch = l.line_glitches.contains(&key);
+    let pose = match corrected {
+        None if glitch => None,
+        None => Some(line),
+        Some(c) => {
+            let k = lines_seen.entry(key).or_insert(0);
+            *k += 1;
+            let placed = if glitch { None } else { c.pose(stamp, line, *k - 1) };
+            placed.or_else(|| c.interpolated(stamp))
+        }
+    };
+    if pose.is_none() {
+        match glitch {
+            true => l.report.scans_skipped.pose_glitch += 1,
+            false => l.report.scans_skipped.no_pose_on_line += 1,
+        }
+    }
+    pose
+}
+
 /// Inserts released scans with their poses.
 pub(crate) struct Inserter<'a> {
     pub(crate) engine: &'a mut Engine,
@@ -76,7 +112,7 @@ pub(crate) struct Inserter<'a> {
     /// `trajectory.tum` holds beside the track's own samples).
     pub(crate) placed: Vec<(Stamp, Pose2)>,
     /// Lines met so far by their key (the `k`-th line with a key takes the `k`-th pose).
-    pub(crate) lines_seen: std::collections::HashMap<crate::recording::LineKey, usize>,
+    pub(crate) lines_seen: HashMap<LineKey, usize>,
     /// The next observation id: one per scan released by the merge, so that every insert
     /// is named (evidence of one instant from several sensors will share one).
     pub(crate) next_id: u64,
@@ -106,29 +142,7 @@ impl Inserter<'_> {
         self.next_id += 1;
         match self.track {
             Track::ScanLine(corrected) => {
-                let Some(line) = msg.pose.filter(|p| p.is_finite()) else {
-                    l.report.scans_skipped.no_pose_on_line += 1;
-                    return Ok(());
-                };
-                let key = line_key(stamp, line);
-                let glitch = l.line_glitches.contains(&key);
-                // A line SLAM placed takes its optimised pose; one it did not (its pose was
-                // a glitch) is interpolated between its neighbours in time, where it can be.
-                let pose = match corrected {
-                    None if glitch => None,
-                    None => Some(line),
-                    Some(c) => {
-                        let k = self.lines_seen.entry(key).or_insert(0);
-                        *k += 1;
-                        let placed = if glitch { None } else { c.pose(stamp, line, *k - 1) };
-                        placed.or_else(|| c.interpolated(stamp))
-                    }
-                };
-                let Some(pose) = pose else {
-                    match glitch {
-                        true => l.report.scans_skipped.pose_glitch += 1,
-                        false => l.report.scans_skipped.no_pose_on_line += 1,
-                    }
+                let Some(pose) = line_pose(corrected.as_ref(), &mut self.lines_seen, l, msg) else {
                     return Ok(());
                 };
                 // Line poses do not depend on the stamp: applied in file order.

@@ -104,41 +104,7 @@ pub fn score(name: &str, grid: &FusionGrid, classes: &ClassTable, truth: &Truth)
     let near_truth = |c: CellIndex| neighbours(c, 1).any(|n| truth_cells.contains(&n));
     let occupied_score = TolerantScore::new(&occupied, &truth_cells, 1);
 
-    let mut predicted: HashMap<CellIndex, u16> = HashMap::new();
-    let mut all_cells = fusemap_core::metrics::ClassAccuracy::default();
-    let floor = classes.index_by_name("floor").map(|i| classes.get(i).id);
-    let t = truth.occupancy;
-    let inside = |c: CellIndex| {
-        c.x >= t.first_cell.x
-            && c.y >= t.first_cell.y
-            && c.x < t.first_cell.x + t.width as i64
-            && c.y < t.first_cell.y + t.height as i64
-    };
-    if let Some(b) = grid.known_box() {
-        let s = semantic_cells(grid, b, classes);
-        for (i, &best) in s.best.cells.iter().enumerate() {
-            let c = CellIndex::new(
-                s.best.first_cell.x + (i % s.best.width) as i64,
-                s.best.first_cell.y + (i / s.best.width) as i64,
-            );
-            if best < 0 {
-                continue;
-            }
-            let id = classes.get(best as u8).id;
-            if occupied.contains(&c) {
-                predicted.insert(c, id);
-            }
-            if inside(c) {
-                let true_id = match truth.semantic.class_at(c) {
-                    0 => floor,
-                    k => Some(k as u16),
-                };
-                all_cells.truth += 1;
-                all_cells.held += 1;
-                all_cells.matched += (Some(id) == true_id) as usize;
-            }
-        }
-    }
+    let (predicted, all_cells) = semantic_predictions(grid, classes, truth, &occupied);
     let truth_classes: HashMap<CellIndex, u16> =
         truth_cells.iter().map(|&c| (c, truth.semantic.class_at(c) as u16)).filter(|(_, k)| *k != 0).collect();
     let semantic = SemanticAccuracy::new(&predicted, &truth_classes, 1);
@@ -176,6 +142,53 @@ pub fn score(name: &str, grid: &FusionGrid, classes: &ClassTable, truth: &Truth)
         machine_body_free_share: free_share(&truth.semantic.machine_body_cells),
         person_static_cells,
     }
+}
+
+/// The class each occupied cell of the map holds (what the semantic scores compare with
+/// the truth), and the share of all known cells inside the truth's raster whose class is
+/// right (unlabelled truth counts as floor).
+fn semantic_predictions(
+    grid: &FusionGrid,
+    classes: &ClassTable,
+    truth: &Truth,
+    occupied: &HashSet<CellIndex>,
+) -> (HashMap<CellIndex, u16>, fusemap_core::metrics::ClassAccuracy) {
+    let mut predicted: HashMap<CellIndex, u16> = HashMap::new();
+    let mut all_cells = fusemap_core::metrics::ClassAccuracy::default();
+    let floor = classes.index_by_name("floor").map(|i| classes.get(i).id);
+    let t = truth.occupancy;
+    let inside = |c: CellIndex| {
+        c.x >= t.first_cell.x
+            && c.y >= t.first_cell.y
+            && c.x < t.first_cell.x + t.width as i64
+            && c.y < t.first_cell.y + t.height as i64
+    };
+    if let Some(b) = grid.known_box() {
+        let s = semantic_cells(grid, b, classes);
+        for (i, &best) in s.best.cells.iter().enumerate() {
+            let c = CellIndex::new(
+                s.best.first_cell.x + (i % s.best.width) as i64,
+                s.best.first_cell.y + (i / s.best.width) as i64,
+            );
+            if best < 0 {
+                continue;
+            }
+            let id = classes.get(best as u8).id;
+            if occupied.contains(&c) {
+                predicted.insert(c, id);
+            }
+            if inside(c) {
+                let true_id = match truth.semantic.class_at(c) {
+                    0 => floor,
+                    k => Some(k as u16),
+                };
+                all_cells.truth += 1;
+                all_cells.held += 1;
+                all_cells.matched += (Some(id) == true_id) as usize;
+            }
+        }
+    }
+    (predicted, all_cells)
 }
 
 fn cells_of(b: CellBox) -> impl Iterator<Item = CellIndex> {

@@ -49,25 +49,45 @@ impl Bound {
 /// Binds the plan's sensors to `topics` (topic name → message count, per kind).
 pub fn bind(plan: &Plan, topics: &BTreeMap<SensorKind, BTreeMap<String, u64>>) -> Result<Bound, PipelineError> {
     let mut out = Bound::default();
-    let empty = BTreeMap::new();
-    let of = |k: SensorKind| topics.get(&k).unwrap_or(&empty);
-    let list = |k: SensorKind| {
-        let v: Vec<&str> = of(k).keys().map(String::as_str).collect();
+    bind_lidars(plan, &LogTopics(topics), &mut out)?;
+    bind_pose_sensors(plan, &LogTopics(topics), &mut out)?;
+    // Cameras are planned apart (`Plan::cameras`) and bound when the run builds their
+    // models from the log's images and camera info (`camera::build_camera`).
+    Ok(out)
+}
+
+/// The log's topics by sensor kind, with their message counts.
+struct LogTopics<'a>(&'a BTreeMap<SensorKind, BTreeMap<String, u64>>);
+
+impl LogTopics<'_> {
+    fn of(&self, k: SensorKind) -> &BTreeMap<String, u64> {
+        static EMPTY: BTreeMap<String, u64> = BTreeMap::new();
+        self.0.get(&k).unwrap_or(&EMPTY)
+    }
+
+    /// The topics of `k`, for an error message.
+    fn list(&self, k: SensorKind) -> String {
+        let v: Vec<&str> = self.of(k).keys().map(String::as_str).collect();
         if v.is_empty() {
             "none".to_string()
         } else {
             v.join(", ")
         }
-    };
+    }
+}
+
+/// Each planned lidar to its topic (the configured one, else the usual one), one lidar a
+/// topic; a note names the scan topics left unmapped.
+fn bind_lidars(plan: &Plan, topics: &LogTopics, out: &mut Bound) -> Result<(), PipelineError> {
+    let scans = topics.of(SensorKind::Lidar);
     for l in &plan.lidars {
-        let scans = of(SensorKind::Lidar);
         let topic = match &l.topic {
             Some(t) if scans.contains_key(t) => t.clone(),
             Some(t) => {
                 return Err(PipelineError::Refused(format!(
                     "lidar `{}`: topic `{t}` is not in the log (its scan topics: {})",
                     l.name,
-                    list(SensorKind::Lidar)
+                    topics.list(SensorKind::Lidar)
                 )))
             }
             None => auto_topic(SensorKind::Lidar, scans).ok_or_else(|| match scans.len() {
@@ -75,7 +95,7 @@ pub fn bind(plan: &Plan, topics: &BTreeMap<SensorKind, BTreeMap<String, u64>>) -
                 _ => PipelineError::Refused(format!(
                     "the log has several scan topics ({}) and none is `/scan`: list the lidars as \
                      [[sensor]] tables with kind = \"lidar\" and their topics",
-                    list(SensorKind::Lidar)
+                    topics.list(SensorKind::Lidar)
                 )),
             })?,
         };
@@ -84,39 +104,44 @@ pub fn bind(plan: &Plan, topics: &BTreeMap<SensorKind, BTreeMap<String, u64>>) -
         }
         out.lidars.push(BoundLidar { lidar: l.clone(), topic });
     }
-    let scan_topics = of(SensorKind::Lidar);
-    if plan.lidars.iter().all(|l| l.topic.is_none()) && scan_topics.len() > out.lidars.len() {
+    if plan.lidars.iter().all(|l| l.topic.is_none()) && scans.len() > out.lidars.len() {
         let unused: Vec<&str> =
-            scan_topics.keys().filter(|t| !out.lidars.iter().any(|b| &b.topic == *t)).map(String::as_str).collect();
+            scans.keys().filter(|t| !out.lidars.iter().any(|b| &b.topic == *t)).map(String::as_str).collect();
         out.notes.push(format!(
             "scan topics not mapped (list them as [[sensor]] lidars to map them): {}",
             unused.join(", ")
         ));
     }
+    Ok(())
+}
+
+/// The listed pose sensors to their topics; a kind not listed (nor disabled) bound to its
+/// usual topic when the log has it.
+fn bind_pose_sensors(plan: &Plan, topics: &LogTopics, out: &mut Bound) -> Result<(), PipelineError> {
     for kind in [SensorKind::WheelOdometry, SensorKind::Imu, SensorKind::Gnss, SensorKind::Pose] {
         let listed = plan.sensors.iter().filter(|s| s.kind == kind);
         let mut any = false;
         for s in listed {
             any = true;
             let topic = match &s.topic {
-                Some(t) if of(kind).contains_key(t) => t.clone(),
+                Some(t) if topics.of(kind).contains_key(t) => t.clone(),
                 Some(t) => {
                     return Err(PipelineError::Refused(format!(
                         "{} sensor `{}`: topic `{t}` is not in the log (its {} topics: {})",
                         kind.as_str(),
                         s.name,
                         kind.as_str(),
-                        list(kind)
+                        topics.list(kind)
                     )))
                 }
-                None => auto_topic(kind, of(kind)).ok_or_else(|| {
+                None => auto_topic(kind, topics.of(kind)).ok_or_else(|| {
                     PipelineError::Refused(format!(
                         "{} sensor `{}`: no topic given and the log has no `{}` (its {} topics: {})",
                         kind.as_str(),
                         s.name,
                         kind.default_topic(),
                         kind.as_str(),
-                        list(kind)
+                        topics.list(kind)
                     ))
                 })?,
             };
@@ -126,13 +151,11 @@ pub fn bind(plan: &Plan, topics: &BTreeMap<SensorKind, BTreeMap<String, u64>>) -
         if any || plan.disabled_kinds.contains(&kind) {
             continue;
         }
-        if let (Some(topic), Some(sensor)) = (auto_topic(kind, of(kind)), auto_sensor(kind)) {
+        if let (Some(topic), Some(sensor)) = (auto_topic(kind, topics.of(kind)), auto_sensor(kind)) {
             out.sensors.push(BoundSensor { sensor, topic });
         }
     }
-    // Cameras are planned apart (`Plan::cameras`) and bound when the run builds their
-    // models from the log's images and camera info (`camera::build_camera`).
-    Ok(out)
+    Ok(())
 }
 
 /// The usual topic of `kind`, else CARMEN's name for it, else the only topic.
