@@ -159,14 +159,7 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
     if let Some(cut) = &log.truncated {
         findings.push(format!("the log is cut short (`fusemap map` maps it up to the cut): {cut}"));
     }
-    if log.stats.malformed > 0 {
-        // The same words as `fusemap map`'s note: the reader skipped these records.
-        findings.push(format!(
-            "{} malformed records skipped; first: {}",
-            log.stats.malformed,
-            log.stats.malformed_examples.join("; ")
-        ));
-    }
+    findings.extend(log.malformed_note());
     stream_findings(&rows, sync.as_ref(), cfg, limits, &mut findings);
     if let Some(s) = &sync {
         write_sync(&mut out, s, cfg, &mut findings)?;

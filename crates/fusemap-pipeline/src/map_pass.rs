@@ -139,13 +139,7 @@ pub fn map_with_track(
     if let Some(cut) = &inv.truncated {
         notes.push(format!("the log is cut short, and was mapped up to the cut: {cut}"));
     }
-    if inv.stats.malformed > 0 {
-        notes.push(format!(
-            "{} malformed records skipped; first: {}",
-            inv.stats.malformed,
-            inv.stats.malformed_examples.join("; ")
-        ));
-    }
+    notes.extend(inv.malformed_note());
     camera_notes(&engine, &mut streams, &mut notes);
     let mut report = log_report(&input, &chosen, streams, mode, skipped, &tree);
     (report.track_s, report.map_s) = (track_s, map_s);

@@ -411,6 +411,18 @@ impl Inventory {
         }
     }
 
+    /// The note on the records the reader skipped as malformed, if it skipped any (the
+    /// same words for `map`'s notes and `doctor`'s findings).
+    pub fn malformed_note(&self) -> Option<String> {
+        (self.stats.malformed > 0).then(|| {
+            format!(
+                "{} malformed records skipped; first: {}",
+                self.stats.malformed,
+                self.stats.malformed_examples.join("; ")
+            )
+        })
+    }
+
     /// Total scans in the log.
     pub fn scan_count(&self) -> u64 {
         self.scans.values().map(|t| t.stamps.len() as u64).sum()

@@ -110,7 +110,7 @@ type Point = (f64, f64);
 
 /// Points on the corridor's walls within the scanned field, one per cell step: the side
 /// walls y = ±2 for x ∈ [0.5, 4] and the end wall x = 4 for |y| < 2 (as
-/// crates/fusemap-core/tests/corridor.rs takes them). Returns (side, end).
+/// crates/fusemap-core/tests/core/corridor.rs takes them). Returns (side, end).
 fn wall_points(res: f64) -> (Vec<Point>, Vec<Point>) {
     let mut side = Vec::new();
     let n = (3.5 / res).round() as i64;
@@ -232,7 +232,7 @@ fn demo_npz_meets_the_corridor_acceptance() {
 
     // Every wall cell is occupied; all but at most 4 are above 0.8, and those are
     // end-wall cells next to the corners, seen last at grazing incidence (see the comment
-    // in crates/fusemap-core/tests/corridor.rs).
+    // in crates/fusemap-core/tests/core/corridor.rs).
     let (side, end) = wall_points(res);
     let mut weak = Vec::new();
     for &(x, y) in side.iter().chain(&end) {

@@ -7,7 +7,7 @@
 //! Measured against the simulator's truth raster: the F1 of occupied cells with a
 //! one-cell tolerance, and the share of the pillar and machine body cells (cells whose
 //! centre lies inside their outlines) the map holds as free — the bodies the faulty rays
-//! carve open. `cargo test --release -p fusemap-core --test lidar_faults -- --ignored
+//! carve open. `cargo test --release -p fusemap-core --test core lidar_faults -- --ignored
 //! --nocapture` prints the table for the whole default scenario.
 
 use fusemap_core::grid::{CellIndex, GridGeometry, OccupancyParams, PassThroughParams, Ternary};

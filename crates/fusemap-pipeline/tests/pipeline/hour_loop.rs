@@ -6,7 +6,7 @@
 //! another SLAM's output.
 //!
 //! Five minutes on two cores, so it is not part of the suite; run it by hand:
-//! `cargo test --release -p fusemap-pipeline --test hour_loop -- --ignored --nocapture`.
+//! `cargo test --release -p fusemap-pipeline --test pipeline hour_loop -- --ignored --nocapture`.
 
 use fusemap_core::geometry::Pose2;
 use fusemap_core::metrics::{absolute_trajectory_error, revisit_relations, score_index_relations, RevisitRule};
