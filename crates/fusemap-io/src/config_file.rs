@@ -13,7 +13,7 @@
 //!   file leaves at its default has no line.
 
 use crate::{Error, Location, Result};
-use fusemap_core::config::Config;
+use fusemap_core::config::{Config, Plan};
 use std::ops::Range;
 use std::path::Path;
 use toml::de::{DeTable, DeValue};
@@ -28,8 +28,21 @@ pub fn load_config(path: &Path) -> Result<Config> {
     parse_config_str(&text, path)
 }
 
+/// Reads, parses and validates the configuration file at `path`, giving the validated
+/// plan (validated once; [`load_config`] gives the file's values instead).
+pub fn load_plan(path: &Path) -> Result<Plan> {
+    let text = read_text(path)?;
+    Ok(parse_plan_str(&text, path)?.1)
+}
+
 /// Parses and validates configuration `text`; `path` is only used in error messages.
 pub fn parse_config_str(text: &str, path: &Path) -> Result<Config> {
+    Ok(parse_plan_str(text, path)?.0)
+}
+
+/// Parses and validates configuration `text`: the file's values and the plan validated
+/// from them; `path` is only used in error messages.
+pub fn parse_plan_str(text: &str, path: &Path) -> Result<(Config, Plan)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let config: Config = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
     // serde fills a fixed-size array (`[f64; 2]`) from the first elements of a longer
@@ -48,8 +61,8 @@ pub fn parse_config_str(text: &str, path: &Path) -> Result<Config> {
             ));
         }
     }
-    config.validate().map_err(|e| field_error(path, text, &e.field, e.message))?;
-    Ok(config)
+    let plan = config.validate().map_err(|e| field_error(path, text, &e.field, e.message))?;
+    Ok((config, plan))
 }
 
 /// Reads a UTF-8 text file; invalid UTF-8 is a format error at the line where it starts.

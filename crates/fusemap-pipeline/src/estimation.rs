@@ -16,6 +16,7 @@
 //! Each sensor's `time_offset_s` is added to its stamps. What is not used is counted by
 //! reason in the report, beside the estimator's own figures.
 
+pub use crate::estimation_report::{EstimationReport, GnssInputReport};
 use crate::extrinsics::{frame_tree, from_tf, resolve};
 use crate::recording::{planar_covariance, Inventory};
 use crate::sensors::{Bound, BoundSensor};
@@ -30,33 +31,6 @@ use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{geodetic::Datum, quaternion_yaw, Mount3, Point2, Pose2, Pose3};
 use fusemap_core::time::{plausible_samples, Stamp};
 use fusemap_io::log::GnssMessage;
-use serde::Serialize;
-use std::collections::BTreeMap;
-
-/// What the pipeline did with the GNSS fixes before the estimator saw them.
-#[derive(Debug, Default, Clone, Serialize)]
-pub struct GnssInputReport {
-    /// The topic.
-    pub topic: String,
-    /// Fixes read.
-    pub read: u64,
-    /// Given to the estimator.
-    pub passed: u64,
-    /// `STATUS_NO_FIX`: ignored.
-    pub no_fix: u64,
-    /// NaN or infinite latitude, longitude or altitude.
-    pub not_finite: u64,
-    /// The datum `[lat°, lon°, alt m]` of the map frame (ENU at it).
-    pub datum: Option<[f64; 3]>,
-    /// `config` or `first good fix`.
-    pub datum_source: String,
-    /// Fixes whose σ was raised to the floor of their status.
-    pub floored: u64,
-    /// Fixes with covariance type UNKNOWN (given the configured σ).
-    pub unknown_covariance: u64,
-    /// The antenna's lever arm `base_from_antenna` (x, y), metres, and where it came from.
-    pub lever_arm: Option<[f64; 2]>,
-}
 
 /// The estimator's inputs from `inv`.
 pub struct Inputs {
@@ -327,10 +301,7 @@ pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Ch
     let odom = bound.first(SensorKind::WheelOdometry);
     let names: Vec<String> =
         bound.sensors.iter().map(|s| format!("{} `{}`", s.sensor.kind.as_str().replace('_', " "), s.topic)).collect();
-    let mut report: BTreeMap<&str, serde_json::Value> = BTreeMap::new();
-    report.insert("estimator", serde_json::to_value(&e.report).unwrap_or_default());
-    report.insert("gnss_input", serde_json::to_value(&gnss).unwrap_or_default());
-    report.insert("inputs", serde_json::Value::from(inputs.len()));
+    let report = EstimationReport { estimator: e.report.clone(), gnss_input: gnss, inputs: inputs.len() };
     let stamps: Vec<Stamp> = odom.map(|o| inv.odom[&o.topic].iter().map(|m| m.stamp).collect()).unwrap_or_default();
     let receive = odom.map(|o| inv.odom[&o.topic].iter().map(|m| m.receive_stamp).collect()).unwrap_or_default();
     // The track's own counters are the odometry's: the samples the track is built on.
@@ -349,7 +320,7 @@ pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Ch
         counts,
         stamps,
         receive,
-        estimator: serde_json::to_value(report).ok(),
+        estimator: Some(Box::new(report)),
         notes,
         slam: None,
     })

@@ -26,6 +26,7 @@
 pub mod camera;
 pub mod doctor;
 pub mod estimation;
+pub mod estimation_report;
 pub mod extrinsics;
 mod insert;
 mod lidar_frames;

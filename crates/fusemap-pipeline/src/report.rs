@@ -82,7 +82,7 @@ pub struct LogReport {
     pub extrinsics: ExtrinsicsReport,
     /// The estimator's report, when it made the poses.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub estimator: Option<serde_json::Value>,
+    pub estimator: Option<Box<crate::estimation_report::EstimationReport>>,
     /// The time-ordered merge of the range streams: per-stream counters.
     pub merge: Vec<StreamStats>,
     /// The most scans the merge held at once.

@@ -62,7 +62,7 @@ pub struct ChosenTrack {
     /// … and their receive stamps.
     pub receive: Vec<Option<Stamp>>,
     /// The estimator's report, when it made the track.
-    pub estimator: Option<serde_json::Value>,
+    pub estimator: Option<Box<crate::estimation_report::EstimationReport>>,
     /// Facts about the track a user should know.
     pub notes: Vec<String>,
     /// What SLAM did, when it corrected the track.

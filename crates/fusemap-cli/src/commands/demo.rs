@@ -22,9 +22,7 @@ use std::time::Instant;
 
 fn plan_of(config: Option<&Path>, default: impl FnOnce() -> Result<Plan>) -> Result<Plan> {
     match config {
-        Some(p) => {
-            fusemap_io::config_file::load_config(p)?.validate().map_err(|e| anyhow::anyhow!("configuration: {e}"))
-        }
+        Some(p) => Ok(fusemap_io::config_file::load_plan(p)?),
         None => default(),
     }
 }

@@ -1,17 +1,12 @@
 //! `fusemap doctor LOG`: the log doctor's report (see `fusemap_pipeline::doctor`).
 
 use anyhow::Result;
-use fusemap_core::config::Config;
 use std::path::Path;
 
 /// `fusemap doctor`: the report on stdout; a log `fusemap map` would refuse exits
 /// non-zero with the reason.
 pub fn run(config: Option<&Path>, path: &Path) -> Result<()> {
-    let cfg = match config {
-        Some(p) => fusemap_io::config_file::load_config(p)?,
-        None => Config::default(),
-    };
-    let plan = cfg.validate().map_err(|e| anyhow::anyhow!("configuration: {e}"))?;
+    let plan = super::plan_of(config)?;
     let report = fusemap_pipeline::doctor::report(&plan, path)?;
     print!("{}", report.text);
     match report.refusal {

@@ -5,7 +5,7 @@ use crate::output::{self, finish};
 use crate::progress;
 use crate::summary::Summary;
 use anyhow::{bail, Result};
-use fusemap_core::config::{Config, Plan};
+use fusemap_core::config::Plan;
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::grid::FusionGrid;
@@ -77,11 +77,7 @@ pub fn map(
     out: &Path,
     crop: Option<Crop>,
 ) -> Result<()> {
-    let cfg = match config {
-        Some(p) => fusemap_io::config_file::load_config(p)?,
-        None => Config::default(),
-    };
-    let plan = cfg.validate().map_err(|e| anyhow::anyhow!("configuration: {e}"))?;
+    let plan = super::plan_of(config)?;
     let export = ExportOptions { crop, export_cells: plan.limits.export_cells };
     if let Some(c) = &crop {
         crate::export::crop_area(&plan.geometry, c, export.export_cells)?;

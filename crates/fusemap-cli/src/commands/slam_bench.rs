@@ -3,7 +3,6 @@
 //! printed as a markdown table (or one JSON object a case).
 
 use anyhow::{bail, Context, Result};
-use fusemap_core::config::Config;
 use fusemap_pipeline::slam_bench::{meets_bounds, run_case, table_row, Drift, BENCH_LOGS, TABLE_HEADER};
 use std::path::Path;
 
@@ -16,11 +15,7 @@ pub fn run(
     distinct_stamps: bool,
     json: bool,
 ) -> Result<()> {
-    let cfg = match config {
-        Some(p) => fusemap_io::config_file::load_config(p)?,
-        None => Config::default(),
-    };
-    let plan = cfg.validate().map_err(|e| anyhow::anyhow!("configuration: {e}"))?;
+    let plan = super::plan_of(config)?;
     for l in logs {
         if !BENCH_LOGS.iter().any(|b| b.name == l) {
             let names: Vec<&str> = BENCH_LOGS.iter().map(|b| b.name).collect();
