@@ -45,6 +45,7 @@ pub mod slam_bench;
 pub mod slam_summary;
 pub mod sync;
 pub mod track;
+pub mod world;
 
 pub use run::{map_inventory, map_log, map_with_track, MapRun, Progress};
 

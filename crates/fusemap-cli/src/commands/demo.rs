@@ -4,7 +4,7 @@
 //! simulator's ground truth and the three are drawn side by side. `--corridor` maps the
 //! document's §3.3 corridor instead.
 
-use crate::commands::map::run_simulated;
+use crate::commands::world::run_simulated;
 use crate::export::ExportOptions;
 use crate::output::{self, finish, layers_of, OutputFiles};
 use crate::progress;

@@ -1,72 +1,14 @@
-//! `fusemap demo` and `fusemap map`: build a map and write its outputs.
+//! `fusemap map`: a robot log or a world file mapped, its outputs written.
 
+use crate::commands::world::run_simulated;
 use crate::export::{Crop, ExportOptions};
 use crate::output::{self, finish};
 use crate::progress;
 use crate::summary::Summary;
 use anyhow::{bail, Result};
 use fusemap_core::config::Plan;
-use fusemap_core::fusion::Engine;
-use fusemap_core::geometry::Pose2;
-use fusemap_core::grid::FusionGrid;
-use fusemap_core::sim::{ScannerSpec, World};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// An engine with the plan's grid and lidars.
-pub fn engine_for(plan: &Plan) -> Engine {
-    let mut engine = Engine::new(FusionGrid::new(plan.geometry, plan.occupancy));
-    engine.set_map_cells_limit(&plan.limits);
-    for l in &plan.lidars {
-        engine.add_lidar(l.name.clone(), l.model);
-    }
-    engine
-}
-
-/// Maps a simulated run of `world` with `scanner` along `poses`.
-#[allow(clippy::too_many_arguments)]
-pub fn run_simulated(
-    plan: &Plan,
-    export: &ExportOptions,
-    world: &World,
-    scanner: &ScannerSpec,
-    poses: Vec<Pose2>,
-    out: &Path,
-    source: &str,
-    inputs: &[PathBuf],
-) -> Result<Summary> {
-    let started = Instant::now();
-    let files = output::prepare(out, inputs)?;
-    let mut engine = engine_for(plan);
-    let ids: Vec<_> = (0..plan.lidars.len() as u16).map(fusemap_core::measurement::SensorId).collect();
-    // Scan i is taken at i / rate: a pose implying an impossible motion from its neighbours
-    // is a glitch (as on a log's pose streams), left out and counted.
-    let stamp = |i: usize| fusemap_core::time::Stamp::from_secs_f64(i as f64 / scanner.rate_hz).unwrap_or_default();
-    let timed: Vec<_> = poses.iter().enumerate().map(|(i, p)| (stamp(i), *p)).collect();
-    let keep = fusemap_core::time::plausible_samples(&timed, &plan.log.motion_limits());
-    let glitches = keep.iter().filter(|k| !**k).count() as u64;
-    let pb = progress::bar(poses.len() as u64, "mapping");
-    for (i, pose) in poses.iter().enumerate() {
-        if !keep[i] {
-            pb.inc(1);
-            continue;
-        }
-        for (k, id) in ids.iter().enumerate() {
-            let mount = plan.lidars[k].model.mount();
-            let scan = fusemap_core::sim::simulate_scan(world, scanner, mount, *pose, stamp(i));
-            // The engine's refusals (a map past limits.map_cells) name the world file.
-            engine.insert_scan(*id, &scan, *pose).map_err(|e| anyhow::anyhow!("{source}: scan {i}: {e}"))?;
-        }
-        pb.inc(1);
-    }
-    pb.finish_and_clear();
-    let notes = if glitches > 0 {
-        vec![fusemap_pipeline::track::glitch_note("the world file's trajectory", glitches, &plan.log)]
-    } else {
-        Vec::new()
-    };
-    finish(&engine, files, export, "world", source, started, notes, None, None)
-}
 
 /// `fusemap map`: a world file (simulated) or a robot log; `crop` exports that region
 /// densely.

@@ -7,6 +7,7 @@ pub mod map;
 pub mod relations;
 pub mod simulate;
 pub mod slam_bench;
+pub mod world;
 
 /// The validated plan of `--config FILE`, or of the defaults without one: the file is
 /// read and validated once (its errors name the file and the line).
