@@ -387,7 +387,7 @@ fn stream_findings(
         }
         if *kind != "scan" && t.gaps > 0 {
             let consequence = if role == Role::PoseTrack && track.is_some_and(|tr| tr.slam.is_some()) {
-                ": SLAM poses the scans inside them (see below)".to_string()
+                ": SLAM interpolates the odometry across them as its scan matcher's first guess".to_string()
             } else if role == Role::PoseTrack {
                 format!(
                     ": a scan inside one gets a pose only if the robot moved at most {} m and {}° across it",

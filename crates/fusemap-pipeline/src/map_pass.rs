@@ -157,15 +157,12 @@ impl Streams {
             Track::ScanLine(_) => 0,
             Track::Timed(_) => offset_ns(input.plan.log.reorder_window_s),
         };
-        let mut s = Streams {
-            merge: OrderedMerge::new(window),
-            lidars: Vec::new(),
-            cameras: Vec::new(),
-            planned: planned_cameras(input.plan, input.inv, notes)?,
-        };
+        let mut s =
+            Streams { merge: OrderedMerge::new(window), lidars: Vec::new(), cameras: Vec::new(), planned: Vec::new() };
         for b in &input.bound.lidars {
             s.add_lidar(input, b, engine, notes)?;
         }
+        s.planned = planned_cameras(input.plan, input.inv, notes)?;
         for c in &s.planned.clone() {
             let built = build_camera(
                 c,

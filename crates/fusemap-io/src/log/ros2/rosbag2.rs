@@ -50,7 +50,7 @@ pub fn parse_metadata(text: &str) -> std::result::Result<Metadata, MetadataError
     let version = match yaml::get(info, "version") {
         None => None,
         Some(n) => {
-            let v = yaml::text(n).unwrap_or_default();
+            let v = yaml::text(n).or_else(|_| yaml::number(n).map(|x| x.to_string())).unwrap_or_default();
             Some(v.parse().map_err(|_| (yaml::line(n), format!("`version: {v}` is not a whole number")))?)
         }
     };
@@ -60,6 +60,8 @@ pub fn parse_metadata(text: &str) -> std::result::Result<Metadata, MetadataError
         Some(items) => items
             .iter()
             .map(|n| yaml::text(n).map_err(|m| (yaml::line(n), format!("`relative_file_paths`: {m}"))))
+            // An empty item (`~`, `""`) names no file, as the list's other spellings skip it.
+            .filter(|p| p.as_ref().map_or(true, |s| !s.is_empty()))
             .collect::<std::result::Result<_, _>>()?,
         // `relative_file_paths:` with nothing after it: no files (refused by the caller).
         None if yaml::text(paths).is_ok_and(|s| s.is_empty()) => Vec::new(),
@@ -300,8 +302,10 @@ rosbag2_bagfile_information:
         assert_eq!(m.relative_file_paths, ["a_0.mcap", "a_1.mcap"]);
         assert_eq!(m.version, Some(9));
 
-        let flow = "rosbag2_bagfile_information:\n    relative_file_paths: [x.db3, \"y.db3\"]\n";
+        let flow = "rosbag2_bagfile_information:\n    relative_file_paths: [x.db3, \"y.db3\", ~]\n";
         assert_eq!(parse_metadata(flow).unwrap().relative_file_paths, ["x.db3", "y.db3"]);
+        let float = "rosbag2_bagfile_information:\n  version: 5.5\n  relative_file_paths: []\n";
+        assert!(parse_metadata(float).unwrap_err().1.contains("5.5"));
     }
 
     /// One bag's metadata as `ros2 bag record` writes it (block style), as PyYAML writes it
