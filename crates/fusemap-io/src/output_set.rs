@@ -50,16 +50,18 @@ pub struct OutputSet {
     /// Held open for the lock; released on drop.
     _lock: File,
     committed: bool,
-    /// True when this set made the output directory: an uncommitted set then removes it
-    /// again (with its lock file), so a run that fails on its input leaves nothing.
-    created_dir: bool,
+    /// The directories this set made, the output directory first and its new parents
+    /// after it: an uncommitted set removes them again (the output directory with its
+    /// lock file), so a run that fails on its input leaves nothing.
+    created: Vec<PathBuf>,
 }
 
 impl OutputSet {
     /// Creates `dir` if needed, takes its lock, removes staging directories of dead runs
     /// and opens a fresh staging directory.
     pub fn begin(dir: &Path) -> Result<Self> {
-        let created_dir = !dir.exists();
+        let created: Vec<PathBuf> =
+            dir.ancestors().take_while(|d| !d.as_os_str().is_empty() && !d.exists()).map(Path::to_path_buf).collect();
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         let lock_path = dir.join(LOCK_FILE);
         let lock = OpenOptions::new()
@@ -95,7 +97,7 @@ impl OutputSet {
         }
         let staging = dir.join(format!("{STAGING_PREFIX}{}", std::process::id()));
         std::fs::create_dir(&staging).map_err(|e| Error::io(&staging, e))?;
-        Ok(Self { dir: dir.to_path_buf(), staging, _lock: lock, committed: false, created_dir })
+        Ok(Self { dir: dir.to_path_buf(), staging, _lock: lock, committed: false, created })
     }
 
     /// The output directory.
@@ -196,8 +198,13 @@ impl Drop for OutputSet {
             let only_lock = std::fs::read_dir(&self.dir)
                 .map(|entries| entries.flatten().all(|e| e.file_name() == LOCK_FILE))
                 .unwrap_or(false);
-            if self.created_dir && only_lock && std::fs::remove_file(self.dir.join(LOCK_FILE)).is_ok() {
-                let _ = std::fs::remove_dir(&self.dir);
+            if !self.created.is_empty() && only_lock && std::fs::remove_file(self.dir.join(LOCK_FILE)).is_ok() {
+                // Leaf first; a parent that is not empty (anything else appeared) stays.
+                for d in &self.created {
+                    if std::fs::remove_dir(d).is_err() {
+                        break;
+                    }
+                }
             }
         }
     }
@@ -384,8 +391,8 @@ mod tests {
         let parent = crate::testdata::temp_dir("output-set-made");
         let dir = parent.join("out/run");
         drop(OutputSet::begin(&dir).unwrap());
-        // The run failed before writing anything: `run` goes, the parent it made stays.
-        assert!(!dir.exists() && parent.join("out").is_dir());
+        // The run failed before writing anything: `run` goes, and so does the `out` it made.
+        assert!(!dir.exists() && !parent.join("out").exists() && parent.is_dir());
         // Something else written there meanwhile keeps the directory.
         let set = OutputSet::begin(&dir).unwrap();
         std::fs::write(dir.join("mine.txt"), b"the user's").unwrap();
