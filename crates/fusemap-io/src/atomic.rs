@@ -190,7 +190,7 @@ mod tests {
     use super::*;
     use std::io::Write;
 
-    fn temp_dir(tag: &str) -> PathBuf {
+    fn temp_dir(tag: &str) -> crate::testdata::TestDir {
         crate::testdata::temp_dir(&format!("atomic-{tag}"))
     }
 

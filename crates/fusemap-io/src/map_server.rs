@@ -385,7 +385,7 @@ mod tests {
     use super::*;
     use fusemap_core::grid::{logodds::logit, CellIndex, OccupancyParams};
 
-    fn temp_dir(tag: &str) -> PathBuf {
+    fn temp_dir(tag: &str) -> crate::testdata::TestDir {
         crate::testdata::temp_dir(&format!("mapserver-{tag}"))
     }
 

@@ -126,9 +126,8 @@ mod tests {
     use super::*;
     use fusemap_core::geometry::Point2;
     use fusemap_core::grid::{logodds::logit, CellIndex, OccupancyParams};
-    use std::path::PathBuf;
 
-    fn temp_dir(tag: &str) -> PathBuf {
+    fn temp_dir(tag: &str) -> crate::testdata::TestDir {
         crate::testdata::temp_dir(&format!("picture-{tag}"))
     }
 

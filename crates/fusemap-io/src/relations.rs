@@ -79,7 +79,8 @@ mod tests {
 
     #[test]
     fn refuses_a_file_over_the_limit() {
-        let p = temp_dir("relations-big").join("huge.relations");
+        let dir = temp_dir("relations-big");
+        let p = dir.join("huge.relations");
         let f = std::fs::File::create(&p).unwrap();
         // Sparse: no disk space used.
         f.set_len(MAX_RELATIONS_BYTES + 1).unwrap();

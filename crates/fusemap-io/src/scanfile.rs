@@ -84,8 +84,7 @@ mod tests {
 
     #[test]
     fn round_trip_and_errors() {
-        let dir = std::env::temp_dir().join(format!("fusemap-scanfile-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::testdata::temp_dir("scanfile");
         let p = dir.join("a.scan");
         let b = crate::testdata::tiny_scanfile_bytes();
         assert_eq!(&b[..8], MAGIC);

@@ -232,29 +232,33 @@ pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwri
 mod tests {
     use super::*;
 
-    fn write(name: &str, text: &str) -> std::path::PathBuf {
-        let p = crate::testdata::temp_dir("scenario").join(name);
+    fn write(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
+        let p = dir.join(name);
         std::fs::write(&p, text).unwrap();
         p
     }
 
     #[test]
     fn scenario_files_fill_defaults_and_name_bad_keys_and_fields() {
-        let s = load_scenario(&write("short.toml", "[robot]\nduration_s = 30.0\n")).unwrap();
+        let dir = crate::testdata::temp_dir("scenario");
+        let s = load_scenario(&write(&dir, "short.toml", "[robot]\nduration_s = 30.0\n")).unwrap();
         assert_eq!(s.robot.duration_s, 30.0);
         assert_eq!(s.lidar, Scenario::default().lidar);
-        let e = load_scenario(&write("typo.toml", "[robot]\nduration_s = 30.0\nspeeed = 1\n")).unwrap_err().to_string();
+        let e = load_scenario(&write(&dir, "typo.toml", "[robot]\nduration_s = 30.0\nspeeed = 1\n"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("typo.toml:3") && e.contains("speeed"), "{e}");
-        let e = load_scenario(&write("bad.toml", "[gnss]\nrate_hz = 0.0\n")).unwrap_err().to_string();
+        let e = load_scenario(&write(&dir, "bad.toml", "[gnss]\nrate_hz = 0.0\n")).unwrap_err().to_string();
         assert!(e.contains("bad.toml") && e.contains("gnss.rate_hz"), "{e}");
         let cam = "[camera]\ndepth_encoding = \"16UC1\"\nlabel_encoding = \"mono16\"\ntime_offset_s = 0.04\n\
                    [camera.backlight]\nfloor_share = 0.4\n[person]\nwindows = [[0.0, 30.0]]\n";
-        let s = load_scenario(&write("camera.toml", cam)).unwrap();
+        let s = load_scenario(&write(&dir, "camera.toml", cam)).unwrap();
         assert_eq!(s.camera.depth_encoding, fusemap_core::sim::production::DepthEncoding::U16Millimetres);
         assert_eq!(s.camera.label_encoding, fusemap_core::sim::production::LabelEncoding::Mono16);
         assert_eq!((s.camera.time_offset_s, s.camera.backlight.floor_share), (0.04, 0.4));
         assert_eq!((s.person.windows.clone(), s.camera.width), (vec![[0.0, 30.0]], 320));
-        let e = load_scenario(&write("enc.toml", "[camera]\ndepth_encoding = \"rgb8\"\n")).unwrap_err().to_string();
+        let e =
+            load_scenario(&write(&dir, "enc.toml", "[camera]\ndepth_encoding = \"rgb8\"\n")).unwrap_err().to_string();
         assert!(e.contains("enc.toml:2"), "{e}");
     }
 
@@ -296,7 +300,8 @@ mod tests {
         s.robot.duration_s = 1.0;
         (s.camera.width, s.camera.height) = (64, 48);
         let rec = simulate(&s).unwrap();
-        let dir = crate::testdata::temp_dir("sim-camera").join("bag");
+        let tmp = crate::testdata::temp_dir("sim-camera");
+        let dir = tmp.join("bag");
         write_bag(&rec, &dir, false).unwrap();
         let first = |topic: &str| {
             rec.messages

@@ -5,7 +5,7 @@
 //! `FUSEMAP_NO_SKIP=1` (set by `.ci/run`) a missing directory is a failure, so CI can
 //! never pass by skipping.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The environment variable that turns skips into failures.
 pub const NO_SKIP_ENV: &str = "FUSEMAP_NO_SKIP";
@@ -68,17 +68,103 @@ pub fn python_with(modules: &[&str]) -> Option<String> {
     }
 }
 
+/// The environment variable that keeps every test directory for a look afterwards.
+pub const KEEP_DIRS_ENV: &str = "FUSEMAP_KEEP_TEST_DIRS";
+
+/// A test's own directory under the system temp dir, removed with everything in it when
+/// the value is dropped. Tests write bags and maps of up to a few hundred megabytes; a
+/// directory that outlived its test filled the disk after a few dozen runs, so the
+/// directory's life is the value's. `FUSEMAP_KEEP_TEST_DIRS=1` keeps them all.
+///
+/// It dereferences to its [`Path`], so `dir.join("x")` and `&dir` work as with a path;
+/// bind it to a name that lives as long as the files are used (`temp_dir(t).join("x")`
+/// alone would remove the directory at the end of the statement).
+#[derive(Debug)]
+#[must_use = "the directory is removed when this value is dropped"]
+pub struct TestDir {
+    path: PathBuf,
+}
+
+impl TestDir {
+    /// The directory's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// `name` inside this directory, as a value that keeps the directory alive: for a
+    /// helper that writes a bag or an output set and hands back its path.
+    pub fn into_child(self, name: &str) -> TestPath {
+        TestPath { path: self.path.join(name), _dir: self }
+    }
+}
+
+/// A path inside a [`TestDir`] that owns the directory ([`TestDir::into_child`]).
+#[derive(Debug)]
+pub struct TestPath {
+    path: PathBuf,
+    _dir: TestDir,
+}
+
+impl std::ops::Deref for TestPath {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl AsRef<Path> for TestPath {
+    fn as_ref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl std::ops::Deref for TestDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl AsRef<Path> for TestDir {
+    fn as_ref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl Drop for TestDir {
+    fn drop(&mut self) {
+        if std::env::var(KEEP_DIRS_ENV).is_ok_and(|v| v == "1") {
+            eprintln!("kept {}", self.path.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.path);
+        }
+    }
+}
+
 /// A fresh empty directory for one test: `fusemap-{tag}-{pid}-{n}` under the system temp
-/// dir, unique per call within the process.
-pub fn temp_dir(tag: &str) -> PathBuf {
+/// dir, unique per call within the process, removed when the returned value is dropped.
+pub fn temp_dir(tag: &str) -> TestDir {
     static N: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let d = std::env::temp_dir().join(format!(
+    let path = std::env::temp_dir().join(format!(
         "fusemap-{tag}-{}-{}",
         std::process::id(),
         N.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
     ));
-    std::fs::create_dir_all(&d).unwrap_or_else(|e| panic!("cannot create {}: {e}", d.display()));
-    d
+    let _ = std::fs::remove_dir_all(&path);
+    std::fs::create_dir_all(&path).unwrap_or_else(|e| panic!("cannot create {}: {e}", path.display()));
+    TestDir { path }
+}
+
+/// A directory for a fixture that several tests of one test binary share through a
+/// static (a static is never dropped, so a [`TestDir`] there would outlive the run):
+/// `{base}/{tag}`, emptied and made afresh. Pass `env!("CARGO_TARGET_TMPDIR")` as `base`,
+/// cargo's scratch directory for integration tests inside the target directory, so the
+/// next run replaces the fixture instead of adding one and two checkouts never share it.
+pub fn fixture_dir(base: &str, tag: &str) -> PathBuf {
+    let path = Path::new(base).join(tag);
+    let _ = std::fs::remove_dir_all(&path);
+    std::fs::create_dir_all(&path).unwrap_or_else(|e| panic!("cannot create {}: {e}", path.display()));
+    path
 }
 
 /// A tiny `SCAN2D01` scan file: 2 scans of 3 beams, poses (0, 1, 0.5) and (4, 5, 6),

@@ -34,14 +34,34 @@ pub fn run(
     }
     let work = std::env::temp_dir().join(format!("fusemap-slam-bench-{}", std::process::id()));
     std::fs::create_dir_all(&work).with_context(|| format!("creating {}", work.display()))?;
+    // The rewritten logs go, whether the bench ends or fails part-way.
+    let failed = run_cases(shared, logs, &chosen, distinct_stamps, &plan, &work, json);
+    let _ = std::fs::remove_dir_all(&work);
+    let failed = failed?;
+    if !json {
+        println!("\n{failed} case(s) outside the acceptance bounds");
+    }
+    Ok(())
+}
+
+/// Runs and prints every case; the number outside the acceptance bounds.
+fn run_cases(
+    shared: &Path,
+    logs: &[String],
+    drifts: &[Drift],
+    distinct_stamps: bool,
+    plan: &fusemap_core::config::Plan,
+    work: &Path,
+    json: bool,
+) -> Result<usize> {
     if !json {
         println!("{TABLE_HEADER}");
     }
     let mut failed = 0;
     for log in BENCH_LOGS.iter().filter(|b| logs.is_empty() || logs.iter().any(|l| l == b.name)) {
         let path = shared.join("datasets").join(log.path);
-        for &drift in &chosen {
-            let r = run_case(log, &path, drift, distinct_stamps, &plan, &work)
+        for &drift in drifts {
+            let r = run_case(log, &path, drift, distinct_stamps, plan, work)
                 .with_context(|| format!("{} with {} drift", log.name, drift.name()))?;
             failed += usize::from(!meets_bounds(&r));
             if json {
@@ -51,9 +71,5 @@ pub fn run(
             }
         }
     }
-    let _ = std::fs::remove_dir_all(&work);
-    if !json {
-        println!("\n{failed} case(s) outside the acceptance bounds");
-    }
-    Ok(())
+    Ok(failed)
 }

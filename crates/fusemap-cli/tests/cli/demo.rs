@@ -9,12 +9,13 @@ use crate::util::{
 };
 use fusemap_core::grid::Ternary;
 use fusemap_io::npz::{read_npz, NpyValues};
-use std::path::{Path, PathBuf};
+use fusemap_io::testdata::TestPath;
+use std::path::Path;
 use std::process::Output;
 
 /// Runs `fusemap demo --out <temp>/out` and returns the output directory and the run.
-fn demo(name: &str) -> (PathBuf, Output) {
-    let out = temp_dir(name).join("out");
+fn demo(name: &str) -> (TestPath, Output) {
+    let out = temp_dir(name).into_child("out");
     let o = run(&["demo", "--corridor", "--out", path_str(&out)]);
     assert_success(&o);
     (out, o)

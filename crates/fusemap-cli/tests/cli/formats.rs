@@ -33,7 +33,7 @@ fn make_fixtures() -> Option<PathBuf> {
         ));
         return None;
     }
-    let out = temp_dir("ros-fixtures").join("out");
+    let out = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), "ros-fixtures").join("out");
     let o = Command::new(&python)
         .arg(repo_root().join("tests/fixtures/make_ros_fixtures.py"))
         .arg(&carmen)

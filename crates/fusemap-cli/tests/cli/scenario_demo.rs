@@ -23,7 +23,8 @@ print(json.dumps({
 
 #[test]
 fn the_scenario_demo_writes_three_scored_maps_and_their_layers() {
-    let out = temp_dir("scenario-demo").join("out");
+    let dir = temp_dir("scenario-demo");
+    let out = dir.join("out");
     let o = run(&["demo", "--out", out.to_str().unwrap()]);
     assert_success(&o);
     for f in [

@@ -15,12 +15,10 @@ pub fn run(args: &[&str]) -> Output {
     fusemap().args(args).output().expect("cannot start fusemap")
 }
 
-/// A fresh, empty directory under the system temp dir, unique per test name and process.
-pub fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fusemap-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("cannot create temp dir");
-    d
+/// A fresh, empty directory for one test, removed when the value is dropped
+/// ([`fusemap_io::testdata::TestDir`]).
+pub fn temp_dir(name: &str) -> fusemap_io::testdata::TestDir {
+    fusemap_io::testdata::temp_dir(&format!("cli-{name}"))
 }
 
 /// stdout as text.

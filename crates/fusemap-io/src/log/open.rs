@@ -99,13 +99,10 @@ mod tests {
     use super::*;
 
     fn detect_bytes(name: &str, bytes: &[u8]) -> Result<LogFormat> {
-        let dir = std::env::temp_dir().join(format!("fusemap-detect-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::testdata::temp_dir("detect");
         let p = dir.join(name);
         std::fs::write(&p, bytes).unwrap();
-        let r = detect(&p);
-        std::fs::remove_file(&p).unwrap();
-        r
+        detect(&p)
     }
 
     #[test]

@@ -1,9 +1,8 @@
 use super::*;
 use fusemap_core::geometry::Point2;
 use fusemap_core::grid::{CellIndex, OccupancyParams};
-use std::path::PathBuf;
 
-fn temp_dir(tag: &str) -> PathBuf {
+fn temp_dir(tag: &str) -> crate::testdata::TestDir {
     crate::testdata::temp_dir(&format!("npz-{tag}"))
 }
 

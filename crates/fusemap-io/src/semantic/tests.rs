@@ -3,7 +3,7 @@ use crate::npz::{read_npz, write_map_npz_with, NpyValues, NpzLayers};
 use fusemap_core::geometry::Point2;
 use fusemap_core::grid::{CellIndex, OccupancyParams, Raster};
 
-fn temp_dir(tag: &str) -> PathBuf {
+fn temp_dir(tag: &str) -> crate::testdata::TestDir {
     crate::testdata::temp_dir(&format!("semantic-{tag}"))
 }
 

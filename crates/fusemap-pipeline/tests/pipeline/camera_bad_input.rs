@@ -18,7 +18,8 @@ fn short() -> SimRecording {
 }
 
 fn run(name: &str, rec: &SimRecording) -> Result<fusemap_pipeline::MapRun, PipelineError> {
-    let bag = fusemap_io::testdata::temp_dir(name).join("bag");
+    let dir = fusemap_io::testdata::temp_dir(name);
+    let bag = dir.join("bag");
     fusemap_io::simulation::write_bag(rec, &bag, true).unwrap();
     let inv = Inventory::read(&bag).unwrap();
     map_inventory(&production_line_plan().unwrap(), &inv, &mut |_| {})
@@ -146,7 +147,8 @@ fn a_late_camera_info_is_noted_and_used() {
 fn a_camera_on_the_usual_topics_is_found_and_can_be_switched_off() {
     use fusemap_core::config::{Config, SensorConfig, SensorKind};
     let rec = short();
-    let bag = fusemap_io::testdata::temp_dir("camera-auto").join("bag");
+    let dir = fusemap_io::testdata::temp_dir("camera-auto");
+    let bag = dir.join("bag");
     fusemap_io::simulation::write_bag(&rec, &bag, true).unwrap();
     let inv = Inventory::read(&bag).unwrap();
     let plan = Config::default().validate().unwrap();

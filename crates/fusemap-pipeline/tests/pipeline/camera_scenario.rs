@@ -42,7 +42,8 @@ fn fixture() -> &'static Fixture {
     static F: OnceLock<Fixture> = OnceLock::new();
     F.get_or_init(|| {
         let rec = simulate(&Scenario::default()).expect("the default scenario simulates");
-        let bag = fusemap_io::testdata::temp_dir("camera-scenario").join("bag");
+        let dir = fusemap_io::testdata::temp_dir("camera-scenario");
+        let bag = dir.join("bag");
         fusemap_io::simulation::write_bag(&rec, &bag, true).expect("the bag is written");
         let plan = production_line_plan().unwrap();
         let run = map(&bag, &plan, three_maps(&plan));
@@ -157,7 +158,8 @@ fn an_uncorrected_camera_clock_offset_misplaces_the_classes() {
     scenario.robot.corner_radius_m = 1.1;
     scenario.camera.time_offset_s = 0.05;
     let rec = simulate(&scenario).unwrap();
-    let bag = fusemap_io::testdata::temp_dir("camera-offset").join("bag");
+    let dir = fusemap_io::testdata::temp_dir("camera-offset");
+    let bag = dir.join("bag");
     fusemap_io::simulation::write_bag(&rec, &bag, true).unwrap();
     let accuracy = |offset: f64| {
         let mut plan = production_line_plan().unwrap();

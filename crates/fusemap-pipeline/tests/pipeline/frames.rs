@@ -7,6 +7,7 @@ use fusemap_io::log::ros2::writer::msgs::geometry_msgs::TransformStamped;
 use fusemap_io::log::ros2::writer::msgs::std_msgs::Header;
 use fusemap_io::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions};
 use fusemap_io::simulation::to_out_message;
+use fusemap_io::testdata::TestPath;
 use fusemap_pipeline::map_log;
 
 fn tf(stamp: fusemap_core::time::Stamp, parent: &str, child: &str, x: f64, y: f64, yaw: f64) -> OutMessage {
@@ -24,17 +25,16 @@ fn tf(stamp: fusemap_core::time::Stamp, parent: &str, child: &str, x: f64, y: f6
 /// Writes the 20 s production line with its odometry as TF only: `odom → BASE` from each
 /// odometry message, plus `map → odom` (10 m east, turned 90°) at 10 Hz when `localiser`,
 /// plus a static `base_footprint → base_link` when BASE is `/base_footprint`.
-fn bag_with_tf(tag: &str, base: &str, localiser: bool) -> std::path::PathBuf {
+fn bag_with_tf(tag: &str, base: &str, localiser: bool) -> TestPath {
     bag_with_tf_glitch(tag, base, localiser, None)
 }
 
 /// [`bag_with_tf`], with the `odom → BASE` sample number `glitch` a kilometre off.
-fn bag_with_tf_glitch(tag: &str, base: &str, localiser: bool, glitch: Option<usize>) -> std::path::PathBuf {
+fn bag_with_tf_glitch(tag: &str, base: &str, localiser: bool, glitch: Option<usize>) -> TestPath {
     let mut s = Scenario::default();
     s.robot.duration_s = 20.0;
     let rec = simulate(&s).unwrap();
-    let dir = fusemap_io::testdata::temp_dir(tag);
-    let bag = dir.join("bag");
+    let bag = fusemap_io::testdata::temp_dir(tag).into_child("bag");
     let mut w =
         Rosbag2Writer::create_with(&bag, Rosbag2WriterOptions { overwrite: true, ..Default::default() }).unwrap();
     let mut n_odom = 0;

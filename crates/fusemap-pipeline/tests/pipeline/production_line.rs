@@ -36,7 +36,7 @@ fn fixture() -> &'static Fixture {
     F.get_or_init(|| {
         let scenario = Scenario::default();
         let rec = simulate(&scenario).expect("the default scenario simulates");
-        let dir = fusemap_io::testdata::temp_dir("production-line");
+        let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), "production-line");
         let bag = dir.join("bag");
         fusemap_io::simulation::write_bag(&rec, &bag, true).expect("the bag is written");
         let inv = Inventory::read(&bag).expect("the bag reads back");

@@ -29,7 +29,7 @@ fn bag() -> &'static PathBuf {
             .collect();
         rec.messages.extend(copies);
         rec.messages.sort_by_key(|m| m.stamp());
-        let dir = fusemap_io::testdata::temp_dir("sensor-tables");
+        let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), "sensor-tables");
         let bag = dir.join("bag");
         fusemap_io::simulation::write_bag(&rec, &bag, true).expect("written");
         bag

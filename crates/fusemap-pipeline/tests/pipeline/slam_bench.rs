@@ -7,36 +7,20 @@
 use fusemap_core::config::Config;
 use fusemap_io::testdata::dataset;
 use fusemap_pipeline::slam_bench::{run_case, table_row, CaseResult, Drift, BENCH_LOGS, TABLE_HEADER};
-use std::path::PathBuf;
-
-/// A scratch directory for the rewritten logs, one per bench call (tests run in parallel),
-/// removed at the end.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Self {
-        static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-        let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let p = std::env::temp_dir().join(format!("fusemap-slam-bench-{name}-{}-{k}", std::process::id()));
-        std::fs::create_dir_all(&p).unwrap();
-        Self(p)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// Runs `logs` (names; all when empty) with `drift`, printing the table.
 fn bench(logs: &[&str], drift: Drift, distinct_stamps: bool) -> Option<Vec<CaseResult>> {
     let plan = Config::default().validate().unwrap();
-    let scratch = Scratch::new(&format!("{}{}", drift.name(), if distinct_stamps { "-distinct" } else { "" }));
+    // One directory per bench call (tests run in parallel), removed at the end.
+    let scratch = fusemap_io::testdata::temp_dir(&format!(
+        "slam-bench-{}{}",
+        drift.name(),
+        if distinct_stamps { "-distinct" } else { "" }
+    ));
     let mut out = Vec::new();
     for log in BENCH_LOGS.iter().filter(|l| logs.is_empty() || logs.contains(&l.name)) {
         let path = dataset(log.path)?;
-        let r = run_case(log, &path, drift, distinct_stamps, &plan, &scratch.0).unwrap();
+        let r = run_case(log, &path, drift, distinct_stamps, &plan, &scratch).unwrap();
         out.push(r);
     }
     eprintln!("{TABLE_HEADER}");

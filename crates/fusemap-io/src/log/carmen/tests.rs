@@ -518,8 +518,7 @@ fn truncated_gzip_file_is_a_format_error() {
         return;
     };
     let bytes = std::fs::read(src).unwrap();
-    let dir = std::env::temp_dir().join(format!("fusemap-carmen-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::testdata::temp_dir("carmen-truncated");
     let cut = dir.join("intel-truncated.log.gz");
     std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
     let mut r = CarmenReader::open(&cut, CarmenOptions::default()).unwrap();
@@ -531,7 +530,7 @@ fn truncated_gzip_file_is_a_format_error() {
             Err(e) => error = Some(e),
         }
     }
-    std::fs::remove_dir_all(&dir).unwrap();
+    drop(dir);
     let error = error.expect("a truncated stream must be an error").to_string();
     let lines = r.line_number();
     assert!(ok > 1000 && lines > 1000, "{ok} messages, {lines} lines");

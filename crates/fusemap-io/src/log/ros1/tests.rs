@@ -84,8 +84,7 @@ fn a_large_scan_decodes_exactly() {
 
 #[test]
 fn open_reads_a_file_and_names_it() {
-    let dir = std::env::temp_dir().join(format!("fusemap-ros1-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::testdata::temp_dir("ros1-open");
     let path = dir.join("standard.bag");
     std::fs::write(&path, bag(vec![(Compression::Bz2, standard_records())])).unwrap();
     let mut reader = BagReader::open(&path).unwrap();
@@ -527,8 +526,7 @@ fn other_benchmark_bags_match_their_provenance() {
 /// Everything `BagReader::open` yields for `bytes` written to a file: messages before
 /// the first error, and the error's text with the file named `test.bag`.
 fn read_file(name: &str, bytes: &[u8]) -> (Vec<LogMessage>, Option<String>) {
-    let dir = std::env::temp_dir().join(format!("fusemap-ros1-prefetch-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::testdata::temp_dir("ros1-prefetch");
     let path = dir.join(name);
     std::fs::write(&path, bytes).unwrap();
     let mut out = (Vec::new(), None);
