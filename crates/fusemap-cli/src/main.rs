@@ -1,10 +1,7 @@
 //! `fusemap`: multi-sensor occupancy-grid mapping.
 
 mod commands;
-mod export;
-mod output;
 mod progress;
-mod summary;
 
 use clap::{Parser, Subcommand};
 use fusemap_core::metrics::RelationMatching;
@@ -51,8 +48,8 @@ enum Command {
         log: Option<PathBuf>,
         /// Export this region densely (metres: x0,y0,x1,y1) instead of everything observed;
         /// also how to get a dense raster of part of a map past limits.export_cells.
-        #[arg(long, value_parser = export::parse_crop, allow_hyphen_values = true)]
-        crop: Option<export::Crop>,
+        #[arg(long, value_parser = fusemap_pipeline::outputs::parse_crop, allow_hyphen_values = true)]
+        crop: Option<fusemap_pipeline::outputs::Crop>,
     },
     /// Check a log's timing: rates, jitter, delays, stamps going backwards, gaps, and how
     /// many scans get a pose.

@@ -5,8 +5,8 @@
 //! built (odometry, TF, poses on CARMEN scan lines, or the estimator fusing odometry, IMU,
 //! GNSS and absolute poses), every lidar mapped through the engine, and a report of what
 //! happened. One call, [`map_log`], runs a whole mapping pass in memory: the `fusemap` CLI,
-//! a Python binding or a calibration search all use it the same way. Writing outputs is
-//! left to the caller.
+//! a Python binding or a calibration search all use it the same way. [`outputs`] writes a
+//! finished run's files, the same for every command.
 //!
 //! | concept | module |
 //! |---|---|
@@ -18,6 +18,7 @@
 //! | sensor mounts from TF or config | [`extrinsics`] |
 //! | the mapping pass | [`run`] |
 //! | the run report | [`report`] |
+//! | the output files and `summary.json` | [`outputs`] |
 //! | the log doctor's figures | [`doctor`] |
 //! | GNSS quality over time, odometry against the gyro | [`pose_sensors_report`] |
 
@@ -32,6 +33,7 @@ mod insert;
 mod lidar_frames;
 mod map_pass;
 pub mod merge;
+pub mod outputs;
 pub mod pose_sensors_report;
 pub mod progress;
 pub mod recording;

@@ -5,8 +5,6 @@
 //! document's §3.3 corridor instead.
 
 use crate::commands::world::run_simulated;
-use crate::export::ExportOptions;
-use crate::output::{self, finish, layers_of, OutputFiles};
 use crate::progress;
 use anyhow::{Context, Result};
 use fusemap_core::config::{Config, Plan};
@@ -15,6 +13,7 @@ use fusemap_core::grid::{CellBox, CellIndex, Raster};
 use fusemap_core::sim::production::{simulate, Scenario};
 use fusemap_core::sim::{ScannerSpec, SimulatedRun};
 use fusemap_io::comparison::{write_comparison_png, Panel};
+use fusemap_pipeline::outputs::{self, finish, layers_of, ExportOptions, OutputFiles, RunRecord};
 use fusemap_pipeline::recording::Inventory;
 use fusemap_pipeline::scenario::{production_line_plan, score, three_maps, MapScore, Truth};
 use std::path::{Path, PathBuf};
@@ -42,7 +41,7 @@ pub fn corridor(out: &Path, config: Option<&Path>) -> Result<()> {
         "built-in corridor (design document §3.3)",
         &inputs,
     )?;
-    summary.print();
+    print!("{summary}");
     println!("outputs       {}", out.display());
     Ok(())
 }
@@ -52,7 +51,7 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     let started = Instant::now();
     let plan = plan_of(config, || Ok(production_line_plan()?))?;
     let inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
-    let mut files = output::prepare(out, &inputs)?;
+    let mut files = outputs::prepare(out, &inputs)?;
     let rec = simulate(&Scenario::default()).map_err(|e| anyhow::anyhow!("scenario: {e}"))?;
     // Everything the demo writes — the simulated bag it reads back, the three maps, the
     // comparison — is staged in the one output set and moves into `out` at its commit.
@@ -92,19 +91,18 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
         write_map_files(&files.staged(m.name()), &run.engine, m)?;
     }
     write_comparison(&files.staged("comparison.png"), &run.engine, &scores, &truth_occupancy, &plan)?;
-    let summary = finish(
-        &run.engine,
-        files,
-        &ExportOptions { crop: None, export_cells: plan.limits.export_cells },
-        "rosbag2 (simulated production line)",
-        &source,
+    let record = RunRecord {
+        source_kind: "rosbag2 (simulated production line)",
+        source: &source,
         started,
-        run.notes.clone(),
-        Some(log),
-        Some(&run.trajectory),
-    )?;
+        notes: run.notes.clone(),
+        log: Some(log),
+        trajectory: Some(&run.trajectory),
+    };
+    let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
+    let summary = finish(&run.engine, files, &export, record)?;
     let picture = out.join("comparison.png");
-    summary.print();
+    print!("{summary}");
     print_scores(&scores, &plan);
     println!("comparison    {}", picture.display());
     let others: Vec<String> = run

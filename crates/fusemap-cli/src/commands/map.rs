@@ -1,12 +1,10 @@
 //! `fusemap map`: a robot log or a world file mapped, its outputs written.
 
 use crate::commands::world::run_simulated;
-use crate::export::{Crop, ExportOptions};
-use crate::output::{self, finish};
 use crate::progress;
-use crate::summary::Summary;
 use anyhow::{bail, Result};
 use fusemap_core::config::Plan;
+use fusemap_pipeline::outputs::{self, finish, Crop, ExportOptions, RunRecord, Summary};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -22,7 +20,7 @@ pub fn map(
     let plan = super::plan_of(config)?;
     let export = ExportOptions { crop, export_cells: plan.limits.export_cells };
     if let Some(c) = &crop {
-        crate::export::crop_area(&plan.geometry, c, export.export_cells)?;
+        outputs::crop_area(&plan.geometry, c, export.export_cells)?;
     }
     let mut inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
     let summary = match (world, log) {
@@ -40,7 +38,7 @@ pub fn map(
             bail!("nothing to map: give a LOG (CARMEN, ROS 1 bag, MCAP, rosbag2 directory) or --world FILE")
         }
     };
-    summary.print();
+    print!("{summary}");
     println!("outputs       {}", out.display());
     // A run that observed no cell wrote only its summary: that is a failure a script must
     // see, with the reason.
@@ -58,7 +56,7 @@ pub fn map(
 /// Maps a robot log through the pipeline and writes the outputs.
 fn run_log(plan: &Plan, export: &ExportOptions, path: &Path, out: &Path, inputs: &[PathBuf]) -> Result<Summary> {
     let started = Instant::now();
-    let files = output::prepare(out, inputs)?;
+    let files = outputs::prepare(out, inputs)?;
     // fusemap-io errors already name the file (and the line or message): no context.
     // The engine's refusals (a map past limits.map_cells) and the pipeline's (a log with
     // no scans, a lidar topic the log lacks) do not know the file: named here.
@@ -68,15 +66,13 @@ fn run_log(plan: &Plan, export: &ExportOptions, path: &Path, out: &Path, inputs:
         other => other.into(),
     })?;
     let value = serde_json::to_value(&run.report)?;
-    finish(
-        &run.engine,
-        files,
-        export,
-        &run.format.to_string(),
-        &path.display().to_string(),
+    let record = RunRecord {
+        source_kind: &run.format.to_string(),
+        source: &path.display().to_string(),
         started,
-        run.notes,
-        Some(value),
-        Some(&run.trajectory),
-    )
+        notes: run.notes,
+        log: Some(value),
+        trajectory: Some(&run.trajectory),
+    };
+    Ok(finish(&run.engine, files, export, record)?)
 }

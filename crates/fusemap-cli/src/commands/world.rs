@@ -2,14 +2,12 @@
 //! the mapping is the pipeline's ([`fusemap_pipeline::world::map_world`]); this writes its
 //! outputs.
 
-use crate::export::ExportOptions;
-use crate::output::{self, finish};
 use crate::progress;
-use crate::summary::Summary;
 use anyhow::Result;
 use fusemap_core::config::Plan;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::sim::{ScannerSpec, World};
+use fusemap_pipeline::outputs::{self, finish, ExportOptions, RunRecord, Summary};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -27,8 +25,9 @@ pub fn run_simulated(
     inputs: &[PathBuf],
 ) -> Result<Summary> {
     let started = Instant::now();
-    let files = output::prepare(out, inputs)?;
+    let files = outputs::prepare(out, inputs)?;
     let run = fusemap_pipeline::world::map_world(plan, world, scanner, &poses, &mut progress::reporter())
         .map_err(|e| anyhow::anyhow!("{source}: {e}"))?;
-    finish(&run.engine, files, export, "world", source, started, run.notes, None, None)
+    let record = RunRecord { source_kind: "world", source, started, notes: run.notes, log: None, trajectory: None };
+    Ok(finish(&run.engine, files, export, record)?)
 }

@@ -3,7 +3,7 @@
 //! overview picture, so a map that is large only because it spans two distant places is
 //! still written instead of failing after it was built.
 
-use anyhow::{bail, Result};
+use super::OutputError;
 use fusemap_core::geometry::Point2;
 use fusemap_core::grid::{CellBox, ExtraLayers, GridGeometry, LayeredGrid, Raster, SparseTiles};
 
@@ -76,14 +76,17 @@ fn cells(b: CellBox) -> u128 {
 
 /// The cells of `crop` on `geometry`, refused past `limit` cells (`[limits] export_cells`)
 /// or outside the grid's index range. Checked before a run as well as at its end.
-pub fn crop_area(geometry: &GridGeometry, c: &Crop, limit: u64) -> Result<CellBox> {
+pub fn crop_area(geometry: &GridGeometry, c: &Crop, limit: u64) -> Result<CellBox, OutputError> {
     let (Some(min), Some(max)) = (geometry.cell_of(c.min), geometry.cell_of(c.max)) else {
-        bail!("--crop {},{},{},{}: beyond the grid's index range", c.min.x, c.min.y, c.max.x, c.max.y);
+        return Err(OutputError::Crop(format!(
+            "--crop {},{},{},{}: beyond the grid's index range",
+            c.min.x, c.min.y, c.max.x, c.max.y
+        )));
     };
     let area = CellBox { min, max };
     let n = cells(area);
     if n > limit as u128 {
-        bail!(
+        return Err(OutputError::Crop(format!(
             "--crop {},{},{},{} is {} x {} = {n} cells at {} m, over limits.export_cells = {limit}; \
              crop a smaller region or raise limits.export_cells",
             c.min.x,
@@ -93,7 +96,7 @@ pub fn crop_area(geometry: &GridGeometry, c: &Crop, limit: u64) -> Result<CellBo
             area.width(),
             area.height(),
             geometry.resolution()
-        );
+        )));
     }
     Ok(area)
 }
@@ -104,7 +107,7 @@ pub fn view_of<L: ExtraLayers>(
     grid: &LayeredGrid<L>,
     options: &ExportOptions,
     notes: &mut Vec<String>,
-) -> Result<MapView> {
+) -> Result<MapView, OutputError> {
     let limit = options.export_cells;
     if let Some(c) = options.crop {
         let area = crop_area(grid.geometry(), &c, limit)?;

@@ -5,6 +5,7 @@ use fusemap_core::metrics::EntropyReport;
 use fusemap_core::sensor::ReturnCounts;
 use fusemap_io::text::printable;
 use serde::Serialize;
+use std::fmt;
 
 /// The summary of one mapping run.
 #[derive(Debug, Serialize)]
@@ -94,16 +95,17 @@ impl MapInfo {
     }
 }
 
-impl Summary {
-    /// Prints the summary for a person.
-    pub fn print(&self) {
-        println!("source        {} ({})", printable(&self.source), self.source_kind);
-        println!("scans         {}", self.scans);
+/// The summary for a person, one figure a line.
+impl fmt::Display for Summary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "source        {} ({})", printable(&self.source), self.source_kind)?;
+        writeln!(f, "scans         {}", self.scans)?;
         if self.camera_frames > 0 {
-            println!("camera frames {}", self.camera_frames);
+            writeln!(f, "camera frames {}", self.camera_frames)?;
         }
         let r = &self.returns;
-        println!(
+        writeln!(
+            f,
             "beams         {} (valid {}, no return {}, invalid {}: nan {}, inf {}, zero {}, negative {}, below min {})",
             self.beams,
             r.valid,
@@ -114,19 +116,21 @@ impl Summary {
             r.zero,
             r.negative,
             r.below_min
-        );
-        println!(
+        )?;
+        writeln!(
+            f,
             "cells updated {} (occupied {}, free {}); {} cell visits by {} rays",
             self.cells_updated.total,
             self.cells_updated.occupied,
             self.cells_updated.free,
             self.cell_visits,
             self.rays_walked
-        );
+        )?;
         if self.rays_rejected > 0 {
-            println!("rays refused  {}", self.rays_rejected);
+            writeln!(f, "rays refused  {}", self.rays_rejected)?;
         }
-        println!(
+        writeln!(
+            f,
             "map           {} x {} cells at {} m, origin ({:.3}, {:.3}), {} tiles",
             self.map.width,
             self.map.height,
@@ -134,17 +138,18 @@ impl Summary {
             self.map.origin[0],
             self.map.origin[1],
             self.map.tiles
-        );
+        )?;
         if let Some(e) = &self.entropy {
-            println!(
+            writeln!(
+                f,
                 "entropy       {:.4} nats mean over the known box; {:.1} % of its cells known",
                 e.mean_entropy_nats,
                 100.0 * e.known_share
-            );
+            )?;
         }
         for n in &self.notes {
-            println!("note          {}", printable(n));
+            writeln!(f, "note          {}", printable(n))?;
         }
-        println!("wall time     {:.3} s", self.wall_time_s);
+        writeln!(f, "wall time     {:.3} s", self.wall_time_s)
     }
 }

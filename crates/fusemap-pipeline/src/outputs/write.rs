@@ -1,12 +1,12 @@
-//! Writing a run's outputs: `map.npz`, `map.pgm` + `map.yaml`, `map.png`, `summary.json`.
-//! They are one set ([`OutputSet`]): written into a staging directory inside the output
-//! directory while the run holds its lock, moved into place together when all are
-//! written, `summary.json` last with each file's size and SHA-256. A failing run leaves
-//! the previous set as it was; no output is ever written over an input.
+//! Writing a run's outputs: `map.npz`, `map.pgm` + `map.yaml`, `map.png`, the camera
+//! layers, `slam.png`, `trajectory.tum` and `summary.json`, as one set ([`Outputs`]):
+//! `summary.json` goes last with each file's size and SHA-256. A failing run leaves the
+//! previous set as it was; no output is ever written over an input.
 
-use crate::export::{view_of, ExportOptions, MapView};
-use crate::summary::{CellsUpdated, MapInfo, Summary};
-use anyhow::{Context, Result};
+use super::set::{OutputFiles, Outputs};
+use super::summary::{CellsUpdated, MapInfo, Summary};
+use super::view::{view_of, ExportOptions, MapView};
+use super::OutputError;
 use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::{Point2, Pose2};
@@ -15,120 +15,24 @@ use fusemap_core::measurement::{SensorId, SensorKind};
 use fusemap_core::metrics::{map_entropy, sparse_entropy};
 use fusemap_core::sensor::ReturnCounts;
 use fusemap_core::time::Stamp;
-use fusemap_io::atomic::ensure_not_input;
 use fusemap_io::npz::NpzLayers;
-use fusemap_io::output_set::OutputSet;
 use fusemap_io::semantic::{ClassInfo, SemanticRaster};
-use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// The files of a run, in `dir`.
-pub struct OutputFiles {
-    /// `map.npz`.
-    pub npz: PathBuf,
-    /// `map.yaml` (its `map.pgm` beside it).
-    pub yaml: PathBuf,
-    /// `map.pgm`.
-    pub pgm: PathBuf,
-    /// `map.png`.
-    pub png: PathBuf,
-    /// `summary.json`.
-    pub summary: PathBuf,
-    /// `trajectory.tum`.
-    pub trajectory: PathBuf,
-    /// `semantic.yaml` (its `semantic.png` beside it), for a run with a camera.
-    pub semantic: PathBuf,
-    /// `semantic.png`.
-    pub semantic_png: PathBuf,
-    /// `dynamic.png`, for a run with a camera.
-    pub dynamic: PathBuf,
-    /// `slam.png`: the optimised trajectory and its loop closures over the map, for a run
-    /// SLAM corrected.
-    pub slam: PathBuf,
-}
-
-impl OutputFiles {
-    /// The output paths in `dir`.
-    pub fn in_dir(dir: &Path) -> Self {
-        Self {
-            npz: dir.join("map.npz"),
-            yaml: dir.join("map.yaml"),
-            pgm: dir.join("map.pgm"),
-            png: dir.join("map.png"),
-            summary: dir.join("summary.json"),
-            trajectory: dir.join("trajectory.tum"),
-            semantic: dir.join("semantic.yaml"),
-            semantic_png: dir.join("semantic.png"),
-            dynamic: dir.join("dynamic.png"),
-            slam: dir.join("slam.png"),
-        }
-    }
-
-    /// The file names of a run's set, for removing an earlier run's files this run does
-    /// not write.
-    pub const NAMES: [&'static str; 10] = [
-        "map.npz",
-        "map.yaml",
-        "map.pgm",
-        "map.png",
-        "summary.json",
-        "trajectory.tum",
-        "semantic.yaml",
-        "semantic.png",
-        "dynamic.png",
-        "slam.png",
-    ];
-
-    fn all(&self) -> [&PathBuf; 10] {
-        [
-            &self.npz,
-            &self.yaml,
-            &self.pgm,
-            &self.png,
-            &self.summary,
-            &self.trajectory,
-            &self.semantic,
-            &self.semantic_png,
-            &self.dynamic,
-            &self.slam,
-        ]
-    }
-}
-
-/// A run's outputs: the paths its writers use (inside the set's staging directory) and
-/// the set that moves them into the output directory at the end.
-pub struct Outputs {
-    /// Where each file is written until the commit.
-    pub files: OutputFiles,
-    set: OutputSet,
-    /// Subdirectories the set owns (`lidar/`), see [`Outputs::own_dir`].
-    owned: Vec<String>,
-}
-
-impl Outputs {
-    /// Declares the subdirectory `name` of the output directory the set's own: at the
-    /// commit, files under it that this run did not write are removed with the other
-    /// stale files.
-    pub fn own_dir(&mut self, name: &str) {
-        self.owned.push(format!("{name}/"));
-    }
-
-    /// Where a writer puts `name` (which may hold a subdirectory, `lidar/map.npz`) so that
-    /// it moves into the output directory with the rest of the set.
-    pub fn staged(&self, name: &str) -> PathBuf {
-        self.set.staged(name)
-    }
-}
-
-/// Checks that no output would overwrite one of `inputs`, creates `dir`, takes its lock
-/// (a second run into it is refused while this one lives) and opens the set.
-pub fn prepare(dir: &Path, inputs: &[PathBuf]) -> Result<Outputs> {
-    for f in OutputFiles::in_dir(dir).all() {
-        ensure_not_input(f, inputs)?;
-    }
-    let set =
-        OutputSet::begin(dir).with_context(|| format!("cannot write into the output directory {}", dir.display()))?;
-    Ok(Outputs { files: OutputFiles::in_dir(set.staging()), set, owned: Vec::new() })
+/// What a run mapped and what it has to say, for the summary beside the map.
+pub struct RunRecord<'a> {
+    /// What was mapped: `world` (simulated) or the log's format.
+    pub source_kind: &'a str,
+    /// The input, as the summary names it.
+    pub source: &'a str,
+    /// When the run began (the summary's wall time counts from here).
+    pub started: Instant,
+    /// Facts about the input a user should know.
+    pub notes: Vec<String>,
+    /// The log run's report (absent for a simulated world).
+    pub log: Option<serde_json::Value>,
+    /// The base's trajectory, written as `trajectory.tum` when there is one.
+    pub trajectory: Option<&'a [(Stamp, Pose2)]>,
 }
 
 /// The semantic and dynamic layers of a run with a camera, over the occupancy raster's
@@ -184,7 +88,7 @@ pub fn write(
     layers: Option<&Layers>,
     summary: &mut Summary,
     trajectory: Option<&[(Stamp, Pose2)]>,
-) -> Result<()> {
+) -> Result<(), OutputError> {
     let Outputs { files, set, owned } = outputs;
     if let Some(t) = trajectory {
         fusemap_io::trajectory::write_tum(&files.trajectory, t)?;
@@ -265,18 +169,13 @@ fn pose_graph_of(log: &serde_json::Value) -> Option<GraphPicture> {
 
 /// Builds the summary of a finished engine and writes every output: the view of the map
 /// `export` asks for (see [`view_of`]).
-#[allow(clippy::too_many_arguments)]
 pub fn finish(
     engine: &Engine,
     outputs: Outputs,
     export: &ExportOptions,
-    source_kind: &str,
-    source: &str,
-    started: Instant,
-    mut notes: Vec<String>,
-    log: Option<serde_json::Value>,
-    trajectory: Option<&[(Stamp, Pose2)]>,
-) -> Result<Summary> {
+    record: RunRecord<'_>,
+) -> Result<Summary, OutputError> {
+    let RunRecord { source_kind, source, started, mut notes, log, trajectory } = record;
     let grid = engine.grid();
     let view = view_of(grid, export, &mut notes)?;
     let raster = match &view {
@@ -342,4 +241,45 @@ pub fn finish(
     write(outputs, &view, layers.as_ref(), &mut summary, trajectory)?;
     summary.wall_time_s = started.elapsed().as_secs_f64();
     Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::outputs::prepare;
+    use fusemap_core::config::Config;
+    use fusemap_core::sim::{corridor, ScannerSpec};
+
+    /// The library alone, without the CLI: the document's corridor mapped and written, and
+    /// the summary lists exactly the files on disk, each with its size.
+    #[test]
+    fn a_finished_world_run_is_written_as_one_listed_set() {
+        let plan = Config::default().validate().unwrap();
+        let poses: Vec<Pose2> = (0..40).map(|i| Pose2::new(0.1 * f64::from(i), 0.0, 0.0)).collect();
+        let run = crate::world::map_world(&plan, &corridor(), &ScannerSpec::document(), &poses, &mut |_| {}).unwrap();
+        let dir = fusemap_io::testdata::temp_dir("outputs-world");
+        let out = dir.join("out");
+        let outputs = prepare(&out, &[]).unwrap();
+        let record = RunRecord {
+            source_kind: "world",
+            source: "corridor",
+            started: Instant::now(),
+            notes: run.notes,
+            log: None,
+            trajectory: None,
+        };
+        let summary = finish(&run.engine, outputs, &ExportOptions::default(), record).unwrap();
+        assert_eq!((summary.scans, summary.source_kind.as_str()), (40, "world"));
+        assert!(summary.entropy.is_some());
+        let mut listed: Vec<&str> = summary.files.iter().map(|f| f.name.as_str()).collect();
+        listed.sort_unstable();
+        assert_eq!(listed, ["map.npz", "map.pgm", "map.png", "map.yaml"]);
+        for f in &summary.files {
+            assert_eq!(std::fs::metadata(out.join(&f.name)).unwrap().len(), f.bytes, "{}", f.name);
+        }
+        let written: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+        assert_eq!(written["scans"], 40);
+        assert!(summary.to_string().starts_with("source        corridor (world)\nscans         40\n"));
+    }
 }
