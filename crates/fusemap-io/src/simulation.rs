@@ -8,10 +8,12 @@
 //! [`fusemap_core::sim::production::Scenario`]; unknown keys are errors naming their line.
 
 use crate::config_file::{field_error, read_text, toml_error};
-use crate::log::ros2::writer::msgs::geometry_msgs::{PoseWithCovariance, TransformStamped, TwistWithCovariance};
-use crate::log::ros2::writer::msgs::nav_msgs::Odometry;
-use crate::log::ros2::writer::msgs::sensor_msgs::{CameraInfo, Image, Imu, LaserScan, NavSatFix, NavSatStatus};
-use crate::log::ros2::writer::msgs::std_msgs::Header;
+use crate::log::ros2::msgs::geometry_msgs::{
+    Pose, PoseWithCovariance, Transform, TransformStamped, Twist, TwistWithCovariance,
+};
+use crate::log::ros2::msgs::nav_msgs::Odometry;
+use crate::log::ros2::msgs::sensor_msgs::{CameraInfo, Image, Imu, LaserScan, NavSatFix, NavSatStatus};
+use crate::log::ros2::msgs::std_msgs::Header;
 use crate::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions, WrittenBag};
 use crate::Result;
 use fusemap_core::grid::logodds::logit;
@@ -52,19 +54,21 @@ pub fn to_out_message(m: &SimMessage) -> OutMessage {
             header: header(o.stamp, &o.frame_id),
             child_frame_id: o.child_frame_id.clone(),
             pose: PoseWithCovariance {
-                position: o.position,
-                orientation: o.orientation,
+                pose: Pose { position: o.position.into(), orientation: o.orientation.into() },
                 covariance: o.pose_covariance,
             },
-            twist: TwistWithCovariance { linear: o.linear, angular: o.angular, covariance: o.twist_covariance },
+            twist: TwistWithCovariance {
+                twist: Twist { linear: o.linear.into(), angular: o.angular.into() },
+                covariance: o.twist_covariance,
+            },
         }),
         SimMessage::Imu(i) => OutMessage::Imu(Imu {
             header: header(i.stamp, &i.frame_id),
-            orientation: i.orientation,
+            orientation: i.orientation.into(),
             orientation_covariance: i.orientation_covariance,
-            angular_velocity: i.angular_velocity,
+            angular_velocity: i.angular_velocity.into(),
             angular_velocity_covariance: i.angular_velocity_covariance,
-            linear_acceleration: i.linear_acceleration,
+            linear_acceleration: i.linear_acceleration.into(),
             linear_acceleration_covariance: i.linear_acceleration_covariance,
         }),
         SimMessage::Fix(f) => OutMessage::NavSatFix(NavSatFix {
@@ -84,7 +88,7 @@ pub fn to_out_message(m: &SimMessage) -> OutMessage {
             encoding: i.encoding.clone(),
             is_bigendian: i.is_bigendian,
             step: i.step,
-            data: i.data.clone(),
+            data: i.data.clone().into(),
         }),
         SimMessage::CameraInfo(c) => OutMessage::CameraInfo(CameraInfo {
             header: header(c.stamp, &c.frame_id),
@@ -104,8 +108,7 @@ fn transform(t: &fusemap_core::sim::production::SimStaticTransform) -> Transform
     TransformStamped {
         header: Header { stamp: t.stamp, frame_id: t.frame_id.clone() },
         child_frame_id: t.child_frame_id.clone(),
-        translation: t.translation,
-        rotation: t.rotation,
+        transform: Transform { translation: t.translation.into(), rotation: t.rotation.into() },
     }
 }
 

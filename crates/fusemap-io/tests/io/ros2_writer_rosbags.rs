@@ -9,14 +9,15 @@
 //! is skipped, or fails under `FUSEMAP_NO_SKIP=1`.
 
 use fusemap_core::time::Stamp;
-use fusemap_io::log::ros2::writer::msgs::geometry_msgs::{
-    PoseWithCovariance, PoseWithCovarianceStamped, TransformStamped, TwistWithCovariance,
+use fusemap_io::log::ros2::msgs::geometry_msgs::{
+    Pose, PoseWithCovariance, PoseWithCovarianceStamped, Quaternion, Transform, TransformStamped, Twist,
+    TwistWithCovariance, Vector3,
 };
-use fusemap_io::log::ros2::writer::msgs::nav_msgs::Odometry;
-use fusemap_io::log::ros2::writer::msgs::sensor_msgs::{
+use fusemap_io::log::ros2::msgs::nav_msgs::Odometry;
+use fusemap_io::log::ros2::msgs::sensor_msgs::{
     CameraInfo, Image, Imu, LaserScan, NavSatFix, NavSatStatus, RegionOfInterest,
 };
-use fusemap_io::log::ros2::writer::msgs::std_msgs::Header;
+use fusemap_io::log::ros2::msgs::std_msgs::Header;
 use fusemap_io::log::ros2::writer::{ChunkCompression, OutMessage, Rosbag2Writer, Rosbag2WriterOptions};
 use fusemap_io::testdata;
 use serde_json::{json, Value};
@@ -48,16 +49,17 @@ fn header(h: &Header) -> Value {
     json!({ "stamp": time(h.stamp), "frame_id": h.frame_id })
 }
 
-fn vec3(v: &[f64; 3]) -> Value {
+fn vec3(v: [f64; 3]) -> Value {
     json!({ "x": fl(v[0]), "y": fl(v[1]), "z": fl(v[2]) })
 }
 
-fn quat(q: &[f64; 4]) -> Value {
-    json!({ "x": fl(q[0]), "y": fl(q[1]), "z": fl(q[2]), "w": fl(q[3]) })
+fn quat(q: &Quaternion) -> Value {
+    json!({ "x": fl(q.x), "y": fl(q.y), "z": fl(q.z), "w": fl(q.w) })
 }
 
 fn pose_cov(p: &PoseWithCovariance) -> Value {
-    json!({ "pose": { "position": vec3(&p.position), "orientation": quat(&p.orientation) }, "covariance": fls(&p.covariance) })
+    json!({ "pose": { "position": vec3(p.pose.position.to_array()), "orientation": quat(&p.pose.orientation) },
+            "covariance": fls(&p.covariance) })
 }
 
 /// The message as rosbags' dataclasses hold it, field for field.
@@ -72,14 +74,15 @@ fn expected(m: &OutMessage) -> Value {
         }),
         OutMessage::Odometry(o) => json!({
             "header": header(&o.header), "child_frame_id": o.child_frame_id, "pose": pose_cov(&o.pose),
-            "twist": { "twist": { "linear": vec3(&o.twist.linear), "angular": vec3(&o.twist.angular) },
+            "twist": { "twist": { "linear": vec3(o.twist.twist.linear.to_array()),
+                                  "angular": vec3(o.twist.twist.angular.to_array()) },
                        "covariance": fls(&o.twist.covariance) },
         }),
         OutMessage::Imu(i) => json!({
             "header": header(&i.header),
             "orientation": quat(&i.orientation), "orientation_covariance": fls(&i.orientation_covariance),
-            "angular_velocity": vec3(&i.angular_velocity), "angular_velocity_covariance": fls(&i.angular_velocity_covariance),
-            "linear_acceleration": vec3(&i.linear_acceleration),
+            "angular_velocity": vec3(i.angular_velocity.to_array()), "angular_velocity_covariance": fls(&i.angular_velocity_covariance),
+            "linear_acceleration": vec3(i.linear_acceleration.to_array()),
             "linear_acceleration_covariance": fls(&i.linear_acceleration_covariance),
         }),
         OutMessage::NavSatFix(f) => json!({
@@ -90,7 +93,7 @@ fn expected(m: &OutMessage) -> Value {
         OutMessage::PoseWithCovarianceStamped(p) => json!({ "header": header(&p.header), "pose": pose_cov(&p.pose) }),
         OutMessage::Tf { transforms, .. } => json!({ "transforms": transforms.iter().map(|t| json!({
             "header": header(&t.header), "child_frame_id": t.child_frame_id,
-            "transform": { "translation": vec3(&t.translation), "rotation": quat(&t.rotation) },
+            "transform": { "translation": vec3(t.transform.translation.to_array()), "rotation": quat(&t.transform.rotation) },
         })).collect::<Vec<_>>() }),
         OutMessage::Image(i) => json!({
             "header": header(&i.header), "height": i.height, "width": i.width, "encoding": i.encoding,
@@ -141,8 +144,7 @@ fn transform(stamp: i64, parent: &str, child: &str, x: f64) -> TransformStamped 
     TransformStamped {
         header: Header::new(Stamp(stamp), parent),
         child_frame_id: child.into(),
-        translation: [x, -0.25, 0.125],
-        rotation: [0.0, 0.0, 0.6, 0.8],
+        transform: Transform { translation: [x, -0.25, 0.125].into(), rotation: [0.0, 0.0, 0.6, 0.8].into() },
     }
 }
 
@@ -183,13 +185,14 @@ fn sample() -> Vec<(i64, &'static str, OutMessage)> {
                     header: h("odom", 11),
                     child_frame_id: "base_link".into(),
                     pose: PoseWithCovariance {
-                        position: [1.0 + k as f64, 2.0, 0.0],
-                        orientation: [0.0, 0.0, 0.6, 0.8],
+                        pose: Pose {
+                            position: [1.0 + k as f64, 2.0, 0.0].into(),
+                            orientation: [0.0, 0.0, 0.6, 0.8].into(),
+                        },
                         covariance: cov36,
                     },
                     twist: TwistWithCovariance {
-                        linear: [0.3, 0.0, 0.0],
-                        angular: [0.0, 0.0, -0.1],
+                        twist: Twist { linear: [0.3, 0.0, 0.0].into(), angular: [0.0, 0.0, -0.1].into() },
                         covariance: cov36,
                     },
                 }),
@@ -210,11 +213,11 @@ fn sample() -> Vec<(i64, &'static str, OutMessage)> {
                 "/imu",
                 OutMessage::Imu(Imu {
                     header: h("imu_link", 13),
-                    orientation: [0.0, 0.0, 0.0, 1.0],
+                    orientation: Quaternion::default(),
                     orientation_covariance: [-1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-                    angular_velocity: [0.01, -0.02, 0.5],
+                    angular_velocity: Vector3 { x: 0.01, y: -0.02, z: 0.5 },
                     angular_velocity_covariance: [0.001; 9],
-                    linear_acceleration: [0.1, 0.2, 9.80665],
+                    linear_acceleration: Vector3 { x: 0.1, y: 0.2, z: 9.80665 },
                     linear_acceleration_covariance: [0.01; 9],
                 }),
             ),
@@ -240,8 +243,7 @@ fn sample() -> Vec<(i64, &'static str, OutMessage)> {
                 OutMessage::PoseWithCovarianceStamped(PoseWithCovarianceStamped {
                     header: h("map", 19),
                     pose: PoseWithCovariance {
-                        position: [-4.5, 3.25, 0.0],
-                        orientation: [0.0, 0.0, -0.6, 0.8],
+                        pose: Pose { position: [-4.5, 3.25, 0.0].into(), orientation: [0.0, 0.0, -0.6, 0.8].into() },
                         covariance: cov36,
                     },
                 }),
@@ -256,7 +258,7 @@ fn sample() -> Vec<(i64, &'static str, OutMessage)> {
                     encoding: "rgb8".into(),
                     is_bigendian: 0,
                     step: 9,
-                    data: (0..18).map(|i| (i * 13 + k) as u8).collect(),
+                    data: (0..18).map(|i| (i * 13 + k) as u8).collect::<Vec<u8>>().into(),
                 }),
             ),
             (

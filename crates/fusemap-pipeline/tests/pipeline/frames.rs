@@ -3,8 +3,8 @@
 
 use fusemap_core::config::{Config, PoseSource};
 use fusemap_core::sim::production::{simulate, Scenario, SimMessage};
-use fusemap_io::log::ros2::writer::msgs::geometry_msgs::TransformStamped;
-use fusemap_io::log::ros2::writer::msgs::std_msgs::Header;
+use fusemap_io::log::ros2::msgs::geometry_msgs::{Transform, TransformStamped};
+use fusemap_io::log::ros2::msgs::std_msgs::Header;
 use fusemap_io::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions};
 use fusemap_io::simulation::to_out_message;
 use fusemap_io::testdata::TestPath;
@@ -16,8 +16,10 @@ fn tf(stamp: fusemap_core::time::Stamp, parent: &str, child: &str, x: f64, y: f6
         transforms: vec![TransformStamped {
             header: Header { stamp, frame_id: parent.into() },
             child_frame_id: child.into(),
-            translation: [x, y, 0.0],
-            rotation: [0.0, 0.0, (yaw / 2.0).sin(), (yaw / 2.0).cos()],
+            transform: Transform {
+                translation: [x, y, 0.0].into(),
+                rotation: [0.0, 0.0, (yaw / 2.0).sin(), (yaw / 2.0).cos()].into(),
+            },
         }],
     }
 }

@@ -65,7 +65,7 @@ fn scans_of_two_frames_on_one_topic_are_each_placed_from_their_own_mount() {
                     if relabel && t.child_frame_id == s.frames.laser {
                         let mut flipped = transforms[0].clone();
                         flipped.child_frame_id = "laser_flipped".into();
-                        flipped.rotation = turned(flipped.rotation);
+                        flipped.transform.rotation = turned(flipped.transform.rotation.to_array()).into();
                         transforms.push(flipped);
                     }
                 }

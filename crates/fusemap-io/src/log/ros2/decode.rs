@@ -106,7 +106,7 @@ pub fn decode_known_with(
                 frame_id: m.header.frame_id,
                 receive_stamp,
                 scan: LaserScan {
-                    stamp: m.header.stamp.to_stamp(),
+                    stamp: m.header.stamp,
                     angle_min: f64::from(m.angle_min),
                     angle_increment: f64::from(m.angle_increment),
                     ranges: m.ranges,
@@ -127,7 +127,7 @@ pub fn decode_known_with(
             let t = m.twist.twist;
             LogMessage::Odometry(OdomMessage {
                 topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
+                stamp: m.header.stamp,
                 receive_stamp,
                 frame_id: m.header.frame_id,
                 child_frame_id: m.child_frame_id,
@@ -147,7 +147,7 @@ pub fn decode_known_with(
                     .transforms
                     .into_iter()
                     .map(|t| Transform {
-                        stamp: t.header.stamp.to_stamp(),
+                        stamp: t.header.stamp,
                         parent: t.header.frame_id,
                         child: t.child_frame_id,
                         translation: t.transform.translation.to_array(),
@@ -160,7 +160,7 @@ pub fn decode_known_with(
             let m: sensor_msgs::Imu = decode_cdr(payload)?;
             LogMessage::Imu(ImuMessage {
                 topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
+                stamp: m.header.stamp,
                 receive_stamp,
                 frame_id: m.header.frame_id,
                 orientation: m.orientation.to_array(),
@@ -175,7 +175,7 @@ pub fn decode_known_with(
             let m: sensor_msgs::NavSatFix = decode_cdr(payload)?;
             LogMessage::Gnss(GnssMessage {
                 topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
+                stamp: m.header.stamp,
                 receive_stamp,
                 frame_id: m.header.frame_id,
                 status: m.status.status,
@@ -192,7 +192,7 @@ pub fn decode_known_with(
             let p = m.pose.pose;
             LogMessage::Pose(PoseMessage {
                 topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
+                stamp: m.header.stamp,
                 receive_stamp,
                 frame_id: m.header.frame_id,
                 position: [p.position.x, p.position.y, p.position.z],
@@ -202,7 +202,7 @@ pub fn decode_known_with(
         }
         KnownType::Image => {
             let m = sensor_msgs::Image::from_payload(payload)?;
-            let stamp = m.header.stamp.to_stamp();
+            let stamp = m.header.stamp;
             let is_bigendian = m.is_bigendian != 0;
             if pixels {
                 LogMessage::Image(ImageMessage {
@@ -236,7 +236,7 @@ pub fn decode_known_with(
             let m: sensor_msgs::CameraInfo = decode_cdr(payload)?;
             LogMessage::CameraInfo(CameraInfoMessage {
                 topic: topic.to_owned(),
-                stamp: m.header.stamp.to_stamp(),
+                stamp: m.header.stamp,
                 receive_stamp,
                 frame_id: m.header.frame_id,
                 width: m.width,

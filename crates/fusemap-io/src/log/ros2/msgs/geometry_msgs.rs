@@ -1,7 +1,60 @@
 //! `geometry_msgs`: points, rotations, poses, velocities and frame transforms.
 
-use super::std_msgs::Header;
+use super::std_msgs::{Header, HEADER};
 use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
+use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
+use crate::log::ros2::writer::definition::MsgDef;
+
+/// `geometry_msgs/Point`.
+pub static POINT: MsgDef = MsgDef { name: "geometry_msgs/Point", text: "float64 x\nfloat64 y\nfloat64 z\n", deps: &[] };
+/// `geometry_msgs/Vector3`.
+pub static VECTOR3: MsgDef =
+    MsgDef { name: "geometry_msgs/Vector3", text: "float64 x\nfloat64 y\nfloat64 z\n", deps: &[] };
+/// `geometry_msgs/Quaternion`.
+pub static QUATERNION: MsgDef =
+    MsgDef { name: "geometry_msgs/Quaternion", text: "float64 x\nfloat64 y\nfloat64 z\nfloat64 w\n", deps: &[] };
+/// `geometry_msgs/Pose`.
+pub static POSE: MsgDef = MsgDef {
+    name: "geometry_msgs/Pose",
+    text: "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n",
+    deps: &[&POINT, &QUATERNION],
+};
+/// `geometry_msgs/PoseWithCovariance`.
+pub static POSE_WITH_COVARIANCE: MsgDef = MsgDef {
+    name: "geometry_msgs/PoseWithCovariance",
+    text: "geometry_msgs/Pose pose\nfloat64[36] covariance\n",
+    deps: &[&POSE],
+};
+/// `geometry_msgs/PoseWithCovarianceStamped`.
+pub static POSE_WITH_COVARIANCE_STAMPED: MsgDef = MsgDef {
+    name: "geometry_msgs/PoseWithCovarianceStamped",
+    text: "std_msgs/Header header\ngeometry_msgs/PoseWithCovariance pose\n",
+    deps: &[&HEADER, &POSE_WITH_COVARIANCE],
+};
+/// `geometry_msgs/Twist`.
+pub static TWIST: MsgDef = MsgDef {
+    name: "geometry_msgs/Twist",
+    text: "geometry_msgs/Vector3 linear\ngeometry_msgs/Vector3 angular\n",
+    deps: &[&VECTOR3],
+};
+/// `geometry_msgs/TwistWithCovariance`.
+pub static TWIST_WITH_COVARIANCE: MsgDef = MsgDef {
+    name: "geometry_msgs/TwistWithCovariance",
+    text: "geometry_msgs/Twist twist\nfloat64[36] covariance\n",
+    deps: &[&TWIST],
+};
+/// `geometry_msgs/Transform`.
+pub static TRANSFORM: MsgDef = MsgDef {
+    name: "geometry_msgs/Transform",
+    text: "geometry_msgs/Vector3 translation\ngeometry_msgs/Quaternion rotation\n",
+    deps: &[&VECTOR3, &QUATERNION],
+};
+/// `geometry_msgs/TransformStamped`.
+pub static TRANSFORM_STAMPED: MsgDef = MsgDef {
+    name: "geometry_msgs/TransformStamped",
+    text: "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/Transform transform\n",
+    deps: &[&HEADER, &TRANSFORM],
+};
 
 /// `geometry_msgs/msg/Point`: a position in space, metres.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -52,10 +105,36 @@ impl Quaternion {
     }
 }
 
+impl Point {
+    /// `[x, y, z]`.
+    pub fn to_array(self) -> [f64; 3] {
+        [self.x, self.y, self.z]
+    }
+}
+
 impl Vector3 {
     /// `[x, y, z]`.
     pub fn to_array(self) -> [f64; 3] {
         [self.x, self.y, self.z]
+    }
+}
+
+impl From<[f64; 3]> for Vector3 {
+    fn from([x, y, z]: [f64; 3]) -> Self {
+        Self { x, y, z }
+    }
+}
+
+impl From<[f64; 3]> for Point {
+    fn from([x, y, z]: [f64; 3]) -> Self {
+        Self { x, y, z }
+    }
+}
+
+impl From<[f64; 4]> for Quaternion {
+    /// From `[x, y, z, w]`.
+    fn from([x, y, z, w]: [f64; 4]) -> Self {
+        Self { x, y, z, w }
     }
 }
 
@@ -77,9 +156,15 @@ pub struct PoseWithCovariance {
     pub covariance: [f64; 36],
 }
 
+impl Default for PoseWithCovariance {
+    fn default() -> Self {
+        Self { pose: Pose::default(), covariance: [0.0; 36] }
+    }
+}
+
 /// `geometry_msgs/msg/PoseWithCovarianceStamped`: a stamped pose estimate (AMCL's
-/// `/amcl_pose`, an external localiser) in `header.frame_id`.
-#[derive(Clone, Debug, PartialEq)]
+/// `/amcl_pose`, an external localiser, RViz's "2D Pose Estimate") in `header.frame_id`.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct PoseWithCovarianceStamped {
     /// Stamp and the frame the pose is given in.
     pub header: Header,
@@ -103,6 +188,12 @@ pub struct TwistWithCovariance {
     pub twist: Twist,
     /// Row-major 6×6 covariance over (x, y, z, rotation about x, about y, about z).
     pub covariance: [f64; 36],
+}
+
+impl Default for TwistWithCovariance {
+    fn default() -> Self {
+        Self { twist: Twist::default(), covariance: [0.0; 36] }
+    }
 }
 
 /// `geometry_msgs/msg/Transform`: a rigid transform between two frames.
@@ -187,5 +278,78 @@ impl CdrDecode for TransformStamped {
             child_frame_id: r.string("child_frame_id")?,
             transform: r.decode_field("transform")?,
         })
+    }
+}
+
+impl CdrEncode for Point {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        w.f64_array(&self.to_array());
+        Ok(())
+    }
+}
+
+impl CdrEncode for Vector3 {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        w.f64_array(&self.to_array());
+        Ok(())
+    }
+}
+
+impl CdrEncode for Quaternion {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        w.f64_array(&self.to_array());
+        Ok(())
+    }
+}
+
+impl CdrEncode for Pose {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.position.encode(w)?;
+        self.orientation.encode(w)
+    }
+}
+
+impl CdrEncode for PoseWithCovariance {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.pose.encode(w)?;
+        w.f64_array(&self.covariance);
+        Ok(())
+    }
+}
+
+impl CdrEncode for PoseWithCovarianceStamped {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        self.pose.encode(w)
+    }
+}
+
+impl CdrEncode for Twist {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.linear.encode(w)?;
+        self.angular.encode(w)
+    }
+}
+
+impl CdrEncode for TwistWithCovariance {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.twist.encode(w)?;
+        w.f64_array(&self.covariance);
+        Ok(())
+    }
+}
+
+impl CdrEncode for Transform {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.translation.encode(w)?;
+        self.rotation.encode(w)
+    }
+}
+
+impl CdrEncode for TransformStamped {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        w.string("child_frame_id", &self.child_frame_id)?;
+        self.transform.encode(w)
     }
 }

@@ -1,11 +1,22 @@
 //! `nav_msgs`: odometry.
 
-use super::geometry_msgs::{PoseWithCovariance, TwistWithCovariance};
-use super::std_msgs::Header;
+use super::geometry_msgs::{PoseWithCovariance, TwistWithCovariance, POSE_WITH_COVARIANCE, TWIST_WITH_COVARIANCE};
+use super::std_msgs::{Header, HEADER};
 use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
+use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
+use crate::log::ros2::writer::definition::MsgDef;
 
-/// `nav_msgs/msg/Odometry`: an estimate of where the robot is and how fast it moves.
-#[derive(Clone, Debug, PartialEq)]
+/// `nav_msgs/Odometry`.
+pub static ODOMETRY: MsgDef = MsgDef {
+    name: "nav_msgs/Odometry",
+    text: "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/PoseWithCovariance pose\n\
+           geometry_msgs/TwistWithCovariance twist\n",
+    deps: &[&HEADER, &POSE_WITH_COVARIANCE, &TWIST_WITH_COVARIANCE],
+};
+
+/// `nav_msgs/msg/Odometry`: an estimate of where the robot is and how fast it moves
+/// (REP 105: `odom_from_base`, the twist in the child frame).
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Odometry {
     /// Stamp, and the frame the pose is given in (usually `odom`).
     pub header: Header,
@@ -25,5 +36,14 @@ impl CdrDecode for Odometry {
             pose: r.decode_field("pose")?,
             twist: r.decode_field("twist")?,
         })
+    }
+}
+
+impl CdrEncode for Odometry {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        w.string("child_frame_id", &self.child_frame_id)?;
+        self.pose.encode(w)?;
+        self.twist.encode(w)
     }
 }

@@ -1,10 +1,68 @@
 //! `sensor_msgs`: planar laser scans, inertial measurements, satellite navigation fixes,
 //! camera images and calibrations.
 
-use super::geometry_msgs::{Quaternion, Vector3};
-use super::std_msgs::Header;
+use super::geometry_msgs::{Quaternion, Vector3, QUATERNION, VECTOR3};
+use super::std_msgs::{Header, HEADER};
 use crate::log::check_image_layout;
 use crate::log::ros2::cdr::{check_encapsulation, CdrDecode, CdrError, CdrReader};
+use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
+use crate::log::ros2::writer::definition::MsgDef;
+use std::borrow::Cow;
+
+/// `sensor_msgs/LaserScan`.
+pub static LASER_SCAN: MsgDef = MsgDef {
+    name: "sensor_msgs/LaserScan",
+    text: "std_msgs/Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\n\
+           float32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\n\
+           float32[] ranges\nfloat32[] intensities\n",
+    deps: &[&HEADER],
+};
+/// `sensor_msgs/Imu`.
+pub static IMU: MsgDef = MsgDef {
+    name: "sensor_msgs/Imu",
+    text: "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\nfloat64[9] orientation_covariance\n\
+           geometry_msgs/Vector3 angular_velocity\nfloat64[9] angular_velocity_covariance\n\
+           geometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance\n",
+    deps: &[&HEADER, &QUATERNION, &VECTOR3],
+};
+/// `sensor_msgs/NavSatStatus`.
+pub static NAV_SAT_STATUS: MsgDef = MsgDef {
+    name: "sensor_msgs/NavSatStatus",
+    text: "int8 STATUS_NO_FIX=-1\nint8 STATUS_FIX=0\nint8 STATUS_SBAS_FIX=1\nint8 STATUS_GBAS_FIX=2\n\
+           uint16 SERVICE_GPS=1\nuint16 SERVICE_GLONASS=2\nuint16 SERVICE_COMPASS=4\nuint16 SERVICE_GALILEO=8\n\
+           int8 status\nuint16 service\n",
+    deps: &[],
+};
+/// `sensor_msgs/NavSatFix`.
+pub static NAV_SAT_FIX: MsgDef = MsgDef {
+    name: "sensor_msgs/NavSatFix",
+    text: "uint8 COVARIANCE_TYPE_UNKNOWN=0\nuint8 COVARIANCE_TYPE_APPROXIMATED=1\n\
+           uint8 COVARIANCE_TYPE_DIAGONAL_KNOWN=2\nuint8 COVARIANCE_TYPE_KNOWN=3\nstd_msgs/Header header\n\
+           sensor_msgs/NavSatStatus status\nfloat64 latitude\nfloat64 longitude\nfloat64 altitude\n\
+           float64[9] position_covariance\nuint8 position_covariance_type\n",
+    deps: &[&HEADER, &NAV_SAT_STATUS],
+};
+/// `sensor_msgs/Image`.
+pub static IMAGE: MsgDef = MsgDef {
+    name: "sensor_msgs/Image",
+    text: "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\n\
+           uint32 step\nuint8[] data\n",
+    deps: &[&HEADER],
+};
+/// `sensor_msgs/RegionOfInterest`.
+pub static REGION_OF_INTEREST: MsgDef = MsgDef {
+    name: "sensor_msgs/RegionOfInterest",
+    text: "uint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\nbool do_rectify\n",
+    deps: &[],
+};
+/// `sensor_msgs/CameraInfo`.
+pub static CAMERA_INFO: MsgDef = MsgDef {
+    name: "sensor_msgs/CameraInfo",
+    text: "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\nfloat64[] d\n\
+           float64[9] k\nfloat64[9] r\nfloat64[12] p\nuint32 binning_x\nuint32 binning_y\n\
+           sensor_msgs/RegionOfInterest roi\n",
+    deps: &[&HEADER, &REGION_OF_INTEREST],
+};
 
 /// `sensor_msgs/msg/LaserScan`: one sweep of a planar range finder.
 ///
@@ -58,7 +116,7 @@ impl CdrDecode for LaserScan {
 ///
 /// A covariance whose first element is -1 marks the quantity as not measured; all zeros
 /// means the covariance is unknown.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Imu {
     /// Stamp and the IMU's frame.
     pub header: Header,
@@ -100,8 +158,27 @@ pub struct NavSatStatus {
     pub service: u16,
 }
 
+impl NavSatStatus {
+    /// No fix.
+    pub const STATUS_NO_FIX: i8 = -1;
+    /// Unaugmented fix.
+    pub const STATUS_FIX: i8 = 0;
+    /// Fix with satellite-based augmentation.
+    pub const STATUS_SBAS_FIX: i8 = 1;
+    /// Fix with ground-based augmentation (RTK, DGPS).
+    pub const STATUS_GBAS_FIX: i8 = 2;
+    /// GPS.
+    pub const SERVICE_GPS: u16 = 1;
+    /// GLONASS.
+    pub const SERVICE_GLONASS: u16 = 2;
+    /// BeiDou (COMPASS).
+    pub const SERVICE_COMPASS: u16 = 4;
+    /// Galileo.
+    pub const SERVICE_GALILEO: u16 = 8;
+}
+
 /// `sensor_msgs/msg/NavSatFix`: a WGS 84 position from a satellite navigation receiver.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct NavSatFix {
     /// Stamp and the antenna's frame.
     pub header: Header,
@@ -117,6 +194,17 @@ pub struct NavSatFix {
     pub position_covariance: [f64; 9],
     /// 0 unknown, 1 approximated, 2 diagonal known, 3 known.
     pub position_covariance_type: u8,
+}
+
+impl NavSatFix {
+    /// Covariance unknown.
+    pub const COVARIANCE_TYPE_UNKNOWN: u8 = 0;
+    /// Covariance approximated.
+    pub const COVARIANCE_TYPE_APPROXIMATED: u8 = 1;
+    /// Only the diagonal is known.
+    pub const COVARIANCE_TYPE_DIAGONAL_KNOWN: u8 = 2;
+    /// The full covariance is known.
+    pub const COVARIANCE_TYPE_KNOWN: u8 = 3;
 }
 
 impl CdrDecode for NavSatStatus {
@@ -139,9 +227,10 @@ impl CdrDecode for NavSatFix {
     }
 }
 
-/// `sensor_msgs/msg/Image`: an uncompressed image, pixel (0, 0) at the top left, with its
-/// pixels borrowed from the payload (so that reading the header costs no copy).
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// `sensor_msgs/msg/Image`: an uncompressed image, row after row, pixel (0, 0) at the top
+/// left. Read, its pixels are borrowed from the payload (so reading the header costs no
+/// copy); to be written, they may be owned.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Image<'a> {
     /// Acquisition time; `frame_id` is the camera's optical frame (z forward, x right,
     /// y down).
@@ -157,7 +246,7 @@ pub struct Image<'a> {
     /// Full row length, bytes.
     pub step: u32,
     /// The pixels, `step × height` bytes.
-    pub data: &'a [u8],
+    pub data: Cow<'a, [u8]>,
 }
 
 impl<'a> Image<'a> {
@@ -175,7 +264,7 @@ impl<'a> Image<'a> {
         let data = r.u8_seq("data")?;
         check_image_layout(width, height, &encoding, step, data.len() as u64)
             .map_err(|e| r.invalid_at("data", at, e))?;
-        Ok(Self { header, height, width, encoding, is_bigendian, step, data })
+        Ok(Self { header, height, width, encoding, is_bigendian, step, data: Cow::Borrowed(data) })
     }
 
     /// Decodes a whole payload (encapsulation header included).
@@ -213,7 +302,8 @@ impl CdrDecode for RegionOfInterest {
 }
 
 /// `sensor_msgs/msg/CameraInfo`: the calibration of a camera (pinhole intrinsics `k`,
-/// distortion `d` of `distortion_model`, rectification `r`, projection `p`).
+/// distortion `d` of `distortion_model`, rectification `r`, projection `p`; Hartley &
+/// Zisserman's `K`, `R`, `P`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraInfo {
     /// Stamp and the optical frame.
@@ -240,6 +330,24 @@ pub struct CameraInfo {
     pub roi: RegionOfInterest,
 }
 
+impl Default for CameraInfo {
+    fn default() -> Self {
+        Self {
+            header: Header::default(),
+            height: 0,
+            width: 0,
+            distortion_model: String::new(),
+            d: Vec::new(),
+            k: [0.0; 9],
+            r: [0.0; 9],
+            p: [0.0; 12],
+            binning_x: 0,
+            binning_y: 0,
+            roi: RegionOfInterest::default(),
+        }
+    }
+}
+
 impl CdrDecode for CameraInfo {
     fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
         Ok(Self {
@@ -255,5 +363,84 @@ impl CdrDecode for CameraInfo {
             binning_y: r.u32("binning_y")?,
             roi: r.decode_field("roi")?,
         })
+    }
+}
+
+impl CdrEncode for LaserScan {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        for v in [
+            self.angle_min,
+            self.angle_max,
+            self.angle_increment,
+            self.time_increment,
+            self.scan_time,
+            self.range_min,
+            self.range_max,
+        ] {
+            w.f32(v);
+        }
+        w.f32_seq("ranges", &self.ranges)?;
+        w.f32_seq("intensities", &self.intensities)
+    }
+}
+
+impl CdrEncode for Imu {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        self.orientation.encode(w)?;
+        w.f64_array(&self.orientation_covariance);
+        self.angular_velocity.encode(w)?;
+        w.f64_array(&self.angular_velocity_covariance);
+        self.linear_acceleration.encode(w)?;
+        w.f64_array(&self.linear_acceleration_covariance);
+        Ok(())
+    }
+}
+
+impl CdrEncode for NavSatFix {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        w.i8(self.status.status);
+        w.u16(self.status.service);
+        w.f64(self.latitude);
+        w.f64(self.longitude);
+        w.f64(self.altitude);
+        w.f64_array(&self.position_covariance);
+        w.u8(self.position_covariance_type);
+        Ok(())
+    }
+}
+
+impl CdrEncode for Image<'_> {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        w.u32(self.height);
+        w.u32(self.width);
+        w.string("encoding", &self.encoding)?;
+        w.u8(self.is_bigendian);
+        w.u32(self.step);
+        w.bytes("data", &self.data)
+    }
+}
+
+impl CdrEncode for CameraInfo {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        w.u32(self.height);
+        w.u32(self.width);
+        w.string("distortion_model", &self.distortion_model)?;
+        w.f64_seq("d", &self.d)?;
+        w.f64_array(&self.k);
+        w.f64_array(&self.r);
+        w.f64_array(&self.p);
+        w.u32(self.binning_x);
+        w.u32(self.binning_y);
+        w.u32(self.roi.x_offset);
+        w.u32(self.roi.y_offset);
+        w.u32(self.roi.height);
+        w.u32(self.roi.width);
+        w.bool(self.roi.do_rectify);
+        Ok(())
     }
 }

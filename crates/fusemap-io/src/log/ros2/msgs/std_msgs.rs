@@ -1,20 +1,42 @@
 //! `std_msgs`: the header shared by stamped messages.
 
-use super::builtin_interfaces::Time;
+use super::builtin_interfaces::{write_time, Time, TIME};
 use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
+use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
+use crate::log::ros2::writer::definition::MsgDef;
+use fusemap_core::time::Stamp;
+
+/// `std_msgs/Header`.
+pub static HEADER: MsgDef =
+    MsgDef { name: "std_msgs/Header", text: "builtin_interfaces/Time stamp\nstring frame_id\n", deps: &[&TIME] };
 
 /// `std_msgs/msg/Header`: when the data was taken and in which coordinate frame.
 /// (ROS 2 dropped the ROS 1 `seq` counter.)
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Header {
-    /// Acquisition time of the data.
-    pub stamp: Time,
+    /// Acquisition time of the data (`builtin_interfaces/Time` on the wire).
+    pub stamp: Stamp,
     /// The frame the data is expressed in (`laser`, `odom`, …).
     pub frame_id: String,
 }
 
+impl Header {
+    /// A header at `stamp` in `frame_id`.
+    pub fn new(stamp: Stamp, frame_id: impl Into<String>) -> Self {
+        Self { stamp, frame_id: frame_id.into() }
+    }
+}
+
 impl CdrDecode for Header {
     fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        Ok(Self { stamp: r.decode_field("stamp")?, frame_id: r.string("frame_id")? })
+        let stamp: Time = r.decode_field("stamp")?;
+        Ok(Self { stamp: stamp.to_stamp(), frame_id: r.string("frame_id")? })
+    }
+}
+
+impl CdrEncode for Header {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        write_time(w, "header.stamp", self.stamp)?;
+        w.string("header.frame_id", &self.frame_id)
     }
 }

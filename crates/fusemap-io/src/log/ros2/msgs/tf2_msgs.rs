@@ -1,7 +1,16 @@
 //! `tf2_msgs`: batches of frame transforms (`/tf`, `/tf_static`).
 
-use super::geometry_msgs::TransformStamped;
+use super::geometry_msgs::{TransformStamped, TRANSFORM_STAMPED};
 use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
+use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
+use crate::log::ros2::writer::definition::MsgDef;
+
+/// `tf2_msgs/TFMessage`.
+pub static TF_MESSAGE: MsgDef = MsgDef {
+    name: "tf2_msgs/TFMessage",
+    text: "geometry_msgs/TransformStamped[] transforms\n",
+    deps: &[&TRANSFORM_STAMPED],
+};
 
 /// `tf2_msgs/msg/TFMessage`: several transforms sent together.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -17,5 +26,14 @@ const MIN_TRANSFORM_STAMPED_LEN: usize = 8 + 8 + 56;
 impl CdrDecode for TfMessage {
     fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
         Ok(Self { transforms: r.seq("transforms", MIN_TRANSFORM_STAMPED_LEN, TransformStamped::decode)? })
+    }
+}
+
+/// A `tf2_msgs/msg/TFMessage` body over borrowed transforms, for the writer.
+pub(crate) struct TfMessageRef<'a>(pub &'a [TransformStamped]);
+
+impl CdrEncode for TfMessageRef<'_> {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        w.seq("transforms", self.0)
     }
 }

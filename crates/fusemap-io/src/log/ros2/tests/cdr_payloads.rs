@@ -24,7 +24,7 @@ fn laser_scan_bytes_laid_out_by_hand() {
     assert_eq!(p.len(), 4 + 68);
 
     let m: sensor_msgs::LaserScan = decode_cdr(&p).unwrap();
-    assert_eq!((m.header.stamp.sec, m.header.stamp.nanosec), (1, 2));
+    assert_eq!(m.header.stamp, Stamp(1_000_000_002));
     assert_eq!(m.header.frame_id, "laser");
     assert_eq!((m.angle_min, m.angle_max, m.angle_increment), (-1.0, 1.0, 0.5));
     assert_eq!(m.range_max, 81.0);

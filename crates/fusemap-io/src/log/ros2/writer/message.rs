@@ -2,12 +2,14 @@
 
 use super::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
 use super::definition::MsgDef;
-use super::msgs::geometry_msgs::{PoseWithCovarianceStamped, TransformStamped, POSE_WITH_COVARIANCE_STAMPED};
-use super::msgs::nav_msgs::{Odometry, ODOMETRY};
-use super::msgs::sensor_msgs::{
+use crate::log::ros2::msgs::geometry_msgs::{
+    PoseWithCovarianceStamped, TransformStamped, POSE_WITH_COVARIANCE_STAMPED,
+};
+use crate::log::ros2::msgs::nav_msgs::{Odometry, ODOMETRY};
+use crate::log::ros2::msgs::sensor_msgs::{
     CameraInfo, Image, Imu, LaserScan, NavSatFix, CAMERA_INFO, IMAGE, IMU, LASER_SCAN, NAV_SAT_FIX,
 };
-use super::msgs::tf2_msgs::{TfMessageRef, TF_MESSAGE};
+use crate::log::ros2::msgs::tf2_msgs::{TfMessageRef, TF_MESSAGE};
 use fusemap_core::time::Stamp;
 
 /// A message for [`Rosbag2Writer::write`](super::Rosbag2Writer::write).
@@ -38,7 +40,7 @@ pub enum OutMessage {
         transforms: Vec<TransformStamped>,
     },
     /// `sensor_msgs/msg/Image`.
-    Image(Image),
+    Image(Image<'static>),
     /// `sensor_msgs/msg/CameraInfo`.
     CameraInfo(CameraInfo),
 }

@@ -6,14 +6,16 @@
 //!   pose estimates, transforms, camera images and calibration) into the bag and moves the
 //!   directory into place at [`finish`](Rosbag2Writer::finish), all at once.
 //! - [`cdr_write`] serialises them as little-endian CDR, the mirror of
-//!   [`super::cdr`]; [`msgs`] holds the plain structs, one module per ROS package.
+//!   [`super::cdr`]; the message structs are the reader's own ([`super::msgs`]), one
+//!   module per ROS package, so what is written is what is read.
 //! - [`definition`] gives each type's full `.msg` text for the `ros2msg` MCAP schema;
 //!   [`metadata`] writes `metadata.yaml` and the QoS profiles players use (static
 //!   transforms latched).
 //!
 //! ```no_run
 //! use fusemap_core::time::Stamp;
-//! use fusemap_io::log::ros2::writer::msgs::{geometry_msgs::TransformStamped, std_msgs::Header};
+//! use fusemap_io::log::ros2::msgs::geometry_msgs::{Transform, TransformStamped};
+//! use fusemap_io::log::ros2::msgs::std_msgs::Header;
 //! use fusemap_io::log::ros2::writer::{OutMessage, Rosbag2Writer};
 //!
 //! # fn main() -> fusemap_io::Result<()> {
@@ -21,8 +23,7 @@
 //! let mount = TransformStamped {
 //!     header: Header::new(Stamp(0), "base_link"),
 //!     child_frame_id: "laser".into(),
-//!     translation: [0.2, 0.0, 0.1],
-//!     rotation: [0.0, 0.0, 0.0, 1.0],
+//!     transform: Transform { translation: [0.2, 0.0, 0.1].into(), rotation: Default::default() },
 //! };
 //! bag.write(Stamp(0), "/tf_static", &OutMessage::Tf { is_static: true, transforms: vec![mount] })?;
 //! let written = bag.finish()?; // out/run1/metadata.yaml and out/run1/run1_0.mcap appear now
@@ -36,7 +37,6 @@ pub mod cdr_write;
 pub mod definition;
 mod message;
 pub mod metadata;
-pub mod msgs;
 mod staging;
 
 pub use bag::{check_topic_name, ChunkCompression, Rosbag2Writer, Rosbag2WriterOptions, WrittenBag};
