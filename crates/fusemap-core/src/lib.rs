@@ -34,6 +34,7 @@
 
 pub mod config;
 pub mod estimator;
+pub mod field_error;
 pub mod frames;
 pub mod fusion;
 pub mod geometry;

@@ -26,11 +26,7 @@ pub fn load_scenario(path: &Path) -> Result<Scenario> {
     let text = read_text(path)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let s: Scenario = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
-    s.validate().map_err(|m| {
-        // The simulator names the field first: `lidar.rate_hz: must be > 0`.
-        let field = m.split(':').next().unwrap_or("").trim().to_string();
-        field_error(path, text, &field, m)
-    })?;
+    s.validate().map_err(|e| field_error(path, text, &e.field, e.message))?;
     Ok(s)
 }
 
@@ -252,7 +248,9 @@ mod tests {
             .to_string();
         assert!(e.contains("typo.toml:3") && e.contains("speeed"), "{e}");
         let e = load_scenario(&write(&dir, "bad.toml", "[gnss]\nrate_hz = 0.0\n")).unwrap_err().to_string();
-        assert!(e.contains("bad.toml") && e.contains("gnss.rate_hz"), "{e}");
+        // The simulator's check names the field apart from the message: the error points
+        // at its line.
+        assert!(e.contains("bad.toml:2") && e.contains("gnss.rate_hz"), "{e}");
         let cam = "[camera]\ndepth_encoding = \"16UC1\"\nlabel_encoding = \"mono16\"\ntime_offset_s = 0.04\n\
                    [camera.backlight]\nfloor_share = 0.4\n[person]\nwindows = [[0.0, 30.0]]\n";
         let s = load_scenario(&write(&dir, "camera.toml", cam)).unwrap();

@@ -11,7 +11,7 @@ use crate::sensor::camera::optical_mount;
 use crate::sensor::{CameraError, CameraModel, CameraParams, ClassSpec, ClassTable, Pinhole};
 use serde::{Deserialize, Serialize};
 
-use super::{err, finite, ConfigError, SensorConfig};
+use super::{err, finite, FieldError, SensorConfig};
 
 /// Default largest stamp difference between a label image and its depth image, seconds:
 /// aligned streams of one RGB-D driver carry the same stamp; 5 ms allows for rounding.
@@ -71,7 +71,7 @@ fn key_of(param: &'static str) -> &'static str {
 
 /// Validates a camera table. `prior` is the map's: the camera's free evidence must be
 /// below it.
-pub(super) fn plan_camera(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<PlannedCamera, ConfigError> {
+pub(super) fn plan_camera(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<PlannedCamera, FieldError> {
     let f = |key: &str| format!("sensor[{i}].{key}");
     let d = CameraParams::default();
     let params = CameraParams {
@@ -124,7 +124,7 @@ pub(super) fn plan_camera(i: usize, s: &SensorConfig, name: String, prior: f64) 
 /// The camera a log run plans when the config lists none and the log carries the usual
 /// topics (`/camera/labels`, `/camera/depth`, `/camera/camera_info`): every parameter at
 /// its default, the mount from the log's TF.
-pub fn default_camera(prior: f64) -> Result<PlannedCamera, ConfigError> {
+pub fn default_camera(prior: f64) -> Result<PlannedCamera, FieldError> {
     let mut c = plan_camera(0, &SensorConfig::new(super::SensorKind::Camera), "camera".into(), prior)?;
     c.explicit = false;
     Ok(c)
@@ -208,7 +208,7 @@ impl From<&ClassSpec> for ClassConfig {
 }
 
 /// The class table of the `[[class]]` tables; none given: the production default.
-pub(super) fn class_table(tables: &[ClassConfig]) -> Result<ClassTable, ConfigError> {
+pub(super) fn class_table(tables: &[ClassConfig]) -> Result<ClassTable, FieldError> {
     if tables.is_empty() {
         return Ok(ClassTable::production_default());
     }

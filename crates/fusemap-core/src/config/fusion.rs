@@ -1,7 +1,7 @@
 //! `[fusion]`: how the sensors' evidence is combined — which sensors are correlated and
 //! how their evidence is merged (design document §2.4), and the dynamic-object layer.
 
-use super::{err, finite, probability, ConfigError};
+use super::{err, finite, probability, FieldError};
 use crate::grid::{DynamicParams, MergeRule};
 use serde::{Deserialize, Serialize};
 
@@ -53,7 +53,7 @@ impl FusionConfig {
     /// Checks the numbers (sensor names are checked against the planned sensors by the
     /// caller) and returns the dynamic layer's parameters for a map whose occupied
     /// threshold is `occupied_threshold`.
-    pub fn validate(&self, occupied_threshold: f64) -> Result<DynamicParams, ConfigError> {
+    pub fn validate(&self, occupied_threshold: f64) -> Result<DynamicParams, FieldError> {
         let w = finite("fusion.correlation_window_s", self.correlation_window_s)?;
         if !(0.0..=1.0).contains(&w) {
             return Err(err("fusion.correlation_window_s", format!("must be within 0..=1 s, got {w}")));

@@ -22,7 +22,7 @@
 //!   message. The world-file loader holds its simulated scanner to `beams_per_scan`.
 //! * `world_poses` is checked by the world-file loader before it builds the trajectory.
 
-use super::{err, ConfigError};
+use super::{err, FieldError};
 use crate::grid::TILE_CELLS;
 use serde::{Deserialize, Serialize};
 
@@ -82,7 +82,7 @@ impl LimitsConfig {
     }
 
     /// Checks the values themselves (every limit at least 1).
-    pub(super) fn validate(&self) -> Result<(), ConfigError> {
+    pub(super) fn validate(&self) -> Result<(), FieldError> {
         for (key, v) in [
             ("map_cells", self.map_cells),
             ("ray_cells", self.ray_cells),
@@ -102,7 +102,7 @@ impl LimitsConfig {
     /// Checks that a ray of `range_m` metres over cells of `cell_m` metres stays within
     /// `ray_cells`. `what` names the range's key (`sensor[0].max_range`), `cell_key` the
     /// cell size's.
-    pub(super) fn check_ray(&self, what: &str, range_m: f64, cell_key: &str, cell_m: f64) -> Result<(), ConfigError> {
+    pub(super) fn check_ray(&self, what: &str, range_m: f64, cell_key: &str, cell_m: f64) -> Result<(), FieldError> {
         let cells = range_m / cell_m;
         if cells.is_finite() && cells <= self.ray_cells as f64 {
             return Ok(());

@@ -214,21 +214,15 @@ impl Default for MapConfig {
     }
 }
 
-/// A configuration error, naming the field.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{field}: {message}")]
-pub struct ConfigError {
-    /// The field, as a TOML path (`map.prior`, `lidar[0].mount`).
-    pub field: String,
-    /// What is wrong with it.
-    pub message: String,
+/// A configuration error names the field ([`FieldError`], the error of every parameter
+/// check).
+pub use crate::field_error::FieldError;
+
+fn err(field: impl Into<String>, message: impl Into<String>) -> FieldError {
+    FieldError::new(field, message)
 }
 
-fn err(field: impl Into<String>, message: impl Into<String>) -> ConfigError {
-    ConfigError { field: field.into(), message: message.into() }
-}
-
-fn finite(field: &str, v: f64) -> Result<f64, ConfigError> {
+fn finite(field: &str, v: f64) -> Result<f64, FieldError> {
     if v.is_finite() {
         Ok(v)
     } else {
@@ -236,7 +230,7 @@ fn finite(field: &str, v: f64) -> Result<f64, ConfigError> {
     }
 }
 
-fn probability(field: &str, v: f64) -> Result<f64, ConfigError> {
+fn probability(field: &str, v: f64) -> Result<f64, FieldError> {
     finite(field, v)?;
     if v > 0.0 && v < 1.0 {
         Ok(v)
@@ -284,7 +278,7 @@ pub struct Plan {
 
 impl Config {
     /// Checks every field and builds the plan. The first problem found is returned.
-    pub fn validate(&self) -> Result<Plan, ConfigError> {
+    pub fn validate(&self) -> Result<Plan, FieldError> {
         let m = &self.map;
         let res = finite("map.resolution", m.resolution)?;
         if res <= 0.0 {
@@ -380,11 +374,7 @@ impl Config {
             })
             .collect();
         let classes = camera::class_table(&self.class)?;
-        // The estimator names the field first: `estimator.gate_probability must be …`.
-        self.estimator.validate().map_err(|m| match m.split_once(' ') {
-            Some((field, rest)) if field.starts_with("estimator.") => err(field, rest),
-            _ => err("estimator", m),
-        })?;
+        self.estimator.validate()?;
         let dynamic = self.fusion.validate(occ_t)?;
         let slam = self.slam.validate()?;
         let limits = self.limits;

@@ -16,7 +16,7 @@ use crate::sensor::{LidarModel, LidarParams, MaxRangePolicy, ScanFilters};
 use serde::{Deserialize, Serialize};
 
 use super::camera::{plan_camera, PlannedCamera};
-use super::{err, finite, probability, ConfigError};
+use super::{err, finite, probability, FieldError};
 
 /// What a sensor is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -394,7 +394,7 @@ pub(super) struct PlannedSensors {
 /// Validates the `[[sensor]]` tables into lidars, cameras and the other sensors. `prior`
 /// is the map's prior (lidar probabilities must straddle it; camera free evidence must be
 /// below it).
-pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<PlannedSensors, ConfigError> {
+pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<PlannedSensors, FieldError> {
     let mut lidars = Vec::new();
     let mut cameras = Vec::new();
     let mut others = Vec::new();
@@ -435,7 +435,7 @@ pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<Planne
             cameras.push(plan_camera(i, s, name, prior)?);
             continue;
         }
-        let pos = |k: &str, v: Option<f64>| -> Result<Option<f64>, ConfigError> {
+        let pos = |k: &str, v: Option<f64>| -> Result<Option<f64>, FieldError> {
             match v {
                 Some(x) if finite(&f(k), x)? <= 0.0 => Err(err(f(k), format!("must be > 0, got {x}"))),
                 v => Ok(v),
@@ -500,7 +500,7 @@ pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<Planne
     Ok(PlannedSensors { lidars, cameras, others })
 }
 
-fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<PlannedLidar, ConfigError> {
+fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<PlannedLidar, FieldError> {
     let f = |name: &str| format!("sensor[{i}].{name}");
     let d = LidarParams::default();
     let p_occ = probability(&f("p_occ"), s.p_occ.unwrap_or(d.p_occ))?;
@@ -534,7 +534,7 @@ fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<Pl
         max_range_policy: s.max_range_policy.unwrap_or(d.max_range_policy),
         filters: s.filters.unwrap_or_default(),
     };
-    params.filters.validate().map_err(|(k, m)| err(f(&format!("filters.{k}")), m))?;
+    params.filters.validate().map_err(|e| e.within(&f("filters")))?;
     Ok(PlannedLidar {
         name,
         model: LidarModel::new(params, mount),

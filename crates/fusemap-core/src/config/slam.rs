@@ -3,7 +3,7 @@
 //! Every key maps onto [`SlamParams`]; the defaults are in [`SlamParams::default`] and the
 //! reasons for them beside each field there.
 
-use super::{err, finite, probability, ConfigError};
+use super::{err, finite, probability, FieldError};
 use crate::slam::{LocalMatchParams, SlamParams, SubmapBounds};
 use serde::{Deserialize, Serialize};
 
@@ -241,7 +241,7 @@ impl Default for SlamConfig {
     }
 }
 
-fn positive(field: &str, v: f64) -> Result<f64, ConfigError> {
+fn positive(field: &str, v: f64) -> Result<f64, FieldError> {
     let v = finite(&format!("slam.{field}"), v)?;
     if v > 0.0 {
         Ok(v)
@@ -250,7 +250,7 @@ fn positive(field: &str, v: f64) -> Result<f64, ConfigError> {
     }
 }
 
-fn non_negative(field: &str, v: f64) -> Result<f64, ConfigError> {
+fn non_negative(field: &str, v: f64) -> Result<f64, FieldError> {
     let v = finite(&format!("slam.{field}"), v)?;
     if v >= 0.0 {
         Ok(v)
@@ -261,7 +261,7 @@ fn non_negative(field: &str, v: f64) -> Result<f64, ConfigError> {
 
 /// A ratio of the smallest to the largest information, which lies in [0, 1]: above 1 every
 /// match would be refused.
-fn unit_ratio(field: &str, v: f64) -> Result<f64, ConfigError> {
+fn unit_ratio(field: &str, v: f64) -> Result<f64, FieldError> {
     let v = finite(field, v)?;
     if (0.0..=1.0).contains(&v) {
         Ok(v)
@@ -272,7 +272,7 @@ fn unit_ratio(field: &str, v: f64) -> Result<f64, ConfigError> {
 
 impl SlamConfig {
     /// Checks every key and builds the parameters.
-    pub fn validate(&self) -> Result<SlamParams, ConfigError> {
+    pub fn validate(&self) -> Result<SlamParams, FieldError> {
         let hit = probability("slam.hit_probability", self.hit_probability)?;
         let miss = probability("slam.miss_probability", self.miss_probability)?;
         if hit <= 0.5 || miss >= 0.5 {

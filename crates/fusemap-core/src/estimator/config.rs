@@ -1,6 +1,7 @@
 //! The estimator's configuration: every noise figure, gate and threshold, as the
 //! `[estimator]` table of the TOML configuration.
 
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// Noise figures, gates and thresholds of the planar estimator.
@@ -169,7 +170,7 @@ impl Default for EstimatorConfig {
 impl EstimatorConfig {
     /// Checks every field; the error names the first bad one in its TOML path
     /// (`estimator.gate_probability`).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), FieldError> {
         let positive = [
             ("heading_init_distance_m", self.heading_init_distance_m),
             ("heading_init_max_fix_sigma_m", self.heading_init_max_fix_sigma_m),
@@ -194,7 +195,10 @@ impl EstimatorConfig {
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("estimator.{name} must be a positive number (got {v})"));
+                return Err(FieldError::new(
+                    format!("estimator.{name}"),
+                    format!("must be a positive number (got {v})"),
+                ));
             }
         }
         let non_negative = [
@@ -214,16 +218,22 @@ impl EstimatorConfig {
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("estimator.{name} must be a non-negative number (got {v})"));
+                return Err(FieldError::new(
+                    format!("estimator.{name}"),
+                    format!("must be a non-negative number (got {v})"),
+                ));
             }
         }
         if !(self.gate_probability > 0.0 && self.gate_probability < 1.0) {
-            return Err(format!("estimator.gate_probability must be in (0, 1) (got {})", self.gate_probability));
+            return Err(FieldError::new(
+                "estimator.gate_probability",
+                format!("must be in (0, 1) (got {})", self.gate_probability),
+            ));
         }
         if !(self.slip_noise_inflation.is_finite() && self.slip_noise_inflation >= 1.0) {
-            return Err(format!(
-                "estimator.slip_noise_inflation must be at least 1 (got {})",
-                self.slip_noise_inflation
+            return Err(FieldError::new(
+                "estimator.slip_noise_inflation",
+                format!("must be at least 1 (got {})", self.slip_noise_inflation),
             ));
         }
         Ok(())
@@ -238,12 +248,12 @@ mod tests {
     fn default_is_valid_and_bad_fields_are_named() {
         assert_eq!(EstimatorConfig::default().validate(), Ok(()));
         let cfg = EstimatorConfig { gate_probability: 1.0, ..Default::default() };
-        assert!(cfg.validate().unwrap_err().contains("estimator.gate_probability"));
+        assert_eq!(cfg.validate().unwrap_err().field, "estimator.gate_probability");
         let cfg = EstimatorConfig { gyro_rate_sigma: f64::NAN, ..Default::default() };
-        assert!(cfg.validate().unwrap_err().contains("estimator.gyro_rate_sigma"));
+        assert_eq!(cfg.validate().unwrap_err().field, "estimator.gyro_rate_sigma");
         let cfg = EstimatorConfig { odometry_translation_noise: -1.0, ..Default::default() };
-        assert!(cfg.validate().unwrap_err().contains("estimator.odometry_translation_noise"));
+        assert_eq!(cfg.validate().unwrap_err().field, "estimator.odometry_translation_noise");
         let cfg = EstimatorConfig { slip_noise_inflation: 0.5, ..Default::default() };
-        assert!(cfg.validate().unwrap_err().contains("estimator.slip_noise_inflation"));
+        assert_eq!(cfg.validate().unwrap_err().field, "estimator.slip_noise_inflation");
     }
 }

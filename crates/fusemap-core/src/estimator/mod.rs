@@ -104,7 +104,7 @@ pub fn estimate(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> Result<Esti
 
 /// One forward filter and backward smoother over `inputs`.
 pub(crate) fn estimate_once(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> Result<Estimate, EstimatorError> {
-    cfg.validate().map_err(EstimatorError::Config)?;
+    cfg.validate().map_err(|e| EstimatorError::Config(e.to_string()))?;
     if inputs.is_empty() {
         return Err(EstimatorError::NoInputs);
     }

@@ -33,6 +33,7 @@
 //!   frame** (`LaserScanBoxFilter` with `box_frame: base_link`; the plane only, z is
 //!   ignored) are the robot's own body and are dropped.
 
+use crate::field_error::FieldError;
 use crate::geometry::PlanarMount;
 use serde::{Deserialize, Serialize};
 
@@ -155,28 +156,34 @@ impl ScanFilters {
     }
 
     /// Checks the parameters; the error names the key (below `filters.`).
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+    pub fn validate(&self) -> Result<(), FieldError> {
         let s = &self.shadow;
         if !(s.min_angle_deg.is_finite() && s.min_angle_deg > 0.0 && s.min_angle_deg < 90.0) {
-            return Err(("shadow.min_angle_deg", format!("must be within (0, 90) degrees, got {}", s.min_angle_deg)));
+            return Err(FieldError::new(
+                "shadow.min_angle_deg",
+                format!("must be within (0, 90) degrees, got {}", s.min_angle_deg),
+            ));
         }
         for (k, v) in [("shadow.window", s.window), ("shadow.neighbors", s.neighbors)] {
             if v > MAX_WINDOW {
-                return Err((k, format!("must be at most {MAX_WINDOW} beams, got {v}")));
+                return Err(FieldError::new(k, format!("must be at most {MAX_WINDOW} beams, got {v}")));
             }
         }
         if s.window == 0 {
-            return Err(("shadow.window", "must be at least 1 beam".into()));
+            return Err(FieldError::new("shadow.window", "must be at least 1 beam"));
         }
         let p = &self.speckle;
         if !(p.max_range_difference.is_finite() && p.max_range_difference >= 0.0) {
-            return Err((
+            return Err(FieldError::new(
                 "speckle.max_range_difference",
                 format!("must be a finite distance >= 0, got {}", p.max_range_difference),
             ));
         }
         if p.window == 0 || p.window > MAX_WINDOW {
-            return Err(("speckle.window", format!("must be within [1, {MAX_WINDOW}] beams, got {}", p.window)));
+            return Err(FieldError::new(
+                "speckle.window",
+                format!("must be within [1, {MAX_WINDOW}] beams, got {}", p.window),
+            ));
         }
         let a = &self.angular_bounds;
         if !(a.lower_deg.is_finite() && a.upper_deg.is_finite()) || a.lower_deg > a.upper_deg {
@@ -188,11 +195,17 @@ impl ScanFilters {
             } else {
                 "angular_bounds"
             };
-            return Err((key, format!("needs finite lower_deg <= upper_deg, got {} / {}", a.lower_deg, a.upper_deg)));
+            return Err(FieldError::new(
+                key,
+                format!("needs finite lower_deg <= upper_deg, got {} / {}", a.lower_deg, a.upper_deg),
+            ));
         }
         let b = &self.self_box;
         if b.min.iter().chain(&b.max).any(|v| !v.is_finite()) || b.min[0] > b.max[0] || b.min[1] > b.max[1] {
-            return Err(("box", format!("needs finite corners with min <= max, got {:?} / {:?}", b.min, b.max)));
+            return Err(FieldError::new(
+                "box",
+                format!("needs finite corners with min <= max, got {:?} / {:?}", b.min, b.max),
+            ));
         }
         Ok(())
     }

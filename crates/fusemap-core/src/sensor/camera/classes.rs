@@ -247,6 +247,6 @@ mod tests {
         }
         let many: Vec<ClassSpec> = (0..=MAX_CLASSES as u16).map(|i| spec(i, &format!("c{i}"))).collect();
         assert!(ClassTable::new(many[..MAX_CLASSES].to_vec()).is_ok());
-        assert!(ClassTable::new(many).unwrap_err().contains("at most 64"));
+        assert!(ClassTable::new(many).unwrap_err().to_string().contains("at most 64"));
     }
 }

@@ -157,7 +157,7 @@ fn bad_parameters_name_their_key() {
     for (f, key) in cases {
         let mut s = ScanFilters::default();
         f(&mut s);
-        assert_eq!(s.validate().unwrap_err().0, key);
+        assert_eq!(s.validate().unwrap_err().field, key);
     }
     assert!(ScanFilters::default().validate().is_ok());
     assert!(ScanFilters::NONE.validate().is_ok());

@@ -97,9 +97,9 @@ use crate::time::Stamp;
 /// Why a scenario cannot be simulated.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SimError {
-    /// [`Scenario::validate`] refused it; the message names the field.
+    /// [`Scenario::validate`] refused it, naming the field.
     #[error("invalid scenario: {0}")]
-    Invalid(String),
+    Invalid(#[from] crate::field_error::FieldError),
 }
 
 /// Rate of [`SimRecording::truth_trajectory`], Hz.

@@ -5,6 +5,7 @@
 //! part of the ground-truth occupancy.
 
 use super::scenario::{non_negative, positive};
+use crate::field_error::FieldError;
 use crate::geometry::Point2;
 use serde::{Deserialize, Serialize};
 
@@ -47,12 +48,15 @@ impl Default for PersonConfig {
 }
 
 impl PersonConfig {
-    pub(crate) fn validate(&self) -> Result<(), String> {
-        if self.from.iter().chain(&self.to).any(|v| !v.is_finite()) {
-            return Err("person.from and person.to must be finite".into());
+    pub(crate) fn validate(&self) -> Result<(), FieldError> {
+        // The end at fault, so that the error points at its line.
+        for (field, end) in [("person.from", self.from), ("person.to", self.to)] {
+            if end.iter().any(|v| !v.is_finite()) {
+                return Err(FieldError::new(field, "must be finite"));
+            }
         }
         if (self.from[0] - self.to[0]).hypot(self.from[1] - self.to[1]) < 1e-6 {
-            return Err("person.to must differ from person.from".into());
+            return Err(FieldError::new("person.to", "must differ from person.from"));
         }
         positive("person.speed_mps", self.speed_mps)?;
         positive("person.radius_m", self.radius_m)?;
@@ -60,7 +64,10 @@ impl PersonConfig {
         for (i, w) in self.windows.iter().enumerate() {
             non_negative(&format!("person.windows[{i}][0]"), w[0])?;
             if !(w[1].is_finite() && w[1] > w[0]) {
-                return Err(format!("person.windows[{i}] must end after it starts, got {w:?}"));
+                return Err(FieldError::new(
+                    format!("person.windows[{i}]"),
+                    format!("must end after it starts, got {w:?}"),
+                ));
             }
         }
         Ok(())
@@ -123,7 +130,7 @@ mod tests {
         let off = PersonConfig { enabled: false, ..PersonConfig::default() };
         assert!(off.position_at(w[0] + 1.0).is_none());
         let bad = PersonConfig { windows: vec![[5.0, 4.0]], ..PersonConfig::default() };
-        assert!(bad.validate().unwrap_err().starts_with("person.windows[0]"));
+        assert!(bad.validate().unwrap_err().to_string().starts_with("person.windows[0]"));
     }
 
     #[test]

@@ -8,6 +8,7 @@ use super::camera::{class_id, CameraConfig};
 use super::person::PersonConfig;
 use super::sensors::{GnssConfig, ImuConfig, LidarConfig, OdometryConfig};
 use super::world::{production_hall_objects, Rect, WorldObject};
+use crate::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// A whole simulated run.
@@ -141,55 +142,58 @@ impl Default for FramesConfig {
 pub const MAX_BEAMS: f64 = 5e7;
 
 /// `Ok` when `v` is finite and > 0.
-pub(crate) fn positive(field: &str, v: f64) -> Result<(), String> {
+pub(crate) fn positive(field: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err(format!("{field} must be a finite number > 0, got {v}"))
+        Err(FieldError::new(field, format!("must be a finite number > 0, got {v}")))
     }
 }
 
 /// `Ok` when `v` is finite and ≥ 0.
-pub(crate) fn non_negative(field: &str, v: f64) -> Result<(), String> {
+pub(crate) fn non_negative(field: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {
-        Err(format!("{field} must be a finite number >= 0, got {v}"))
+        Err(FieldError::new(field, format!("must be a finite number >= 0, got {v}")))
     }
 }
 
 /// `Ok` when `v` is a probability.
-pub(crate) fn probability(field: &str, v: f64) -> Result<(), String> {
+pub(crate) fn probability(field: &str, v: f64) -> Result<(), FieldError> {
     if (0.0..=1.0).contains(&v) {
         Ok(())
     } else {
-        Err(format!("{field} must lie in [0, 1], got {v}"))
+        Err(FieldError::new(field, format!("must lie in [0, 1], got {v}")))
     }
 }
 
 /// `Ok` when `v` is finite.
-pub(crate) fn finite(field: &str, v: f64) -> Result<(), String> {
+pub(crate) fn finite(field: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(format!("{field} must be finite, got {v}"))
+        Err(FieldError::new(field, format!("must be finite, got {v}")))
     }
 }
 
 impl Scenario {
     /// Checks every field; the error names the first bad one.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), FieldError> {
         let w = &self.world;
         w.extent.check("world.extent")?;
         if w.start_time_s.unsigned_abs() > 9_000_000_000 {
-            return Err(format!("world.start_time_s must lie within ±9e9 s (year 2255), got {}", w.start_time_s));
+            return Err(FieldError::new(
+                "world.start_time_s",
+                format!("must lie within ±9e9 s (year 2255), got {}", w.start_time_s),
+            ));
         }
         for (i, o) in w.objects.iter().enumerate() {
             o.check(&format!("world.objects[{i}]"))?;
             if class_id(&o.class).is_none_or(|c| c == 0 || c > 5) {
-                return Err(format!(
-                    "world.objects[{i}].class `{}` is not an object class of the table (wall, glass, pillar, machine)",
-                    o.class
+                return Err(FieldError::new(
+                    format!("world.objects[{i}].class"),
+                    format!("`{}` is not an object class of the table (wall, glass, pillar, machine)", o.class),
                 ));
             }
         }
@@ -203,24 +207,31 @@ impl Scenario {
         positive("robot.max_angular_accel_radps2", r.max_angular_accel_radps2)?;
         positive("robot.duration_s", r.duration_s)?;
         if r.duration_s > 3_600.0 {
-            return Err(format!("robot.duration_s must be at most 3600 (one hour in memory), got {}", r.duration_s));
+            return Err(FieldError::new(
+                "robot.duration_s",
+                format!("must be at most 3600 (one hour in memory), got {}", r.duration_s),
+            ));
         }
         non_negative("robot.corner_radius_m", r.corner_radius_m)?;
         positive("robot.lookahead_m", r.lookahead_m)?;
         if r.waypoints.len() < 3 || r.waypoints.iter().flatten().any(|v| !v.is_finite()) {
-            return Err("robot.waypoints needs at least 3 finite points (a closed loop)".into());
+            return Err(FieldError::new("robot.waypoints", "needs at least 3 finite points (a closed loop)"));
         }
         for i in 0..r.waypoints.len() {
             let (a, b) = (r.waypoints[i], r.waypoints[(i + 1) % r.waypoints.len()]);
             if (a[0] - b[0]).hypot(a[1] - b[1]) < 1e-6 {
-                return Err(format!("robot.waypoints[{i}] repeats the next waypoint"));
+                return Err(FieldError::new(format!("robot.waypoints[{i}]"), "repeats the next waypoint"));
             }
         }
         self.lidar.validate()?;
         let beams = self.lidar.beams as f64 * self.lidar.rate_hz * r.duration_s;
         if beams > MAX_BEAMS {
-            return Err(format!(
-                "lidar.beams × lidar.rate_hz × robot.duration_s = {beams:.3e} beams, more than the {MAX_BEAMS:.0e} a run may hold in memory"
+            return Err(FieldError::new(
+                "lidar.beams",
+                format!(
+                "makes {beams:.3e} beams with lidar.rate_hz × robot.duration_s, more than the {MAX_BEAMS:.0e} a run \
+                 may hold in memory"
+            ),
             ));
         }
         self.odometry.validate()?;
@@ -239,7 +250,7 @@ impl Scenario {
             ("frames.camera_optical", &f.camera_optical),
         ] {
             if name.is_empty() {
-                return Err(format!("{field} must not be empty"));
+                return Err(FieldError::new(field, "must not be empty"));
             }
         }
         Ok(())
@@ -255,47 +266,49 @@ mod tests {
         assert_eq!(Scenario::default().validate(), Ok(()));
         let mut s = Scenario::default();
         s.robot.max_speed_mps = -1.0;
-        assert!(s.validate().unwrap_err().starts_with("robot.max_speed_mps"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("robot.max_speed_mps"));
         let mut s = Scenario::default();
         s.lidar.glass_pass_probability = 1.5;
-        assert!(s.validate().unwrap_err().starts_with("lidar.glass_pass_probability"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("lidar.glass_pass_probability"));
         let mut s = Scenario::default();
         s.world.grooves[1] = Rect::new(1.0, 1.0, 0.0, 2.0);
-        assert!(s.validate().unwrap_err().starts_with("world.grooves[1]"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("world.grooves[1]"));
         let mut s = Scenario::default();
         s.gnss.datum_lat_deg = 91.0;
-        assert!(s.validate().unwrap_err().starts_with("gnss.datum"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("gnss.datum"));
         let mut s = Scenario::default();
         s.robot.waypoints.truncate(2);
-        assert!(s.validate().unwrap_err().starts_with("robot.waypoints"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("robot.waypoints"));
         let mut s = Scenario::default();
         s.frames.gps.clear();
-        assert!(s.validate().unwrap_err().starts_with("frames.gps"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("frames.gps"));
         let mut s = Scenario::default();
         s.world.start_time_s = i64::MAX;
-        assert!(s.validate().unwrap_err().starts_with("world.start_time_s"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("world.start_time_s"));
         let mut s = Scenario::default();
         s.robot.duration_s = 3_600.0;
         s.lidar.beams = 2_000;
-        assert!(s.validate().unwrap_err().starts_with("lidar.beams × lidar.rate_hz"));
+        let e = s.validate().unwrap_err();
+        assert!(e.field == "lidar.beams" && e.message.contains("lidar.rate_hz × robot.duration_s"), "{e}");
         let mut s = Scenario::default();
         s.odometry.rate_hz = f64::NAN;
-        assert!(s.validate().unwrap_err().starts_with("odometry.rate_hz"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("odometry.rate_hz"));
         let mut s = Scenario::default();
         s.world.objects[6].class = "fence".into();
-        assert!(s.validate().unwrap_err().starts_with("world.objects[6].class"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("world.objects[6].class"));
         let mut s = Scenario::default();
         s.camera.hfov_deg = 180.0;
-        assert!(s.validate().unwrap_err().starts_with("camera.hfov_deg"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("camera.hfov_deg"));
         let mut s = Scenario::default();
         s.camera.backlight.class = "sky".into();
-        assert!(s.validate().unwrap_err().starts_with("camera.backlight.class"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("camera.backlight.class"));
         let mut s = Scenario::default();
         s.camera.width = 4096;
         s.camera.height = 4096;
-        assert!(s.validate().unwrap_err().starts_with("camera.width × camera.height"));
+        let e = s.validate().unwrap_err();
+        assert!(e.field == "camera.width" && e.message.contains("camera.height × camera.rate_hz"), "{e}");
         let mut s = Scenario::default();
         s.person.speed_mps = 0.0;
-        assert!(s.validate().unwrap_err().starts_with("person.speed_mps"));
+        assert!(s.validate().unwrap_err().to_string().starts_with("person.speed_mps"));
     }
 }

@@ -3,21 +3,22 @@
 
 use super::scenario::{finite, non_negative, positive, probability};
 use super::world::Rect;
+use crate::field_error::FieldError;
 use crate::geometry::{Datum, Mount3};
 use serde::{Deserialize, Serialize};
 
-fn check_mount(field: &str, m: &Mount3) -> Result<(), String> {
+fn check_mount(field: &str, m: &Mount3) -> Result<(), FieldError> {
     for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", m.yaw)] {
         finite(&format!("{field}.{k}"), v)?;
     }
     Ok(())
 }
 
-fn check_offset(field: &str, v: f64) -> Result<(), String> {
+fn check_offset(field: &str, v: f64) -> Result<(), FieldError> {
     if v.is_finite() && v.abs() <= 10.0 {
         Ok(())
     } else {
-        Err(format!("{field} must be finite and within ±10 s, got {v}"))
+        Err(FieldError::new(field, format!("must be finite and within ±10 s, got {v}")))
     }
 }
 
@@ -111,26 +112,26 @@ impl LidarConfig {
         }
     }
 
-    pub(crate) fn validate(&self) -> Result<(), String> {
+    pub(crate) fn validate(&self) -> Result<(), FieldError> {
         positive("lidar.rate_hz", self.rate_hz)?;
         if self.rate_hz > 1000.0 {
-            return Err(format!("lidar.rate_hz must be at most 1000, got {}", self.rate_hz));
+            return Err(FieldError::new("lidar.rate_hz", format!("must be at most 1000, got {}", self.rate_hz)));
         }
         if !(1..=100_000).contains(&self.beams) {
-            return Err(format!("lidar.beams must lie in 1..=100000, got {}", self.beams));
+            return Err(FieldError::new("lidar.beams", format!("must lie in 1..=100000, got {}", self.beams)));
         }
         positive("lidar.fov_deg", self.fov_deg)?;
         if self.fov_deg > 360.0 {
-            return Err(format!("lidar.fov_deg must be at most 360, got {}", self.fov_deg));
+            return Err(FieldError::new("lidar.fov_deg", format!("must be at most 360, got {}", self.fov_deg)));
         }
         non_negative("lidar.range_min_m", self.range_min_m)?;
         positive("lidar.range_max_m", self.range_max_m)?;
         if self.range_min_m >= self.range_max_m {
-            return Err("lidar.range_min_m must be below lidar.range_max_m".into());
+            return Err(FieldError::new("lidar.range_min_m", "must be below lidar.range_max_m"));
         }
         non_negative("lidar.sweep_time_s", self.sweep_time_s)?;
         if self.sweep_time_s * self.rate_hz > 1.0 {
-            return Err("lidar.sweep_time_s must not exceed the scan period 1 / lidar.rate_hz".into());
+            return Err(FieldError::new("lidar.sweep_time_s", "must not exceed the scan period 1 / lidar.rate_hz"));
         }
         non_negative("lidar.range_noise_std_m", self.range_noise_std_m)?;
         probability("lidar.glass_pass_probability", self.glass_pass_probability)?;
@@ -139,7 +140,7 @@ impl LidarConfig {
         positive("lidar.edge_jump_m", self.edge_jump_m)?;
         probability("lidar.dropout_probability", self.dropout_probability)?;
         check_mount("lidar.mount", &self.mount)?;
-        self.mount.to_planar(1e-6).map_err(|e| format!("lidar.mount: {e}"))?;
+        self.mount.to_planar(1e-6).map_err(|e| FieldError::new("lidar.mount", e.to_string()))?;
         check_offset("lidar.time_offset_s", self.time_offset_s)
     }
 }
@@ -189,10 +190,13 @@ impl Default for OdometryConfig {
 }
 
 impl OdometryConfig {
-    pub(crate) fn validate(&self) -> Result<(), String> {
+    pub(crate) fn validate(&self) -> Result<(), FieldError> {
         positive("odometry.rate_hz", self.rate_hz)?;
         if self.rate_hz > 200.0 {
-            return Err(format!("odometry.rate_hz must be at most 200 (the truth rate), got {}", self.rate_hz));
+            return Err(FieldError::new(
+                "odometry.rate_hz",
+                format!("must be at most 200 (the truth rate), got {}", self.rate_hz),
+            ));
         }
         positive("odometry.wheel_separation_m", self.wheel_separation_m)?;
         positive("odometry.scale_error", self.scale_error)?;
@@ -247,10 +251,13 @@ impl Default for ImuConfig {
 }
 
 impl ImuConfig {
-    pub(crate) fn validate(&self) -> Result<(), String> {
+    pub(crate) fn validate(&self) -> Result<(), FieldError> {
         positive("imu.rate_hz", self.rate_hz)?;
         if self.rate_hz > 200.0 {
-            return Err(format!("imu.rate_hz must be at most 200 (the truth rate), got {}", self.rate_hz));
+            return Err(FieldError::new(
+                "imu.rate_hz",
+                format!("must be at most 200 (the truth rate), got {}", self.rate_hz),
+            ));
         }
         finite("imu.gyro_bias_radps", self.gyro_bias_radps)?;
         non_negative("imu.gyro_noise_std_radps", self.gyro_noise_std_radps)?;
@@ -367,14 +374,15 @@ impl Default for GnssConfig {
 
 impl GnssConfig {
     /// The map frame's datum.
-    pub fn datum(&self) -> Result<Datum, String> {
-        Datum::new(self.datum_lat_deg, self.datum_lon_deg, self.datum_alt_m).map_err(|e| format!("gnss.datum: {e}"))
+    pub fn datum(&self) -> Result<Datum, FieldError> {
+        Datum::new(self.datum_lat_deg, self.datum_lon_deg, self.datum_alt_m)
+            .map_err(|e| FieldError::new("gnss.datum", e.to_string()))
     }
 
-    pub(crate) fn validate(&self) -> Result<(), String> {
+    pub(crate) fn validate(&self) -> Result<(), FieldError> {
         positive("gnss.rate_hz", self.rate_hz)?;
         if self.rate_hz > 200.0 {
-            return Err(format!("gnss.rate_hz must be at most 200, got {}", self.rate_hz));
+            return Err(FieldError::new("gnss.rate_hz", format!("must be at most 200, got {}", self.rate_hz)));
         }
         self.datum()?;
         check_mount("gnss.mount", &self.mount)?;
@@ -385,7 +393,7 @@ impl GnssConfig {
         non_negative("gnss.outlier_min_m", self.outlier_min_m)?;
         non_negative("gnss.outlier_max_m", self.outlier_max_m)?;
         if self.outlier_min_m > self.outlier_max_m {
-            return Err("gnss.outlier_min_m must not exceed gnss.outlier_max_m".into());
+            return Err(FieldError::new("gnss.outlier_min_m", "must not exceed gnss.outlier_max_m"));
         }
         for (i, z) in self.zones.iter().enumerate() {
             z.area.check(&format!("gnss.zones[{i}].area"))?;

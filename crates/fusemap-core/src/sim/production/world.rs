@@ -1,6 +1,7 @@
 //! The production hall: objects with materials, floor grooves, and a ray caster that
 //! reports which material a beam hit and the surface normal there.
 
+use crate::field_error::FieldError;
 use crate::geometry::Point2;
 use serde::{Deserialize, Serialize};
 
@@ -42,10 +43,13 @@ impl Rect {
         p.x >= self.min[0] && p.x <= self.max[0] && p.y >= self.min[1] && p.y <= self.max[1]
     }
 
-    pub(crate) fn check(&self, field: &str) -> Result<(), String> {
+    pub(crate) fn check(&self, field: &str) -> Result<(), FieldError> {
         let all = [self.min[0], self.min[1], self.max[0], self.max[1]];
         if all.iter().any(|v| !v.is_finite()) || self.min[0] >= self.max[0] || self.min[1] >= self.max[1] {
-            return Err(format!("{field}: a rectangle needs finite min < max, got {:?}..{:?}", self.min, self.max));
+            return Err(FieldError::new(
+                field,
+                format!("a rectangle needs finite min < max, got {:?}..{:?}", self.min, self.max),
+            ));
         }
         Ok(())
     }
@@ -138,22 +142,25 @@ impl WorldObject {
         }
     }
 
-    pub(crate) fn check(&self, field: &str) -> Result<(), String> {
+    pub(crate) fn check(&self, field: &str) -> Result<(), FieldError> {
         if !(self.height_m.is_finite() && self.height_m > 0.0) {
-            return Err(format!("{field}.height_m must be > 0, got {}", self.height_m));
+            return Err(FieldError::new(format!("{field}.height_m"), format!("must be > 0, got {}", self.height_m)));
         }
         match &self.shape {
             Shape::Segment { a, b, thickness_m } => {
                 if a.iter().chain(b).any(|v| !v.is_finite()) || a == b {
-                    return Err(format!("{field}.shape: a segment needs two distinct finite ends"));
+                    return Err(FieldError::new(format!("{field}.shape"), "a segment needs two distinct finite ends"));
                 }
                 if !(thickness_m.is_finite() && *thickness_m >= 0.0) {
-                    return Err(format!("{field}.shape.thickness_m must be >= 0, got {thickness_m}"));
+                    return Err(FieldError::new(
+                        format!("{field}.shape.thickness_m"),
+                        format!("must be >= 0, got {thickness_m}"),
+                    ));
                 }
             }
             Shape::Polygon { points } => {
                 if points.len() < 3 || points.iter().flatten().any(|v| !v.is_finite()) {
-                    return Err(format!("{field}.shape: a polygon needs at least 3 finite points"));
+                    return Err(FieldError::new(format!("{field}.shape"), "a polygon needs at least 3 finite points"));
                 }
             }
         }

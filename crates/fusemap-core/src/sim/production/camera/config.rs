@@ -1,6 +1,7 @@
 //! The camera's table of the scenario (`[camera]`, `[camera.backlight]`).
 
 use super::super::scenario::{finite, non_negative, positive, probability};
+use crate::field_error::FieldError;
 use crate::geometry::{Mount3, Pose3};
 use serde::{Deserialize, Serialize};
 
@@ -183,37 +184,40 @@ impl CameraConfig {
         Pose3::new([m.x, m.y, m.z], m.quaternion()).compose(&Pose3::new([0.0; 3], optical_rotation()))
     }
 
-    pub(crate) fn validate(&self, duration_s: f64) -> Result<(), String> {
+    pub(crate) fn validate(&self, duration_s: f64) -> Result<(), FieldError> {
         for (field, v) in [
             ("camera.label_topic", &self.label_topic),
             ("camera.depth_topic", &self.depth_topic),
             ("camera.info_topic", &self.info_topic),
         ] {
             if v.is_empty() {
-                return Err(format!("{field} must not be empty"));
+                return Err(FieldError::new(field, "must not be empty"));
             }
         }
         positive("camera.rate_hz", self.rate_hz)?;
         if self.rate_hz > 100.0 {
-            return Err(format!("camera.rate_hz must be at most 100, got {}", self.rate_hz));
+            return Err(FieldError::new("camera.rate_hz", format!("must be at most 100, got {}", self.rate_hz)));
         }
         for (field, v) in [("camera.width", self.width), ("camera.height", self.height)] {
             if !(1..=4096).contains(&v) {
-                return Err(format!("{field} must lie in 1..=4096, got {v}"));
+                return Err(FieldError::new(field, format!("must lie in 1..=4096, got {v}")));
             }
         }
         if !(self.hfov_deg.is_finite() && self.hfov_deg > 0.0 && self.hfov_deg < 170.0) {
-            return Err(format!("camera.hfov_deg must lie in (0, 170), got {}", self.hfov_deg));
+            return Err(FieldError::new("camera.hfov_deg", format!("must lie in (0, 170), got {}", self.hfov_deg)));
         }
         let m = &self.mount;
         for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", m.yaw)] {
             finite(&format!("camera.mount.{k}"), v)?;
         }
         if m.z <= 0.0 {
-            return Err(format!("camera.mount.z must be above the floor (> 0), got {}", m.z));
+            return Err(FieldError::new("camera.mount.z", format!("must be above the floor (> 0), got {}", m.z)));
         }
         if !(self.time_offset_s.is_finite() && self.time_offset_s.abs() <= 10.0) {
-            return Err(format!("camera.time_offset_s must be finite and within ±10 s, got {}", self.time_offset_s));
+            return Err(FieldError::new(
+                "camera.time_offset_s",
+                format!("must be finite and within ±10 s, got {}", self.time_offset_s),
+            ));
         }
         positive("camera.max_depth_m", self.max_depth_m)?;
         non_negative("camera.depth_sigma_k", self.depth_sigma_k)?;
@@ -224,14 +228,21 @@ impl CameraConfig {
         non_negative("camera.backlight.half_angle_deg", b.half_angle_deg)?;
         probability("camera.backlight.floor_share", b.floor_share)?;
         if super::class_id(&b.class).is_none() {
-            return Err(format!("camera.backlight.class `{}` is not a class of the table", b.class));
+            return Err(FieldError::new(
+                "camera.backlight.class",
+                format!("`{}` is not a class of the table", b.class),
+            ));
         }
         positive("camera.backlight.blob_scale_px", b.blob_scale_px)?;
         positive("camera.backlight.blob_period_s", b.blob_period_s)?;
         let bytes = f64::from(self.width) * f64::from(self.height) * 6.0 * self.rate_hz * duration_s;
         if self.enabled && bytes > MAX_CAMERA_BYTES {
-            return Err(format!(
-                "camera.width × camera.height × camera.rate_hz × robot.duration_s needs {bytes:.3e} bytes of images, more than the {MAX_CAMERA_BYTES:.0e} a run may hold in memory"
+            return Err(FieldError::new(
+                "camera.width",
+                format!(
+                "needs {bytes:.3e} bytes of images with camera.height × camera.rate_hz × robot.duration_s, more than \
+                 the {MAX_CAMERA_BYTES:.0e} a run may hold in memory"
+            ),
             ));
         }
         Ok(())
