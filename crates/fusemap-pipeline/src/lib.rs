@@ -19,6 +19,7 @@
 //! | the mapping pass | [`run`] |
 //! | the run report | [`report`] |
 //! | the output files and `summary.json` | [`outputs`] |
+//! | a command's arguments checked and resolved into a run | [`job`] |
 //! | the log doctor's figures | [`doctor`] |
 //! | GNSS quality over time, odometry against the gyro | [`pose_sensors_report`] |
 
@@ -30,6 +31,7 @@ pub mod estimation;
 pub mod estimation_report;
 pub mod extrinsics;
 mod insert;
+pub mod job;
 mod lidar_frames;
 mod map_pass;
 pub mod merge;

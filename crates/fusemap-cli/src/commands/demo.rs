@@ -4,15 +4,15 @@
 //! simulator's ground truth and the three are drawn side by side. `--corridor` maps the
 //! document's §3.3 corridor instead.
 
-use crate::commands::world::run_simulated;
 use crate::progress;
 use anyhow::{Context, Result};
-use fusemap_core::config::{Config, Plan};
+use fusemap_core::config::Plan;
 use fusemap_core::fusion::{Engine, MapEntry};
 use fusemap_core::grid::{CellBox, CellIndex, Raster};
 use fusemap_core::sim::production::{simulate, Scenario};
 use fusemap_core::sim::{ScannerSpec, SimulatedRun};
 use fusemap_io::comparison::{write_comparison_png, Panel};
+use fusemap_pipeline::job::MapJob;
 use fusemap_pipeline::outputs::{self, finish, layers_of, ExportOptions, OutputFiles, RunRecord};
 use fusemap_pipeline::recording::Inventory;
 use fusemap_pipeline::scenario::{production_line_plan, score, three_maps, MapScore, Truth};
@@ -28,19 +28,10 @@ fn plan_of(config: Option<&Path>, default: impl FnOnce() -> Result<Plan>) -> Res
 
 /// `fusemap demo --corridor`: the design document's corridor with the default config.
 pub fn corridor(out: &Path, config: Option<&Path>) -> Result<()> {
-    let plan = plan_of(config, || Config::default().validate().map_err(|e| anyhow::anyhow!("configuration: {e}")))?;
     let run = SimulatedRun::document_corridor();
-    let inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
-    let summary = run_simulated(
-        &plan,
-        &ExportOptions { crop: None, export_cells: plan.limits.export_cells },
-        &fusemap_core::sim::corridor(),
-        &ScannerSpec::document(),
-        run.poses,
-        out,
-        "built-in corridor (design document §3.3)",
-        &inputs,
-    )?;
+    let name = "built-in corridor (design document §3.3)";
+    let job = MapJob::world(config, fusemap_core::sim::corridor(), ScannerSpec::document(), run.poses, name, out)?;
+    let summary = job.run(&mut progress::reporter())?;
     print!("{summary}");
     println!("outputs       {}", out.display());
     Ok(())

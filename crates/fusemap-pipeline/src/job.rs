@@ -1,0 +1,219 @@
+//! The plan step between a command's flags and its run (as ripgrep turns its low-level
+//! arguments into high-level ones before searching): everything a map run needs is read,
+//! validated and resolved here, once — the configuration into a [`Plan`], a world file
+//! into walls and poses, `--crop` checked against the grid and `[limits]`, the files the
+//! run reads listed so no output overwrites one — and a [`MapJob`] comes out. Running it
+//! ([`MapJob::run`]) maps and writes the output set ([`crate::outputs`]) and returns the
+//! summary. A front end (the CLI, a Python binding, a calibration search) builds jobs and
+//! runs them; it keeps only its flags, its progress display and its exit codes.
+
+use crate::outputs::{crop_area, finish, prepare, Crop, ExportOptions, OutputError, RunRecord, Summary};
+use crate::{PipelineError, Progress};
+use fusemap_core::config::{Config, FieldError, Plan};
+use fusemap_core::geometry::Pose2;
+use fusemap_core::sim::{ScannerSpec, World};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Why a job could not be planned or run. Each message names the file or the input it is
+/// about.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    /// A file could not be read or is not valid (the error names it, and the line).
+    #[error(transparent)]
+    Read(#[from] fusemap_io::Error),
+    /// The built-in configuration is not valid (a `[limits]` or `[map]` default changed
+    /// without its checks).
+    #[error("configuration: {0}")]
+    Config(FieldError),
+    /// The outputs cannot be written, or `--crop` names no exportable region.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// The arguments ask for no run or for two at once.
+    #[error("{0}")]
+    Arguments(String),
+    /// The run's report could not be put into `summary.json`.
+    #[error("cannot write the run report as JSON: {0}")]
+    Report(#[from] serde_json::Error),
+    /// The mapping refused or failed; `input` names the log or the world.
+    #[error("{input}: {error}")]
+    Run {
+        /// The log or the world.
+        input: String,
+        /// Why.
+        error: PipelineError,
+    },
+}
+
+/// The validated plan of a configuration file, or of the built-in defaults without one:
+/// the file is read and validated once (its errors name the file and the line).
+pub fn plan_of(config: Option<&Path>) -> Result<Plan, JobError> {
+    match config {
+        Some(p) => Ok(fusemap_io::config_file::load_plan(p)?),
+        None => Config::default().validate().map_err(JobError::Config),
+    }
+}
+
+/// What a map run maps.
+pub enum MapSource {
+    /// A robot log (CARMEN, ROS 1 bag, MCAP, rosbag2 directory), recognised by its content.
+    Log(PathBuf),
+    /// A simulated run: `scanner` in `world` from each of `poses`; `name` says what it is
+    /// in the summary and in errors.
+    World {
+        /// The walls.
+        world: World,
+        /// The simulated scanner.
+        scanner: ScannerSpec,
+        /// `world_from_base` of each scan, in order.
+        poses: Vec<Pose2>,
+        /// The world file, or the built-in world's name.
+        name: String,
+    },
+}
+
+/// One map run, planned: a log or a world mapped with `plan` into `out`.
+pub struct MapJob {
+    /// The validated configuration.
+    pub plan: Plan,
+    /// What is mapped.
+    pub source: MapSource,
+    /// The output directory.
+    pub out: PathBuf,
+    /// The view of the map to write.
+    pub export: ExportOptions,
+    /// Every file the run reads (configuration, world, log): no output may replace one.
+    pub inputs: Vec<PathBuf>,
+}
+
+impl MapJob {
+    /// `fusemap map`: a world file (simulated) or a log, not both, with `config` (or the
+    /// defaults); `crop` is checked now, before hours of mapping could end in its refusal.
+    pub fn plan(
+        config: Option<&Path>,
+        world: Option<&Path>,
+        log: Option<&Path>,
+        out: &Path,
+        crop: Option<Crop>,
+    ) -> Result<Self, JobError> {
+        let plan = plan_of(config)?;
+        let export = ExportOptions { crop, export_cells: plan.limits.export_cells };
+        if let Some(c) = &crop {
+            crop_area(&plan.geometry, c, export.export_cells)?;
+        }
+        let mut inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
+        let source = match (world, log) {
+            (Some(w), None) => {
+                inputs.push(w.to_path_buf());
+                let wf = fusemap_io::world_file::load_world_with(w, &plan.limits)?;
+                let name = w.display().to_string();
+                MapSource::World { world: wf.world, scanner: wf.scanner, poses: wf.poses, name }
+            }
+            (None, Some(l)) => {
+                inputs.push(l.to_path_buf());
+                MapSource::Log(l.to_path_buf())
+            }
+            (Some(_), Some(_)) => {
+                return Err(JobError::Arguments("give either --world FILE or a LOG, not both".into()))
+            }
+            (None, None) => {
+                return Err(JobError::Arguments(
+                    "nothing to map: give a LOG (CARMEN, ROS 1 bag, MCAP, rosbag2 directory) or --world FILE".into(),
+                ))
+            }
+        };
+        Ok(Self { plan, source, out: out.to_path_buf(), export, inputs })
+    }
+
+    /// A built-in world (`fusemap demo --corridor`) with `config` (or the defaults).
+    pub fn world(
+        config: Option<&Path>,
+        world: World,
+        scanner: ScannerSpec,
+        poses: Vec<Pose2>,
+        name: &str,
+        out: &Path,
+    ) -> Result<Self, JobError> {
+        let plan = plan_of(config)?;
+        let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
+        let inputs = config.map(Path::to_path_buf).into_iter().collect();
+        let source = MapSource::World { world, scanner, poses, name: name.to_string() };
+        Ok(Self { plan, source, out: out.to_path_buf(), export, inputs })
+    }
+
+    /// Maps and writes the output set; the summary, as `summary.json` has it.
+    pub fn run(self, progress: &mut dyn FnMut(Progress)) -> Result<Summary, JobError> {
+        let started = Instant::now();
+        let outputs = prepare(&self.out, &self.inputs)?;
+        match &self.source {
+            MapSource::Log(path) => {
+                let input = path.display().to_string();
+                // fusemap-io errors already name the file (and the line or message); the
+                // engine's refusals (a map past limits.map_cells) and the pipeline's (a log
+                // with no scans, a lidar topic the log lacks) do not: named here.
+                let run = crate::map_log(&self.plan, path, progress).map_err(|error| match error {
+                    PipelineError::Read(e) => JobError::Read(e),
+                    error => JobError::Run { input: input.clone(), error },
+                })?;
+                let log = Some(serde_json::to_value(&run.report)?);
+                let record = RunRecord {
+                    source_kind: &run.format.to_string(),
+                    source: &input,
+                    started,
+                    notes: run.notes,
+                    log,
+                    trajectory: Some(&run.trajectory),
+                };
+                Ok(finish(&run.engine, outputs, &self.export, record)?)
+            }
+            MapSource::World { world, scanner, poses, name } => {
+                let run = crate::world::map_world(&self.plan, world, scanner, poses, progress)
+                    .map_err(|error| JobError::Run { input: name.clone(), error })?;
+                let record = RunRecord {
+                    source_kind: "world",
+                    source: name,
+                    started,
+                    notes: run.notes,
+                    log: None,
+                    trajectory: None,
+                };
+                Ok(finish(&run.engine, outputs, &self.export, record)?)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn map_arguments_are_refused_before_anything_runs() {
+        let dir = fusemap_io::testdata::temp_dir("job-plan");
+        let out = dir.join("out");
+        let e = MapJob::plan(None, None, None, &out, None).err().unwrap().to_string();
+        assert!(e.starts_with("nothing to map"), "{e}");
+        let (w, l) = (dir.join("w.toml"), dir.join("l.log"));
+        let e = MapJob::plan(None, Some(&w), Some(&l), &out, None).err().unwrap().to_string();
+        assert!(e.contains("not both"), "{e}");
+        let huge = crate::outputs::parse_crop("0,0,1000,1000").unwrap();
+        let e = MapJob::plan(None, None, Some(&l), &out, Some(huge)).err().unwrap().to_string();
+        assert!(e.contains("limits.export_cells"), "{e}");
+        assert!(!out.exists(), "planning wrote nothing");
+        let job = MapJob::plan(None, None, Some(&l), &out, None).unwrap();
+        assert!(matches!(&job.source, MapSource::Log(p) if p == &l));
+        assert_eq!(job.inputs, [l]);
+    }
+
+    #[test]
+    fn a_world_job_maps_and_writes_its_set() {
+        let dir = fusemap_io::testdata::temp_dir("job-world");
+        let out = dir.join("out");
+        let poses: Vec<Pose2> = (0..40).map(|i| Pose2::new(0.1 * f64::from(i), 0.0, 0.0)).collect();
+        let job = MapJob::world(None, fusemap_core::sim::corridor(), ScannerSpec::document(), poses, "corridor", &out)
+            .unwrap();
+        let summary = job.run(&mut |_| {}).unwrap();
+        assert_eq!((summary.scans, summary.source.as_str()), (40, "corridor"));
+        assert!(out.join("map.npz").is_file() && out.join("summary.json").is_file());
+    }
+}
