@@ -1,6 +1,6 @@
 //! A run's outputs, as a robotics user loads them: the view of the map to write
 //! ([`view`]), the output set staged and committed whole ([`set`]), the writers and the
-//! summary ([`write`], [`summary`]). Every command that writes a map (`map`, `demo`, the
+//! summary ([`write`](mod@write), [`summary`]). Every command that writes a map (`map`, `demo`, the
 //! validation and calibration runs to come) goes through [`finish`], so the files and
 //! `summary.json`'s schema are the same whichever command made them.
 
