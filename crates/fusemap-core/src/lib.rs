@@ -14,7 +14,7 @@
 //! | the engine taking time-ordered measurements | [`fusion`] |
 //! | the `map → base_link` track from odometry, gyro, GNSS (EKF + RTS smoother) | [`estimator`] |
 //! | entropy, precision / recall, SLAM-benchmark relations (Kümmerle et al. 2009) | [`metrics`] |
-//! | simulated worlds and scanners, the production-line simulator | [`sim`] |
+//! | simulated worlds and scanners (the production-line simulator is `fusemap-sim`) | [`sim`] |
 //! | the validated run configuration | [`config`] |
 //!
 //! ```

@@ -66,7 +66,7 @@ pub fn parse_plan_str(text: &str, path: &Path) -> Result<(Config, Plan)> {
 }
 
 /// Reads a UTF-8 text file; invalid UTF-8 is a format error at the line where it starts.
-pub(crate) fn read_text(path: &Path) -> Result<String> {
+pub fn read_text(path: &Path) -> Result<String> {
     crate::input_file::refuse_special_file(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     String::from_utf8(bytes).map_err(|e| {
@@ -84,7 +84,7 @@ pub(crate) fn line_of(text: &[u8], offset: usize) -> u64 {
 
 /// Turns a `toml` error into an [`Error::Format`] at the line its span starts on, with
 /// the message reduced to one line.
-pub(crate) fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
+pub fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
     let location = match e.span() {
         Some(span) => Location::Line(line_of(text.as_bytes(), span.start)),
         None => Location::File,
@@ -108,7 +108,7 @@ fn one_line(message: &str) -> String {
 
 /// A validation error on `field` (a TOML path such as `lidar[0].p_occ`), located at the
 /// field's line when the file writes it.
-pub(crate) fn field_error(path: &Path, text: &str, field: &str, message: String) -> Error {
+pub fn field_error(path: &Path, text: &str, field: &str, message: String) -> Error {
     let location = match field_line(text, field) {
         Some(line) => Location::LineField(line, field.to_string()),
         None => Location::Field(field.to_string()),

@@ -21,7 +21,6 @@ pub mod read_ahead;
 pub mod relations;
 pub mod scanfile;
 pub mod semantic;
-pub mod simulation;
 pub mod slam_picture;
 pub mod text;
 pub mod trajectory;

@@ -9,13 +9,13 @@ use anyhow::{Context, Result};
 use fusemap_core::config::Plan;
 use fusemap_core::fusion::{Engine, MapEntry};
 use fusemap_core::grid::{CellBox, CellIndex, Raster};
-use fusemap_core::sim::production::{simulate, Scenario};
 use fusemap_core::sim::{ScannerSpec, SimulatedRun};
 use fusemap_io::comparison::{write_comparison_png, Panel};
 use fusemap_pipeline::job::MapJob;
 use fusemap_pipeline::outputs::{self, finish, layers_of, ExportOptions, OutputFiles, RunRecord};
 use fusemap_pipeline::recording::Inventory;
 use fusemap_pipeline::scenario::{production_line_plan, score, three_maps, MapScore, Truth};
+use fusemap_sim::{simulate, Scenario};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -48,7 +48,7 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     // comparison — is staged in the one output set and moves into `out` at its commit.
     files.own_dir("sim");
     let sim_dir = files.staged("sim");
-    let sim = fusemap_io::simulation::write_simulation(&rec, &sim_dir, plan.geometry.resolution(), true)
+    let sim = fusemap_sim::bag::write_simulation(&rec, &sim_dir, plan.geometry.resolution(), true)
         .with_context(|| format!("writing the simulation to {}", sim_dir.display()))?;
     let inv = Inventory::read_with(&sim.bag.dir, &plan.limits)?;
     let (bound, chosen, track_s) = fusemap_pipeline::run::prepare(&plan, &inv)?;
@@ -135,7 +135,7 @@ fn write_comparison(
     path: &Path,
     engine: &Engine,
     scores: &[MapScore],
-    truth: &fusemap_core::sim::production::TruthRaster,
+    truth: &fusemap_sim::TruthRaster,
     plan: &Plan,
 ) -> Result<()> {
     let area = CellBox {

@@ -2,21 +2,21 @@
 //! a scenario file's world) recorded as a rosbag2 bag, with its ground truth beside it.
 
 use anyhow::{Context, Result};
-use fusemap_core::sim::production::{simulate, Scenario};
+use fusemap_sim::{simulate, Scenario};
 use std::path::Path;
 
 /// Runs the simulator and writes `DIR/bag`, `DIR/truth.yaml` + `.pgm`,
 /// `DIR/truth_semantic.yaml` + `.png`, `DIR/truth.tum`.
 pub fn run(scenario: Option<&Path>, out: &Path, resolution: f64, overwrite: bool) -> Result<()> {
     let s = match scenario {
-        Some(p) => fusemap_io::simulation::load_scenario(p)?,
+        Some(p) => fusemap_sim::bag::load_scenario(p)?,
         None => Scenario::default(),
     };
     if let Some(p) = scenario {
         fusemap_io::atomic::ensure_not_input(&out.join("bag"), &[p.to_path_buf()])?;
     }
     let rec = simulate(&s).map_err(|e| anyhow::anyhow!("scenario: {e}"))?;
-    let files = fusemap_io::simulation::write_simulation(&rec, out, resolution, overwrite)
+    let files = fusemap_sim::bag::write_simulation(&rec, out, resolution, overwrite)
         .with_context(|| format!("writing the simulation to {}", out.display()))?;
     println!("bag           {} ({} messages)", files.bag.dir.display(), files.bag.message_count);
     for t in &files.bag.topics {

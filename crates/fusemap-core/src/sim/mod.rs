@@ -1,9 +1,9 @@
 //! Simulated worlds and scanners: the design document's corridor (§3.1) and the larger
-//! worlds benchmarks and tests need, with exact ground truth.
+//! worlds benchmarks and tests need, with exact ground truth. (The production-line
+//! simulator, with every sensor and its faults, is the `fusemap-sim` crate.)
 
 pub mod camera_frame;
 mod odometry_drift;
-pub mod production;
 mod rng;
 mod scanner;
 mod workloads;

@@ -3,5 +3,4 @@
 
 mod corridor;
 mod invalid_returns;
-mod lidar_faults;
 mod sync;

@@ -4,8 +4,8 @@
 //! still maps, and never panics.
 
 use fusemap_core::config::{Config, SensorConfig, SensorKind};
-use fusemap_core::sim::production::{simulate, Scenario, SimMessage, SimRecording, SimStaticTransform};
 use fusemap_pipeline::map_log;
+use fusemap_sim::{simulate, Scenario, SimMessage, SimRecording, SimStaticTransform};
 
 fn short_run() -> SimRecording {
     let mut s = Scenario::default();
@@ -20,7 +20,7 @@ fn map(
 ) -> Result<fusemap_pipeline::MapRun, fusemap_pipeline::PipelineError> {
     let dir = fusemap_io::testdata::temp_dir(tag);
     let bag = dir.join("bag");
-    fusemap_io::simulation::write_bag(rec, &bag, true).expect("the bag is written");
+    fusemap_sim::bag::write_bag(rec, &bag, true).expect("the bag is written");
     let plan = cfg.validate().expect("valid config");
     map_log(&plan, &bag, &mut |_| {})
 }

@@ -2,13 +2,13 @@
 //! holes, an unsupported encoding, frames without a pose, a missing or late CameraInfo,
 //! a distorted one. Each is a counted skip or one clear error, never a panic.
 
-use fusemap_core::sim::production::{simulate, Scenario, SimMessage, SimRecording};
 use fusemap_core::time::Stamp;
 use fusemap_pipeline::camera::CameraReport;
 use fusemap_pipeline::recording::Inventory;
 use fusemap_pipeline::run::map_inventory;
 use fusemap_pipeline::scenario::production_line_plan;
 use fusemap_pipeline::PipelineError;
+use fusemap_sim::{simulate, Scenario, SimMessage, SimRecording};
 
 fn short() -> SimRecording {
     let mut s = Scenario::default();
@@ -20,7 +20,7 @@ fn short() -> SimRecording {
 fn run(name: &str, rec: &SimRecording) -> Result<fusemap_pipeline::MapRun, PipelineError> {
     let dir = fusemap_io::testdata::temp_dir(name);
     let bag = dir.join("bag");
-    fusemap_io::simulation::write_bag(rec, &bag, true).unwrap();
+    fusemap_sim::bag::write_bag(rec, &bag, true).unwrap();
     let inv = Inventory::read(&bag).unwrap();
     map_inventory(&production_line_plan().unwrap(), &inv, &mut |_| {})
 }
@@ -30,12 +30,7 @@ fn camera(run: &fusemap_pipeline::MapRun) -> &CameraReport {
 }
 
 /// Applies `f` to every `k`-th image of `topic`.
-fn every(
-    rec: &mut SimRecording,
-    topic: &str,
-    k: usize,
-    mut f: impl FnMut(&mut fusemap_core::sim::production::SimImage),
-) -> usize {
+fn every(rec: &mut SimRecording, topic: &str, k: usize, mut f: impl FnMut(&mut fusemap_sim::SimImage)) -> usize {
     let mut n = 0;
     for m in rec.messages.iter_mut() {
         if let SimMessage::Image(i) = m {
@@ -97,7 +92,7 @@ fn frames_without_a_pose_are_counted() {
     let last = rec.messages.iter().map(|m| m.stamp()).max().unwrap();
     // The last three label and depth images are stamped a minute after the log ends.
     for topic in ["/camera/labels", "/camera/depth"] {
-        let mut imgs: Vec<&mut fusemap_core::sim::production::SimImage> = rec
+        let mut imgs: Vec<&mut fusemap_sim::SimImage> = rec
             .messages
             .iter_mut()
             .filter_map(|m| match m {
@@ -149,7 +144,7 @@ fn a_camera_on_the_usual_topics_is_found_and_can_be_switched_off() {
     let rec = short();
     let dir = fusemap_io::testdata::temp_dir("camera-auto");
     let bag = dir.join("bag");
-    fusemap_io::simulation::write_bag(&rec, &bag, true).unwrap();
+    fusemap_sim::bag::write_bag(&rec, &bag, true).unwrap();
     let inv = Inventory::read(&bag).unwrap();
     let plan = Config::default().validate().unwrap();
     let r = map_inventory(&plan, &inv, &mut |_| {}).unwrap();

@@ -5,12 +5,12 @@
 //! poses) and scored against the simulator's ground truth.
 
 use fusemap_core::grid::Ternary;
-use fusemap_core::sim::production::{simulate, Scenario, SimRecording};
 use fusemap_core::time::Stamp;
 use fusemap_pipeline::recording::Inventory;
 use fusemap_pipeline::run::prepare;
 use fusemap_pipeline::scenario::{production_line_plan, score, three_maps, MapScore, Truth};
 use fusemap_pipeline::{map_with_track, MapRun};
+use fusemap_sim::{simulate, Scenario, SimRecording};
 use std::sync::OnceLock;
 
 struct Fixture {
@@ -44,7 +44,7 @@ fn fixture() -> &'static Fixture {
         let rec = simulate(&Scenario::default()).expect("the default scenario simulates");
         let dir = fusemap_io::testdata::temp_dir("camera-scenario");
         let bag = dir.join("bag");
-        fusemap_io::simulation::write_bag(&rec, &bag, true).expect("the bag is written");
+        fusemap_sim::bag::write_bag(&rec, &bag, true).expect("the bag is written");
         let plan = production_line_plan().unwrap();
         let run = map(&bag, &plan, three_maps(&plan));
         let scores = scores_of(&rec, &run, &plan);
@@ -160,7 +160,7 @@ fn an_uncorrected_camera_clock_offset_misplaces_the_classes() {
     let rec = simulate(&scenario).unwrap();
     let dir = fusemap_io::testdata::temp_dir("camera-offset");
     let bag = dir.join("bag");
-    fusemap_io::simulation::write_bag(&rec, &bag, true).unwrap();
+    fusemap_sim::bag::write_bag(&rec, &bag, true).unwrap();
     let accuracy = |offset: f64| {
         let mut plan = production_line_plan().unwrap();
         plan.cameras[0].time_offset_s = offset;

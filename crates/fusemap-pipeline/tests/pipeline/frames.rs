@@ -2,13 +2,13 @@
 //! odometry's `odom → base_link`, the track is their composition at each scan's stamp.
 
 use fusemap_core::config::{Config, PoseSource};
-use fusemap_core::sim::production::{simulate, Scenario, SimMessage};
 use fusemap_io::log::ros2::msgs::geometry_msgs::{Transform, TransformStamped};
 use fusemap_io::log::ros2::msgs::std_msgs::Header;
 use fusemap_io::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions};
-use fusemap_io::simulation::to_out_message;
 use fusemap_io::testdata::TestPath;
 use fusemap_pipeline::map_log;
+use fusemap_sim::bag::to_out_message;
+use fusemap_sim::{simulate, Scenario, SimMessage};
 
 fn tf(stamp: fusemap_core::time::Stamp, parent: &str, child: &str, x: f64, y: f64, yaw: f64) -> OutMessage {
     OutMessage::Tf {

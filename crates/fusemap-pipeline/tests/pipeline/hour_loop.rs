@@ -10,8 +10,8 @@
 
 use fusemap_core::geometry::Pose2;
 use fusemap_core::metrics::{absolute_trajectory_error, revisit_relations, score_index_relations, RevisitRule};
-use fusemap_core::sim::production::{simulate, Scenario};
 use fusemap_pipeline::recording::Inventory;
+use fusemap_sim::{simulate, Scenario};
 use std::path::Path;
 use std::time::Instant;
 
@@ -39,7 +39,7 @@ fn an_hour_of_laps_with_odometry_and_lidar_only_keeps_revisits_within_10_cm() {
     let rec = simulate(&scenario).expect("the scenario simulates");
     let dir = fusemap_io::testdata::temp_dir("hour-loop");
     let bag = dir.join("bag");
-    fusemap_io::simulation::write_bag(&rec, &bag, true).expect("the bag is written");
+    fusemap_sim::bag::write_bag(&rec, &bag, true).expect("the bag is written");
     let inv = Inventory::read(&bag).expect("the bag reads back");
     let cfg = fusemap_io::config_file::parse_config_str(CONFIG, Path::new("hour_loop.toml")).expect("config");
     let plan = cfg.validate().expect("valid config");

@@ -15,12 +15,12 @@ use fusemap_core::estimator::{estimate, Estimate};
 use fusemap_core::geometry::Pose2;
 use fusemap_core::grid::{CellIndex, GridGeometry};
 use fusemap_core::metrics::TolerantScore;
-use fusemap_core::sim::production::{simulate, Scenario, SimRecording};
 use fusemap_core::time::{InFrame, PoseBuffer, PoseTrack, Stamp, SyncMode};
 use fusemap_pipeline::recording::Inventory;
 use fusemap_pipeline::run::{prepare, prepare_track, topics_by_kind};
 use fusemap_pipeline::track::{ChosenTrack, Track};
 use fusemap_pipeline::{estimation, map_with_track, sensors};
+use fusemap_sim::{simulate, Scenario, SimRecording};
 use std::collections::HashSet;
 use std::sync::OnceLock;
 
@@ -38,7 +38,7 @@ fn fixture() -> &'static Fixture {
         let rec = simulate(&scenario).expect("the default scenario simulates");
         let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), "production-line");
         let bag = dir.join("bag");
-        fusemap_io::simulation::write_bag(&rec, &bag, true).expect("the bag is written");
+        fusemap_sim::bag::write_bag(&rec, &bag, true).expect("the bag is written");
         let inv = Inventory::read(&bag).expect("the bag reads back");
         let mut cfg = Config::default();
         // The map frame of the simulator: ENU at its datum.

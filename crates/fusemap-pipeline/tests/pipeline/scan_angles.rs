@@ -3,10 +3,10 @@
 //! disagrees with `angle_min … angle_max` (drawn over another field of view).
 
 use fusemap_core::config::{Config, SlamMode};
-use fusemap_core::sim::production::{simulate, Scenario, SimMessage};
 use fusemap_io::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions};
-use fusemap_io::simulation::to_out_message;
 use fusemap_pipeline::map_log;
+use fusemap_sim::bag::to_out_message;
+use fusemap_sim::{simulate, Scenario, SimMessage};
 
 #[test]
 fn scans_with_inconsistent_angles_are_refused_and_counted() {

@@ -7,10 +7,10 @@
 
 use fusemap_core::config::{Config, SlamMode};
 use fusemap_core::grid::{CellIndex, Ternary};
-use fusemap_core::sim::production::{simulate, Scenario, SimMessage};
 use fusemap_io::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions};
-use fusemap_io::simulation::to_out_message;
 use fusemap_pipeline::map_log;
+use fusemap_sim::bag::to_out_message;
+use fusemap_sim::{simulate, Scenario, SimMessage};
 use std::collections::HashSet;
 use std::f64::consts::PI;
 use std::path::Path;

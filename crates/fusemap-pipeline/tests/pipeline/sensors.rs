@@ -3,8 +3,8 @@
 //! `time_offset_s` moves its scans in time.
 
 use fusemap_core::config::{Config, PoseSource, SensorConfig, SensorKind};
-use fusemap_core::sim::production::{simulate, Scenario, SimMessage};
 use fusemap_pipeline::{map_log, PipelineError};
+use fusemap_sim::{simulate, Scenario, SimMessage};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
@@ -31,7 +31,7 @@ fn bag() -> &'static PathBuf {
         rec.messages.sort_by_key(|m| m.stamp());
         let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), "sensor-tables");
         let bag = dir.join("bag");
-        fusemap_io::simulation::write_bag(&rec, &bag, true).expect("written");
+        fusemap_sim::bag::write_bag(&rec, &bag, true).expect("written");
         bag
     })
 }

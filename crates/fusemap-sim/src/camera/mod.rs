@@ -23,9 +23,9 @@ use super::messages::{SimCameraInfo, SimImage, SimMessage, SimStaticTransform};
 use super::path::Trajectory;
 use super::person::PersonConfig;
 use super::world::{Caster, WorldObject};
-use crate::geometry::{normalize_angle, Point2, Pose2};
-use crate::sim::SplitMix64;
-use crate::time::Stamp;
+use fusemap_core::geometry::{normalize_angle, Point2, Pose2};
+use fusemap_core::sim::SplitMix64;
+use fusemap_core::time::Stamp;
 use render::{Frame, Renderer};
 
 /// Class id of unlabelled pixels.

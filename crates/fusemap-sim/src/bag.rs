@@ -5,20 +5,20 @@
 //! cell as a palette PNG + YAML, and the true trajectory as TUM.
 //!
 //! Scenario files are TOML mapping one to one onto
-//! [`fusemap_core::sim::production::Scenario`]; unknown keys are errors naming their line.
+//! [`crate::Scenario`]; unknown keys are errors naming their line.
 
-use crate::config_file::{field_error, read_text, toml_error};
-use crate::log::ros2::msgs::geometry_msgs::{
-    Pose, PoseWithCovariance, Transform, TransformStamped, Twist, TwistWithCovariance,
-};
-use crate::log::ros2::msgs::nav_msgs::Odometry;
-use crate::log::ros2::msgs::sensor_msgs::{CameraInfo, Image, Imu, LaserScan, NavSatFix, NavSatStatus};
-use crate::log::ros2::msgs::std_msgs::Header;
-use crate::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions, WrittenBag};
-use crate::Result;
+use crate::{Scenario, SimMessage, SimRecording, TruthSemantic, CLASS_COLORS, CLASS_NAMES};
 use fusemap_core::grid::logodds::logit;
 use fusemap_core::grid::{GridGeometry, OccupancyParams, Raster};
-use fusemap_core::sim::production::{Scenario, SimMessage, SimRecording, TruthSemantic, CLASS_COLORS, CLASS_NAMES};
+use fusemap_io::config_file::{field_error, read_text, toml_error};
+use fusemap_io::log::ros2::msgs::geometry_msgs::{
+    Pose, PoseWithCovariance, Transform, TransformStamped, Twist, TwistWithCovariance,
+};
+use fusemap_io::log::ros2::msgs::nav_msgs::Odometry;
+use fusemap_io::log::ros2::msgs::sensor_msgs::{CameraInfo, Image, Imu, LaserScan, NavSatFix, NavSatStatus};
+use fusemap_io::log::ros2::msgs::std_msgs::Header;
+use fusemap_io::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions, WrittenBag};
+use fusemap_io::Result;
 use std::path::{Path, PathBuf};
 
 /// Reads and validates a scenario file.
@@ -100,7 +100,7 @@ pub fn to_out_message(m: &SimMessage) -> OutMessage {
     }
 }
 
-fn transform(t: &fusemap_core::sim::production::SimStaticTransform) -> TransformStamped {
+fn transform(t: &crate::SimStaticTransform) -> TransformStamped {
     TransformStamped {
         header: Header { stamp: t.stamp, frame_id: t.frame_id.clone() },
         child_frame_id: t.child_frame_id.clone(),
@@ -156,7 +156,7 @@ pub fn truth_raster(rec: &SimRecording, geometry: GridGeometry) -> Option<Raster
 /// map_server's) and the classes. Returns the YAML's path.
 pub fn write_truth_semantic(yaml_path: &Path, t: &TruthSemantic) -> Result<PathBuf> {
     let png_path = yaml_path.with_extension("png");
-    let fail = |m: String| crate::Error::format(yaml_path, crate::Location::File, m);
+    let fail = |m: String| fusemap_io::Error::format(yaml_path, fusemap_io::Location::File, m);
     let (Ok(w), Ok(h)) = (u32::try_from(t.width), u32::try_from(t.height)) else {
         return Err(fail(format!("a {} × {} raster is too large for PNG", t.width, t.height)));
     };
@@ -168,7 +168,7 @@ pub fn write_truth_semantic(yaml_path: &Path, t: &TruthSemantic) -> Result<PathB
         .and_then(|n| n.to_str())
         .ok_or_else(|| fail("the image's file name is not valid UTF-8".into()))?
         .to_string();
-    crate::atomic::write_atomic(&png_path, |out| {
+    fusemap_io::atomic::write_atomic(&png_path, |out| {
         let mut e = png::Encoder::new(out, w, h);
         e.set_color(png::ColorType::Indexed);
         e.set_depth(png::BitDepth::Eight);
@@ -192,7 +192,7 @@ pub fn write_truth_semantic(yaml_path: &Path, t: &TruthSemantic) -> Result<PathB
     for (id, (n, c)) in CLASS_NAMES.iter().zip(CLASS_COLORS).enumerate() {
         yaml += &format!("  - {{id: {id}, name: {n}, color: [{}, {}, {}]}}\n", c[0], c[1], c[2]);
     }
-    crate::atomic::write_atomic(yaml_path, |out| std::io::Write::write_all(out, yaml.as_bytes()))?;
+    fusemap_io::atomic::write_atomic(yaml_path, |out| std::io::Write::write_all(out, yaml.as_bytes()))?;
     Ok(yaml_path.to_path_buf())
 }
 
@@ -212,10 +212,10 @@ pub struct SimulationFiles {
 /// the true classes (`out/truth_semantic.yaml` + `.png`) and the true trajectory
 /// (`out/truth.tum`).
 pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwrite: bool) -> Result<SimulationFiles> {
-    std::fs::create_dir_all(out).map_err(|e| crate::Error::io(out, e))?;
+    std::fs::create_dir_all(out).map_err(|e| fusemap_io::Error::io(out, e))?;
     let bag = write_bag(rec, &out.join("bag"), overwrite)?;
     let truth_map = match GridGeometry::centered(resolution).ok().and_then(|g| truth_raster(rec, g)) {
-        Some(r) => Some(crate::map_server::write_map_server(&out.join("truth.yaml"), &r)?),
+        Some(r) => Some(fusemap_io::map_server::write_map_server(&out.join("truth.yaml"), &r)?),
         None => None,
     };
     let truth_semantic = match GridGeometry::centered(resolution).ok().and_then(|g| rec.truth_semantic(g).ok()) {
@@ -223,7 +223,7 @@ pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwri
         None => None,
     };
     let truth_trajectory = out.join("truth.tum");
-    crate::trajectory::write_tum(&truth_trajectory, &rec.truth_trajectory)?;
+    fusemap_io::trajectory::write_tum(&truth_trajectory, &rec.truth_trajectory)?;
     Ok(SimulationFiles { bag, truth_map, truth_semantic, truth_trajectory })
 }
 
@@ -239,7 +239,7 @@ mod tests {
 
     #[test]
     fn scenario_files_fill_defaults_and_name_bad_keys_and_fields() {
-        let dir = crate::testdata::temp_dir("scenario");
+        let dir = fusemap_io::testdata::temp_dir("scenario");
         let s = load_scenario(&write(&dir, "short.toml", "[robot]\nduration_s = 30.0\n")).unwrap();
         assert_eq!(s.robot.duration_s, 30.0);
         assert_eq!(s.lidar, Scenario::default().lidar);
@@ -254,8 +254,8 @@ mod tests {
         let cam = "[camera]\ndepth_encoding = \"16UC1\"\nlabel_encoding = \"mono16\"\ntime_offset_s = 0.04\n\
                    [camera.backlight]\nfloor_share = 0.4\n[person]\nwindows = [[0.0, 30.0]]\n";
         let s = load_scenario(&write(&dir, "camera.toml", cam)).unwrap();
-        assert_eq!(s.camera.depth_encoding, fusemap_core::sim::production::DepthEncoding::U16Millimetres);
-        assert_eq!(s.camera.label_encoding, fusemap_core::sim::production::LabelEncoding::Mono16);
+        assert_eq!(s.camera.depth_encoding, crate::DepthEncoding::U16Millimetres);
+        assert_eq!(s.camera.label_encoding, crate::LabelEncoding::Mono16);
         assert_eq!((s.camera.time_offset_s, s.camera.backlight.floor_share), (0.04, 0.4));
         assert_eq!((s.person.windows.clone(), s.camera.width), (vec![[0.0, 30.0]], 320));
         let e =
@@ -268,8 +268,8 @@ mod tests {
         let mut s = Scenario::default();
         s.robot.duration_s = 0.5;
         s.camera.enabled = false;
-        let rec = fusemap_core::sim::production::simulate(&s).unwrap();
-        let dir = crate::testdata::temp_dir("sim-semantic");
+        let rec = crate::simulate(&s).unwrap();
+        let dir = fusemap_io::testdata::temp_dir("sim-semantic");
         let files = write_simulation(&rec, &dir, 0.1, false).unwrap();
         let yaml = std::fs::read_to_string(files.truth_semantic.unwrap()).unwrap();
         assert!(yaml.contains("image: truth_semantic.png\nresolution: 0.1\n"), "{yaml}");
@@ -293,15 +293,15 @@ mod tests {
     /// library decodes a label image, a depth image and a CameraInfo of a simulated bag.
     #[test]
     fn rosbags_decodes_the_simulated_camera() {
-        use fusemap_core::sim::production::{simulate, SimImage};
-        let Some(python) = crate::testdata::python_with(&["rosbags.rosbag2", "rosbags.typesys", "numpy"]) else {
+        use crate::{simulate, SimImage};
+        let Some(python) = fusemap_io::testdata::python_with(&["rosbags.rosbag2", "rosbags.typesys", "numpy"]) else {
             return;
         };
         let mut s = Scenario::default();
         s.robot.duration_s = 1.0;
         (s.camera.width, s.camera.height) = (64, 48);
         let rec = simulate(&s).unwrap();
-        let tmp = crate::testdata::temp_dir("sim-camera");
+        let tmp = fusemap_io::testdata::temp_dir("sim-camera");
         let dir = tmp.join("bag");
         write_bag(&rec, &dir, false).unwrap();
         let first = |topic: &str| {

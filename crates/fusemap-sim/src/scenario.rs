@@ -4,11 +4,12 @@
 //! a missing key takes the production line's value. [`Scenario::validate`] names the
 //! offending field in the TOML path form (`lidar.glass_pass_probability`).
 
-use super::camera::{class_id, CameraConfig};
-use super::person::PersonConfig;
-use super::sensors::{GnssConfig, ImuConfig, LidarConfig, OdometryConfig};
-use super::world::{production_hall_objects, Rect, WorldObject};
-use crate::field_error::FieldError;
+use crate::camera::{class_id, CameraConfig};
+use crate::checks::{non_negative, positive};
+use crate::person::PersonConfig;
+use crate::sensors::{GnssConfig, ImuConfig, LidarConfig, OdometryConfig};
+use crate::world::{production_hall_objects, Rect, WorldObject};
+use fusemap_core::field_error::FieldError;
 use serde::{Deserialize, Serialize};
 
 /// A whole simulated run.
@@ -140,42 +141,6 @@ impl Default for FramesConfig {
 
 /// Most lidar beams a run may simulate (8 bytes each in memory).
 pub const MAX_BEAMS: f64 = 5e7;
-
-/// `Ok` when `v` is finite and > 0.
-pub(crate) fn positive(field: &str, v: f64) -> Result<(), FieldError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(FieldError::new(field, format!("must be a finite number > 0, got {v}")))
-    }
-}
-
-/// `Ok` when `v` is finite and ≥ 0.
-pub(crate) fn non_negative(field: &str, v: f64) -> Result<(), FieldError> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(FieldError::new(field, format!("must be a finite number >= 0, got {v}")))
-    }
-}
-
-/// `Ok` when `v` is a probability.
-pub(crate) fn probability(field: &str, v: f64) -> Result<(), FieldError> {
-    if (0.0..=1.0).contains(&v) {
-        Ok(())
-    } else {
-        Err(FieldError::new(field, format!("must lie in [0, 1], got {v}")))
-    }
-}
-
-/// `Ok` when `v` is finite.
-pub(crate) fn finite(field: &str, v: f64) -> Result<(), FieldError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(FieldError::new(field, format!("must be finite, got {v}")))
-    }
-}
 
 impl Scenario {
     /// Checks every field; the error names the first bad one.

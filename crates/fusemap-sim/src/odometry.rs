@@ -3,13 +3,13 @@
 //! `odom_from_base` (Thrun et al., *Probabilistic Robotics*, §5.4, the odometry motion
 //! model run forwards). `odom` starts at identity.
 
-use super::messages::{diagonal6, rpy_to_quaternion, SimOdometry};
-use super::path::{unicycle_step, Trajectory, TRUTH_RATE_HZ};
-use super::sensors::OdometryConfig;
-use super::world::Rect;
-use crate::geometry::{Point2, Pose2};
-use crate::sim::SplitMix64;
-use crate::time::Stamp;
+use crate::messages::{diagonal6, rpy_to_quaternion, SimOdometry};
+use crate::path::{unicycle_step, Trajectory, TRUTH_RATE_HZ};
+use crate::sensors::OdometryConfig;
+use crate::world::Rect;
+use fusemap_core::geometry::{Point2, Pose2};
+use fusemap_core::sim::SplitMix64;
+use fusemap_core::time::Stamp;
 
 /// Dead-reckons the run and emits a message every `1 / rate_hz` seconds (at the first
 /// 200 Hz step at or after each due time). Returns the messages and the number of

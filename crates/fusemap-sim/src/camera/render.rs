@@ -12,11 +12,11 @@
 //! vertical planes (vertical lines converge): at the image edge of the default camera a
 //! column's rays differ by 14° in heading from top to bottom.
 
-use super::super::person::ray_circle;
-use super::super::world::{Caster, EdgeHit, Material, WorldObject};
 use super::{class_id, CameraConfig, CLASS_CEILING, CLASS_FLOOR, CLASS_GLASS, CLASS_PERSON};
-use crate::geometry::{Point2, Pose2};
-use crate::sim::SplitMix64;
+use crate::person::ray_circle;
+use crate::world::{Caster, EdgeHit, Material, WorldObject};
+use fusemap_core::geometry::{Point2, Pose2};
+use fusemap_core::sim::SplitMix64;
 
 /// What the renderer needs of one object.
 #[derive(Clone, Copy, Debug)]
@@ -90,7 +90,8 @@ impl<'a> Renderer<'a> {
         // Fans one pixel pitch wide, measured from the optical axis heading so a heading
         // range across ±π (a camera looking backwards) stays contiguous.
         let step = 1.0 / fx;
-        let rel: Vec<f64> = headings.iter().map(|&a| crate::geometry::normalize_angle(a - axis_heading)).collect();
+        let rel: Vec<f64> =
+            headings.iter().map(|&a| fusemap_core::geometry::normalize_angle(a - axis_heading)).collect();
         let lo = rel.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = rel.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let fans = (((hi - lo) / step).floor() as usize + 1).min(1 << 16);

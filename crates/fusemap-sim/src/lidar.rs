@@ -4,14 +4,14 @@
 //! The walking person is traced at the beam's own time too (a cheap circle test beside the
 //! static caster, which stays unchanged).
 
-use super::messages::SimScan;
-use super::path::Trajectory;
-use super::person::{ray_circle, PersonConfig};
-use super::sensors::LidarConfig;
-use super::world::{Caster, Material};
-use crate::geometry::Point2;
-use crate::sim::SplitMix64;
-use crate::time::Stamp;
+use crate::messages::SimScan;
+use crate::path::Trajectory;
+use crate::person::{ray_circle, PersonConfig};
+use crate::sensors::LidarConfig;
+use crate::world::{Caster, Material};
+use fusemap_core::geometry::Point2;
+use fusemap_core::sim::SplitMix64;
+use fusemap_core::time::Stamp;
 
 /// What the lidar did over a run, for reports and tests.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -47,14 +47,16 @@
 //! ```
 //!
 //! ```
-//! use fusemap_core::sim::production::{simulate, Scenario};
+//! use fusemap_sim::{simulate, Scenario};
 //! let mut scenario = Scenario::default();
 //! scenario.robot.duration_s = 5.0;
 //! let run = simulate(&scenario).unwrap();
 //! assert!(run.messages.windows(2).all(|w| w[0].stamp() <= w[1].stamp()));
 //! ```
 
+pub mod bag;
 mod camera;
+mod checks;
 mod gnss;
 mod imu;
 mod lidar;
@@ -91,15 +93,15 @@ pub use semantic_truth::TruthSemantic;
 pub use sensors::{DropoutMode, GnssConfig, GnssZone, ImuConfig, LidarConfig, OdometryConfig, ZoneKind};
 pub use world::{production_hall_objects, Caster, EdgeHit, Hit, Material, Rect, Shape, WorldObject};
 
-use crate::sim::SplitMix64;
-use crate::time::Stamp;
+use fusemap_core::sim::SplitMix64;
+use fusemap_core::time::Stamp;
 
 /// Why a scenario cannot be simulated.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SimError {
     /// [`Scenario::validate`] refused it, naming the field.
     #[error("invalid scenario: {0}")]
-    Invalid(#[from] crate::field_error::FieldError),
+    Invalid(#[from] fusemap_core::field_error::FieldError),
 }
 
 /// Rate of [`SimRecording::truth_trajectory`], Hz.

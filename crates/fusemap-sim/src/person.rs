@@ -4,9 +4,9 @@
 //! must then let its trail decay). It is seen by the lidar and the camera and is never
 //! part of the ground-truth occupancy.
 
-use super::scenario::{non_negative, positive};
-use crate::field_error::FieldError;
-use crate::geometry::Point2;
+use crate::checks::{non_negative, positive};
+use fusemap_core::field_error::FieldError;
+use fusemap_core::geometry::Point2;
 use serde::{Deserialize, Serialize};
 
 /// The person (`[person]` in a scenario file).

@@ -1,21 +1,21 @@
 //! The RTK receiver: the true antenna position (lever arm on the true pose) in the map's
 //! ENU frame, plus the error of the zone it is in, converted to WGS84 through the datum
-//! (exact ECEF maths, [`crate::geometry::geodetic`]).
+//! (exact ECEF maths, [`fusemap_core::geometry::geodetic`]).
 //!
 //! Degraded zones carry a first-order Gauss–Markov error
 //! `e_k = φ·e_(k−1) + σ·√(1 − φ²)·n_k`, `φ = exp(−Δt/τ)` (stationary σ; Brown & Hwang,
 //! *Introduction to Random Signals and Applied Kalman Filtering*, §2.9), and occasional
 //! outliers the reported covariance does not admit, which a robust estimator must reject.
 
-use super::messages::{
+use crate::messages::{
     diagonal3, SimFix, COVARIANCE_TYPE_DIAGONAL_KNOWN, COVARIANCE_TYPE_UNKNOWN, SERVICE_GALILEO, SERVICE_GPS,
     STATUS_FIX, STATUS_GBAS_FIX, STATUS_NO_FIX,
 };
-use super::path::Trajectory;
-use super::sensors::{DropoutMode, GnssConfig, ZoneKind};
-use crate::geometry::{Datum, Point2};
-use crate::sim::SplitMix64;
-use crate::time::Stamp;
+use crate::path::Trajectory;
+use crate::sensors::{DropoutMode, GnssConfig, ZoneKind};
+use fusemap_core::geometry::{Datum, Point2};
+use fusemap_core::sim::SplitMix64;
+use fusemap_core::time::Stamp;
 
 /// The fixes and the ground truth of their errors.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -1,8 +1,8 @@
 //! The camera's table of the scenario (`[camera]`, `[camera.backlight]`).
 
-use super::super::scenario::{finite, non_negative, positive, probability};
-use crate::field_error::FieldError;
-use crate::geometry::{Mount3, Pose3};
+use crate::checks::{finite, non_negative, positive, probability};
+use fusemap_core::field_error::FieldError;
+use fusemap_core::geometry::{Mount3, Pose3};
 use serde::{Deserialize, Serialize};
 
 /// How label images are encoded (`sensor_msgs/image_encodings`).

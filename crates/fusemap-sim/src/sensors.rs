@@ -1,10 +1,10 @@
 //! Sensor tables of the scenario: rates, noise, the failures the design document names
 //! (§2.2), mounts and clock offsets.
 
-use super::scenario::{finite, non_negative, positive, probability};
-use super::world::Rect;
-use crate::field_error::FieldError;
-use crate::geometry::{Datum, Mount3};
+use crate::checks::{finite, non_negative, positive, probability};
+use crate::world::Rect;
+use fusemap_core::field_error::FieldError;
+use fusemap_core::geometry::{Datum, Mount3};
 use serde::{Deserialize, Serialize};
 
 fn check_mount(field: &str, m: &Mount3) -> Result<(), FieldError> {
@@ -402,7 +402,7 @@ impl GnssConfig {
     }
 
     /// The zone kind at `p` (dropout wins over degraded), `None` in good reception.
-    pub fn zone_at(&self, p: crate::geometry::Point2) -> Option<ZoneKind> {
+    pub fn zone_at(&self, p: fusemap_core::geometry::Point2) -> Option<ZoneKind> {
         let mut kind = None;
         for z in self.zones.iter().filter(|z| z.area.contains(p)) {
             if z.kind == ZoneKind::Dropout {
@@ -417,7 +417,7 @@ impl GnssConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Point2;
+    use fusemap_core::geometry::Point2;
 
     #[test]
     fn beam_layout() {

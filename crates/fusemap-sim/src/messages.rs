@@ -4,8 +4,8 @@
 //! `sensor_msgs/CameraInfo` and `tf2_msgs/TFMessage` one field at a time. Quaternions are `(x, y, z, w)`,
 //! covariances row-major.
 
-use crate::geometry::{quaternion_yaw, Mount3, Pose2};
-use crate::time::Stamp;
+use fusemap_core::geometry::{quaternion_yaw, Mount3, Pose2};
+use fusemap_core::time::Stamp;
 
 /// `sensor_msgs/NavSatStatus.STATUS_NO_FIX`.
 pub const STATUS_NO_FIX: i8 = -1;
@@ -303,7 +303,7 @@ impl SimMessage {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::quaternion_to_rpy;
+    use fusemap_core::geometry::quaternion_to_rpy;
     use proptest::prelude::*;
 
     proptest! {

@@ -7,14 +7,14 @@
 //! Measured against the simulator's truth raster: the F1 of occupied cells with a
 //! one-cell tolerance, and the share of the pillar and machine body cells (cells whose
 //! centre lies inside their outlines) the map holds as free — the bodies the faulty rays
-//! carve open. `cargo test --release -p fusemap-core --test core lidar_faults -- --ignored
+//! carve open. `cargo test --release -p fusemap-sim --test sim lidar_faults -- --ignored
 //! --nocapture` prints the table for the whole default scenario.
 
 use fusemap_core::grid::{CellIndex, GridGeometry, OccupancyParams, PassThroughParams, Ternary};
 use fusemap_core::metrics::TolerantScore;
 use fusemap_core::sensor::{LaserScan, LidarModel, LidarParams, ReturnCounts, ScanFilters};
-use fusemap_core::sim::production::{simulate, Scenario, Shape, SimMessage, Trajectory};
 use fusemap_core::{fusion::Engine, geometry::Point2};
+use fusemap_sim::{simulate, Scenario, Shape, SimMessage, Trajectory};
 use std::collections::HashSet;
 
 /// What one map scored.

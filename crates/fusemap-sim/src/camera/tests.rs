@@ -2,8 +2,8 @@
 //! person, determinism and stamps.
 
 use super::*;
-use crate::sim::production::world::{Material, Shape};
-use crate::sim::production::{simulate, Scenario};
+use crate::world::{Material, Shape};
+use crate::{simulate, Scenario};
 
 /// A camera without noise or backlight, `w × h`, pitched down `pitch_deg`.
 fn exact(w: u32, h: u32, pitch_deg: f64) -> CameraConfig {
@@ -158,7 +158,7 @@ fn glass_is_labelled_glass_and_returns_its_depth_or_what_lies_behind() {
 fn backlight_mislabels_only_floor_pixels_and_only_facing_the_window() {
     let mut cfg = exact(160, 120, 25.0);
     cfg.backlight.enabled = true;
-    let objects = crate::sim::production::production_hall_objects();
+    let objects = crate::production_hall_objects();
     let caster = Caster::new(&objects);
     let mut sim = CameraSim::new(&cfg, &objects, &caster, 3);
     let mut f = NoisyFrame::default();
@@ -244,10 +244,7 @@ fn small(duration_s: f64) -> Scenario {
     s
 }
 
-fn images<'a>(
-    run: &'a crate::sim::production::SimRecording,
-    topic: &'a str,
-) -> impl Iterator<Item = &'a SimImage> + 'a {
+fn images<'a>(run: &'a crate::SimRecording, topic: &'a str) -> impl Iterator<Item = &'a SimImage> + 'a {
     run.messages.iter().filter_map(move |m| match m {
         SimMessage::Image(i) if i.topic == topic => Some(i),
         _ => None,

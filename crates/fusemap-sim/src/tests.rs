@@ -3,8 +3,8 @@
 //! `cargo test -p fusemap-core production -- --nocapture` prints the figures.
 
 use super::*;
-use crate::geometry::Point2;
-use crate::grid::{CellIndex, GridGeometry};
+use fusemap_core::geometry::Point2;
+use fusemap_core::grid::{CellIndex, GridGeometry};
 use std::sync::OnceLock;
 
 fn default_run() -> &'static SimRecording {
@@ -445,9 +445,9 @@ fn imu_lateral_acceleration_is_centripetal() {
 /// map against the truth raster: the precision of its occupied cells (within one cell of
 /// truth) and the share of glass-fence cells it marks occupied.
 fn map_with_true_poses(s: &Scenario) -> (f64, f64, usize) {
-    use crate::fusion::Engine;
-    use crate::grid::{FusionGrid, OccupancyParams, Ternary};
-    use crate::sensor::{LaserScan, LidarModel, LidarParams};
+    use fusemap_core::fusion::Engine;
+    use fusemap_core::grid::{FusionGrid, OccupancyParams, Ternary};
+    use fusemap_core::sensor::{LaserScan, LidarModel, LidarParams};
     let run = simulate(s).unwrap();
     let traj = Trajectory::generate(&s.robot);
     let start = Stamp(s.world.start_time_s * 1_000_000_000);

@@ -2,11 +2,11 @@
 //! (acceleration minus gravity, so +g on z at rest) at the IMU's lever arm, in the IMU
 //! frame, + bias + noise. No orientation (REP 145: `orientation_covariance[0] = -1`).
 
-use super::messages::{diagonal3, SimImu};
-use super::path::Trajectory;
-use super::sensors::ImuConfig;
-use crate::sim::SplitMix64;
-use crate::time::Stamp;
+use crate::messages::{diagonal3, SimImu};
+use crate::path::Trajectory;
+use crate::sensors::ImuConfig;
+use fusemap_core::sim::SplitMix64;
+use fusemap_core::time::Stamp;
 
 /// Standard gravity, m/s² (CGPM 1901).
 pub const STANDARD_GRAVITY: f64 = 9.806_65;

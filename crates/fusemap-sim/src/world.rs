@@ -1,8 +1,8 @@
 //! The production hall: objects with materials, floor grooves, and a ray caster that
 //! reports which material a beam hit and the surface normal there.
 
-use crate::field_error::FieldError;
-use crate::geometry::Point2;
+use fusemap_core::field_error::FieldError;
+use fusemap_core::geometry::Point2;
 use serde::{Deserialize, Serialize};
 
 /// What a surface is made of: it decides how the lidar sees it (design document, §2.2:
@@ -83,7 +83,7 @@ pub struct WorldObject {
     /// A name for reports (`pillar_3`).
     pub name: String,
     /// Semantic class a camera would report, one of the class table's names (`wall`, `glass`,
-    /// `pillar`, `machine`; see [`super::camera::class_id`]).
+    /// `pillar`, `machine`; see [`crate::camera::class_id`]).
     pub class: String,
     /// Surface material.
     pub material: Material,

@@ -1,11 +1,11 @@
 //! The semantic ground truth: the class of every truly occupied cell, the cells of each
 //! kind of object a map must not carve open, and what the camera truly did.
 
-use super::camera::{class_id, CLASS_GLASS, CLASS_MACHINE, CLASS_PILLAR};
-use super::recording::{SimRecording, TruthRasterError};
-use crate::geometry::Point2;
-use crate::grid::{CellIndex, GridGeometry};
-use crate::time::Stamp;
+use crate::camera::{class_id, CLASS_GLASS, CLASS_MACHINE, CLASS_PILLAR};
+use crate::recording::{SimRecording, TruthRasterError};
+use fusemap_core::geometry::Point2;
+use fusemap_core::grid::{CellIndex, GridGeometry};
+use fusemap_core::time::Stamp;
 
 /// The true class map of a run, on a rectangle of a grid (the same cells as
 /// [`SimRecording::truth_occupancy`]).
@@ -30,7 +30,7 @@ pub struct TruthSemantic {
     /// touches).
     pub glass_cells: Vec<CellIndex>,
     /// Map-frame floor points the camera's backlight labelled as an obstacle (a bounded
-    /// sample, see [`super::MAX_BACKLIT_POINTS`]).
+    /// sample, see [`crate::MAX_BACKLIT_POINTS`]).
     pub backlit_floor_points: Vec<Point2>,
     /// Per camera frame: its true time and its published stamp.
     pub camera_stamps: Vec<(Stamp, Stamp)>,
@@ -57,7 +57,7 @@ impl SimRecording {
     /// [`SimRecording::truth_occupancy`] marks occupied, the pillar and machine body
     /// cells and the glass cells, the backlit floor sample and the camera's stamps. The
     /// walking person is not part of it. Refuses objects whose class is not an object
-    /// class of the table, and rasters above [`super::MAX_TRUTH_CELLS`] cells.
+    /// class of the table, and rasters above [`crate::MAX_TRUTH_CELLS`] cells.
     pub fn truth_semantic(&self, geometry: GridGeometry) -> Result<TruthSemantic, TruthRasterError> {
         let mut classes = Vec::with_capacity(self.objects.len());
         for o in &self.objects {

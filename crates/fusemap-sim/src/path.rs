@@ -6,9 +6,9 @@
 //! along its arc, so wheel odometry fed the same commands without errors reproduces the
 //! true motion to rounding.
 
-use super::scenario::RobotConfig;
-use super::world::WorldObject;
-use crate::geometry::{normalize_angle, Point2, Pose2};
+use crate::scenario::RobotConfig;
+use crate::world::WorldObject;
+use fusemap_core::geometry::{normalize_angle, Point2, Pose2};
 
 /// Integration and truth rate, Hz.
 pub const TRUTH_RATE_HZ: f64 = 200.0;

@@ -1,13 +1,13 @@
 //! What a run produces: the time-ordered messages and the ground truth to score an
 //! estimator and a map against.
 
-use super::camera::CameraTruth;
-use super::lidar::LidarStats;
-use super::messages::SimMessage;
-use super::world::{polygon_contains, Rect, WorldObject};
-use crate::geometry::{Datum, Point2, Pose2};
-use crate::grid::{CellIndex, GridGeometry};
-use crate::time::Stamp;
+use crate::camera::CameraTruth;
+use crate::lidar::LidarStats;
+use crate::messages::SimMessage;
+use crate::world::{polygon_contains, Rect, WorldObject};
+use fusemap_core::geometry::{Datum, Point2, Pose2};
+use fusemap_core::grid::{CellIndex, GridGeometry};
+use fusemap_core::time::Stamp;
 
 /// A simulated run.
 #[derive(Clone, Debug)]
@@ -215,7 +215,7 @@ pub fn segment_meets_box(a: Point2, b: Point2, lo: Point2, hi: Point2) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::production::{simulate, Scenario};
+    use crate::{simulate, Scenario};
 
     #[test]
     fn segment_box_cases() {
