@@ -11,12 +11,6 @@ use crate::{Scenario, SimMessage, SimRecording, TruthSemantic, CLASS_COLORS, CLA
 use fusemap_core::grid::logodds::logit;
 use fusemap_core::grid::{GridGeometry, OccupancyParams, Raster};
 use fusemap_io::config_file::{field_error, read_text, toml_error};
-use fusemap_io::log::ros2::msgs::geometry_msgs::{
-    Pose, PoseWithCovariance, Transform, TransformStamped, Twist, TwistWithCovariance,
-};
-use fusemap_io::log::ros2::msgs::nav_msgs::Odometry;
-use fusemap_io::log::ros2::msgs::sensor_msgs::{CameraInfo, Image, Imu, LaserScan, NavSatFix, NavSatStatus};
-use fusemap_io::log::ros2::msgs::std_msgs::Header;
 use fusemap_io::log::ros2::writer::{OutMessage, Rosbag2Writer, Rosbag2WriterOptions, WrittenBag};
 use fusemap_io::Result;
 use std::path::{Path, PathBuf};
@@ -30,81 +24,16 @@ pub fn load_scenario(path: &Path) -> Result<Scenario> {
     Ok(s)
 }
 
-/// The ROS message of a simulated one.
+/// The message to write for a simulated one: the same struct, on its own.
 pub fn to_out_message(m: &SimMessage) -> OutMessage {
-    let header = |stamp, frame: &str| Header { stamp, frame_id: frame.to_string() };
     match m {
-        SimMessage::Scan(s) => OutMessage::LaserScan(LaserScan {
-            header: header(s.stamp, &s.frame_id),
-            angle_min: s.angle_min,
-            angle_max: s.angle_max,
-            angle_increment: s.angle_increment,
-            time_increment: s.time_increment,
-            scan_time: s.scan_time,
-            range_min: s.range_min,
-            range_max: s.range_max,
-            ranges: s.ranges.clone(),
-            intensities: s.intensities.clone(),
-        }),
-        SimMessage::Odometry(o) => OutMessage::Odometry(Odometry {
-            header: header(o.stamp, &o.frame_id),
-            child_frame_id: o.child_frame_id.clone(),
-            pose: PoseWithCovariance {
-                pose: Pose { position: o.position.into(), orientation: o.orientation.into() },
-                covariance: o.pose_covariance,
-            },
-            twist: TwistWithCovariance {
-                twist: Twist { linear: o.linear.into(), angular: o.angular.into() },
-                covariance: o.twist_covariance,
-            },
-        }),
-        SimMessage::Imu(i) => OutMessage::Imu(Imu {
-            header: header(i.stamp, &i.frame_id),
-            orientation: i.orientation.into(),
-            orientation_covariance: i.orientation_covariance,
-            angular_velocity: i.angular_velocity.into(),
-            angular_velocity_covariance: i.angular_velocity_covariance,
-            linear_acceleration: i.linear_acceleration.into(),
-            linear_acceleration_covariance: i.linear_acceleration_covariance,
-        }),
-        SimMessage::Fix(f) => OutMessage::NavSatFix(NavSatFix {
-            header: header(f.stamp, &f.frame_id),
-            status: NavSatStatus { status: f.status, service: f.service },
-            latitude: f.latitude,
-            longitude: f.longitude,
-            altitude: f.altitude,
-            position_covariance: f.position_covariance,
-            position_covariance_type: f.position_covariance_type,
-        }),
-        SimMessage::StaticTransform(t) => OutMessage::Tf { is_static: true, transforms: vec![transform(t)] },
-        SimMessage::Image(i) => OutMessage::Image(Image {
-            header: header(i.stamp, &i.frame_id),
-            height: i.height,
-            width: i.width,
-            encoding: i.encoding.clone(),
-            is_bigendian: i.is_bigendian,
-            step: i.step,
-            data: i.data.clone().into(),
-        }),
-        SimMessage::CameraInfo(c) => OutMessage::CameraInfo(CameraInfo {
-            header: header(c.stamp, &c.frame_id),
-            height: c.height,
-            width: c.width,
-            distortion_model: c.distortion_model.clone(),
-            d: c.d.clone(),
-            k: c.k,
-            r: c.r,
-            p: c.p,
-            ..CameraInfo::default()
-        }),
-    }
-}
-
-fn transform(t: &crate::SimStaticTransform) -> TransformStamped {
-    TransformStamped {
-        header: Header { stamp: t.stamp, frame_id: t.frame_id.clone() },
-        child_frame_id: t.child_frame_id.clone(),
-        transform: Transform { translation: t.translation.into(), rotation: t.rotation.into() },
+        SimMessage::Scan(s) => OutMessage::LaserScan(s.msg.clone()),
+        SimMessage::Odometry(o) => OutMessage::Odometry(o.msg.clone()),
+        SimMessage::Imu(i) => OutMessage::Imu(i.msg.clone()),
+        SimMessage::Fix(f) => OutMessage::NavSatFix(f.msg.clone()),
+        SimMessage::StaticTransform(t) => OutMessage::Tf { is_static: true, transforms: vec![t.msg.clone()] },
+        SimMessage::Image(i) => OutMessage::Image(i.msg.clone()),
+        SimMessage::CameraInfo(c) => OutMessage::CameraInfo(c.msg.clone()),
     }
 }
 
@@ -119,7 +48,7 @@ pub fn write_bag(rec: &SimRecording, dir: &Path, overwrite: bool) -> Result<Writ
         let transforms = statics
             .iter()
             .filter_map(|m| match m {
-                SimMessage::StaticTransform(t) => Some(transform(t)),
+                SimMessage::StaticTransform(t) => Some(t.msg.clone()),
                 _ => None,
             })
             .collect();
@@ -360,7 +289,7 @@ print(json.dumps(out))
             assert_eq!((g["encoding"].as_str(), g["step"].as_u64()), (Some(enc), Some(64 * bytes as u64)), "{topic}");
             assert_eq!(g["bytes"].as_u64(), Some(64 * 48 * bytes as u64), "{topic}");
             assert_eq!(g["frame"], "camera_optical");
-            assert_eq!(g["stamp"][0].as_i64(), Some(img.stamp.0.div_euclid(1_000_000_000)));
+            assert_eq!(g["stamp"][0].as_i64(), Some(img.header.stamp.0.div_euclid(1_000_000_000)));
             for (k, p) in [(0, 0), (24, 32), (47, 63), (40, 10)].into_iter().enumerate() {
                 let (want, read) = (px(img, bytes, p), &g["pixels"][k]);
                 // JSON floats need not round-trip to the last bit: compare f32 values.

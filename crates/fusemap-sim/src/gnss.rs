@@ -7,15 +7,17 @@
 //! *Introduction to Random Signals and Applied Kalman Filtering*, §2.9), and occasional
 //! outliers the reported covariance does not admit, which a robust estimator must reject.
 
-use crate::messages::{
-    diagonal3, SimFix, COVARIANCE_TYPE_DIAGONAL_KNOWN, COVARIANCE_TYPE_UNKNOWN, SERVICE_GALILEO, SERVICE_GPS,
-    STATUS_FIX, STATUS_GBAS_FIX, STATUS_NO_FIX,
-};
+use crate::messages::{diagonal3, SimFix};
 use crate::path::Trajectory;
 use crate::sensors::{DropoutMode, GnssConfig, ZoneKind};
 use fusemap_core::geometry::{Datum, Point2};
 use fusemap_core::sim::SplitMix64;
 use fusemap_core::time::Stamp;
+use fusemap_io::log::ros2::msgs::sensor_msgs::{NavSatFix, NavSatStatus};
+use fusemap_io::log::ros2::msgs::std_msgs::Header;
+
+/// The satellite systems every fix is computed from.
+const SERVICES: u16 = NavSatStatus::SERVICE_GPS | NavSatStatus::SERVICE_GALILEO;
 
 /// The fixes and the ground truth of their errors.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -76,18 +78,18 @@ pub fn simulate_gnss(
         let (status, sigma, err) = match zone {
             Some(ZoneKind::Dropout) => {
                 if cfg.dropout_mode == DropoutMode::NoFix {
-                    out.fixes.push(SimFix {
-                        stamp,
-                        topic: cfg.topic.clone(),
-                        frame_id: frame_id.into(),
-                        status: STATUS_NO_FIX,
-                        service: SERVICE_GPS | SERVICE_GALILEO,
-                        latitude: f64::NAN,
-                        longitude: f64::NAN,
-                        altitude: f64::NAN,
-                        position_covariance: [0.0; 9],
-                        position_covariance_type: COVARIANCE_TYPE_UNKNOWN,
-                    });
+                    out.fixes.push(SimFix::new(
+                        &cfg.topic,
+                        NavSatFix {
+                            header: Header::new(stamp, frame_id),
+                            status: NavSatStatus { status: NavSatStatus::STATUS_NO_FIX, service: SERVICES },
+                            latitude: f64::NAN,
+                            longitude: f64::NAN,
+                            altitude: f64::NAN,
+                            position_covariance: [0.0; 9],
+                            position_covariance_type: NavSatFix::COVARIANCE_TYPE_UNKNOWN,
+                        },
+                    ));
                 }
                 continue;
             }
@@ -101,26 +103,26 @@ pub fn simulate_gnss(
                     e[1] += size * s;
                     out.outliers.push(stamp);
                 }
-                (STATUS_FIX, cfg.degraded_sigma_m, e)
+                (NavSatStatus::STATUS_FIX, cfg.degraded_sigma_m, e)
             }
             None => {
                 let g = cfg.good_sigma_m;
-                (STATUS_GBAS_FIX, g, [g * white[0], g * white[1], 2.0 * g * white[2]])
+                (NavSatStatus::STATUS_GBAS_FIX, g, [g * white[0], g * white[1], 2.0 * g * white[2]])
             }
         };
         let (latitude, longitude, altitude) = datum.to_geodetic([p.x + err[0], p.y + err[1], cfg.mount.z + err[2]]);
-        out.fixes.push(SimFix {
-            stamp,
-            topic: cfg.topic.clone(),
-            frame_id: frame_id.into(),
-            status,
-            service: SERVICE_GPS | SERVICE_GALILEO,
-            latitude,
-            longitude,
-            altitude,
-            position_covariance: diagonal3([sigma * sigma, sigma * sigma, 4.0 * sigma * sigma]),
-            position_covariance_type: COVARIANCE_TYPE_DIAGONAL_KNOWN,
-        });
+        out.fixes.push(SimFix::new(
+            &cfg.topic,
+            NavSatFix {
+                header: Header::new(stamp, frame_id),
+                status: NavSatStatus { status, service: SERVICES },
+                latitude,
+                longitude,
+                altitude,
+                position_covariance: diagonal3([sigma * sigma, sigma * sigma, 4.0 * sigma * sigma]),
+                position_covariance_type: NavSatFix::COVARIANCE_TYPE_DIAGONAL_KNOWN,
+            },
+        ));
     }
     out
 }

@@ -7,6 +7,9 @@ use crate::path::Trajectory;
 use crate::sensors::ImuConfig;
 use fusemap_core::sim::SplitMix64;
 use fusemap_core::time::Stamp;
+use fusemap_io::log::ros2::msgs::geometry_msgs::Quaternion;
+use fusemap_io::log::ros2::msgs::sensor_msgs::Imu;
+use fusemap_io::log::ros2::msgs::std_msgs::Header;
 
 /// Standard gravity, m/s² (CGPM 1901).
 pub const STANDARD_GRAVITY: f64 = 9.806_65;
@@ -45,17 +48,19 @@ pub fn simulate_imu(
             linear_acceleration[i] = acc[i] + cfg.accel_bias_mps2[i] + sa * rng.gaussian();
         }
         angular_velocity[2] += cfg.gyro_bias_radps;
-        out.push(SimImu {
-            stamp: Stamp(start.0 + ((t + cfg.time_offset_s) * 1e9).round() as i64),
-            topic: cfg.topic.clone(),
-            frame_id: frame_id.into(),
-            orientation: [0.0, 0.0, 0.0, 1.0],
-            orientation_covariance,
-            angular_velocity,
-            angular_velocity_covariance: diagonal3([sg * sg; 3]),
-            linear_acceleration,
-            linear_acceleration_covariance: diagonal3([sa * sa; 3]),
-        });
+        let stamp = Stamp(start.0 + ((t + cfg.time_offset_s) * 1e9).round() as i64);
+        out.push(SimImu::new(
+            &cfg.topic,
+            Imu {
+                header: Header::new(stamp, frame_id),
+                orientation: Quaternion::default(),
+                orientation_covariance,
+                angular_velocity: angular_velocity.into(),
+                angular_velocity_covariance: diagonal3([sg * sg; 3]),
+                linear_acceleration: linear_acceleration.into(),
+                linear_acceleration_covariance: diagonal3([sa * sa; 3]),
+            },
+        ));
     }
     out
 }

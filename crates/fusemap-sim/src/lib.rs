@@ -81,9 +81,8 @@ pub use camera::{
 pub use imu::STANDARD_GRAVITY;
 pub use lidar::LidarStats;
 pub use messages::{
-    rpy_to_quaternion, SimCameraInfo, SimFix, SimImage, SimImu, SimMessage, SimOdometry, SimScan, SimStaticTransform,
-    COVARIANCE_TYPE_DIAGONAL_KNOWN, COVARIANCE_TYPE_UNKNOWN, SERVICE_GALILEO, SERVICE_GPS, STATUS_FIX, STATUS_GBAS_FIX,
-    STATUS_NO_FIX, STATUS_SBAS_FIX,
+    rpy_to_quaternion, OnTopic, SimCameraInfo, SimFix, SimImage, SimImu, SimMessage, SimOdometry, SimScan,
+    SimStaticTransform,
 };
 pub use path::{rounded_loop, Approach, Trajectory, TruthSample, TRUTH_RATE_HZ};
 pub use person::{ray_circle, PersonConfig};

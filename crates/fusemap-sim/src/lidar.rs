@@ -12,6 +12,8 @@ use crate::world::{Caster, Material};
 use fusemap_core::geometry::Point2;
 use fusemap_core::sim::SplitMix64;
 use fusemap_core::time::Stamp;
+use fusemap_io::log::ros2::msgs::sensor_msgs::LaserScan;
+use fusemap_io::log::ros2::msgs::std_msgs::Header;
 
 /// What the lidar did over a run, for reports and tests.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -162,20 +164,21 @@ pub fn simulate_scans(
             out.push(v as f32);
         }
         let stamp = Stamp(start.0 + ((t0 + cfg.time_offset_s) * 1e9).round() as i64);
-        scans.push(SimScan {
-            stamp,
-            topic: cfg.topic.clone(),
-            frame_id: frame_id.into(),
-            angle_min: a0 as f32,
-            angle_max: (a0 + inc * (cfg.beams - 1) as f64) as f32,
-            angle_increment: inc as f32,
-            time_increment: ti as f32,
-            scan_time: period as f32,
-            range_min: cfg.range_min_m as f32,
-            range_max: cfg.range_max_m as f32,
-            ranges: out,
-            intensities: truth.iter().map(|t| t.1).collect(),
-        });
+        scans.push(SimScan::new(
+            &cfg.topic,
+            LaserScan {
+                header: Header::new(stamp, frame_id),
+                angle_min: a0 as f32,
+                angle_max: (a0 + inc * (cfg.beams - 1) as f64) as f32,
+                angle_increment: inc as f32,
+                time_increment: ti as f32,
+                scan_time: period as f32,
+                range_min: cfg.range_min_m as f32,
+                range_max: cfg.range_max_m as f32,
+                ranges: out,
+                intensities: truth.iter().map(|t| t.1).collect(),
+            },
+        ));
         k += 1;
     }
     (scans, stats)

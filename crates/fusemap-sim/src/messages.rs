@@ -1,28 +1,16 @@
-//! Plain-Rust mirrors of the ROS messages a recording holds. Field names and meanings
-//! follow the `.msg` definitions so a writer fills `sensor_msgs/LaserScan`,
-//! `nav_msgs/Odometry`, `sensor_msgs/Imu`, `sensor_msgs/NavSatFix`, `sensor_msgs/Image`,
-//! `sensor_msgs/CameraInfo` and `tf2_msgs/TFMessage` one field at a time. Quaternions are `(x, y, z, w)`,
-//! covariances row-major.
+//! The messages of a recording: the ROS message structs fusemap's reader decodes and its
+//! writer encodes ([`fusemap_io::log::ros2::msgs`], one struct per message type), each
+//! with the topic it is published on. The simulator fills them field by field as a
+//! robot's drivers would; writing the bag is then only a matter of encoding them.
+//! Quaternions are `(x, y, z, w)`, covariances row-major.
 
 use fusemap_core::geometry::{quaternion_yaw, Mount3, Pose2};
 use fusemap_core::time::Stamp;
-
-/// `sensor_msgs/NavSatStatus.STATUS_NO_FIX`.
-pub const STATUS_NO_FIX: i8 = -1;
-/// `sensor_msgs/NavSatStatus.STATUS_FIX`: unaugmented (here: a float RTK solution).
-pub const STATUS_FIX: i8 = 0;
-/// `sensor_msgs/NavSatStatus.STATUS_SBAS_FIX`.
-pub const STATUS_SBAS_FIX: i8 = 1;
-/// `sensor_msgs/NavSatStatus.STATUS_GBAS_FIX`: ground-based augmentation (RTK fixed).
-pub const STATUS_GBAS_FIX: i8 = 2;
-/// `sensor_msgs/NavSatStatus.SERVICE_GPS`.
-pub const SERVICE_GPS: u16 = 1;
-/// `sensor_msgs/NavSatStatus.SERVICE_GALILEO`.
-pub const SERVICE_GALILEO: u16 = 8;
-/// `sensor_msgs/NavSatFix.COVARIANCE_TYPE_UNKNOWN`.
-pub const COVARIANCE_TYPE_UNKNOWN: u8 = 0;
-/// `sensor_msgs/NavSatFix.COVARIANCE_TYPE_DIAGONAL_KNOWN`.
-pub const COVARIANCE_TYPE_DIAGONAL_KNOWN: u8 = 2;
+use fusemap_io::log::ros2::msgs::geometry_msgs::{Transform, TransformStamped};
+use fusemap_io::log::ros2::msgs::nav_msgs::Odometry;
+use fusemap_io::log::ros2::msgs::sensor_msgs::{CameraInfo, Image, Imu, LaserScan, NavSatFix};
+use fusemap_io::log::ros2::msgs::std_msgs::Header;
+use std::ops::{Deref, DerefMut};
 
 /// The quaternion `(x, y, z, w)` of REP 103 roll, pitch, yaw (`Rz·Ry·Rx`).
 pub fn rpy_to_quaternion(roll: f64, pitch: f64, yaw: f64) -> [f64; 4] {
@@ -50,194 +38,74 @@ pub fn diagonal3(diag: [f64; 3]) -> [f64; 9] {
     c
 }
 
-/// `sensor_msgs/LaserScan`. Ranges follow REP 117: `+inf` no return, NaN or 0 an
-/// invalid reading.
+/// A message and the topic it is published on. It dereferences to the message, so its
+/// fields read as on the ROS type (`scan.ranges`, `fix.header.stamp`).
 #[derive(Clone, Debug, PartialEq)]
-pub struct SimScan {
-    /// Header stamp: the sensor clock at the first beam.
-    pub stamp: Stamp,
-    /// Topic.
+pub struct OnTopic<T> {
+    /// The topic.
     pub topic: String,
-    /// Header frame (the laser).
-    pub frame_id: String,
-    /// Angle of the first beam, radians.
-    pub angle_min: f32,
-    /// Angle of the last beam, radians.
-    pub angle_max: f32,
-    /// Angle between beams, radians.
-    pub angle_increment: f32,
-    /// Time between beams, seconds: beam `i` was measured at `stamp + i·time_increment`.
-    pub time_increment: f32,
-    /// Time between scans, seconds.
-    pub scan_time: f32,
-    /// Shortest valid range, metres.
-    pub range_min: f32,
-    /// Longest valid range, metres.
-    pub range_max: f32,
-    /// Ranges, metres.
-    pub ranges: Vec<f32>,
-    /// Return intensities (arbitrary units: glass 10, machine 40, wall 50, steel 90).
-    pub intensities: Vec<f32>,
+    /// The message.
+    pub msg: T,
 }
 
-/// `nav_msgs/Odometry`: `odom_from_base` and the body-frame twist.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SimOdometry {
-    /// Header stamp.
-    pub stamp: Stamp,
-    /// Topic.
-    pub topic: String,
-    /// Header frame (`odom`).
-    pub frame_id: String,
-    /// Child frame (`base_link`).
-    pub child_frame_id: String,
-    /// Position, metres.
-    pub position: [f64; 3],
-    /// Orientation quaternion `(x, y, z, w)`.
-    pub orientation: [f64; 4],
-    /// Pose covariance (x, y, z, roll, pitch, yaw), row-major 6×6.
-    pub pose_covariance: [f64; 36],
-    /// Linear velocity in the child frame, m/s.
-    pub linear: [f64; 3],
-    /// Angular velocity in the child frame, rad/s.
-    pub angular: [f64; 3],
-    /// Twist covariance, row-major 6×6.
-    pub twist_covariance: [f64; 36],
+impl<T> OnTopic<T> {
+    /// `msg` on `topic`.
+    pub fn new(topic: impl Into<String>, msg: T) -> Self {
+        Self { topic: topic.into(), msg }
+    }
 }
+
+impl<T> Deref for OnTopic<T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        &self.msg
+    }
+}
+
+impl<T> DerefMut for OnTopic<T> {
+    fn deref_mut(&mut self) -> &mut T {
+        &mut self.msg
+    }
+}
+
+/// `sensor_msgs/LaserScan`; ranges follow REP 117: `+inf` no return, NaN or 0 an invalid
+/// reading; intensities in arbitrary units (glass 10, machine 40, wall 50, steel 90).
+pub type SimScan = OnTopic<LaserScan>;
+/// `nav_msgs/Odometry`: `odom_from_base` and the body-frame twist.
+pub type SimOdometry = OnTopic<Odometry>;
+/// `sensor_msgs/Imu` without orientation (REP 145: `orientation_covariance[0] = -1`);
+/// specific force with gravity (+9.81 on z at rest).
+pub type SimImu = OnTopic<Imu>;
+/// `sensor_msgs/NavSatFix`: GBAS_FIX good, FIX degraded, NO_FIX dropout; the covariance
+/// is the zone's nominal σ, never the unreported outliers.
+pub type SimFix = OnTopic<NavSatFix>;
+/// One `geometry_msgs/TransformStamped` of `/tf_static`: `parent_from_child`.
+pub type SimStaticTransform = OnTopic<TransformStamped>;
+/// `sensor_msgs/Image`: labels (`mono8`, `mono16`) or depth (`32FC1`, `16UC1`).
+pub type SimImage = OnTopic<Image<'static>>;
+/// `sensor_msgs/CameraInfo` of a pinhole camera (`plumb_bob`, no distortion).
+pub type SimCameraInfo = OnTopic<CameraInfo>;
 
 impl SimOdometry {
     /// The planar pose `odom_from_base`.
     pub fn pose2(&self) -> Pose2 {
-        Pose2::new(self.position[0], self.position[1], quaternion_yaw(self.orientation))
+        let p = &self.msg.pose.pose;
+        Pose2::new(p.position.x, p.position.y, quaternion_yaw(p.orientation.to_array()))
     }
-}
-
-/// `sensor_msgs/Imu` without orientation (REP 145: `orientation_covariance[0] = -1`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct SimImu {
-    /// Header stamp.
-    pub stamp: Stamp,
-    /// Topic.
-    pub topic: String,
-    /// Header frame (`imu_link`).
-    pub frame_id: String,
-    /// Orientation: identity, and unused (see `orientation_covariance`).
-    pub orientation: [f64; 4],
-    /// `[-1, 0, …]`: no orientation estimate.
-    pub orientation_covariance: [f64; 9],
-    /// Angular velocity in the IMU frame, rad/s.
-    pub angular_velocity: [f64; 3],
-    /// Its covariance, row-major 3×3.
-    pub angular_velocity_covariance: [f64; 9],
-    /// Specific force in the IMU frame (gravity included: +9.81 on z at rest), m/s².
-    pub linear_acceleration: [f64; 3],
-    /// Its covariance, row-major 3×3.
-    pub linear_acceleration_covariance: [f64; 9],
-}
-
-/// `sensor_msgs/NavSatFix`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SimFix {
-    /// Header stamp.
-    pub stamp: Stamp,
-    /// Topic.
-    pub topic: String,
-    /// Header frame (the antenna, `gps`).
-    pub frame_id: String,
-    /// `NavSatStatus.status`: GBAS_FIX (2) good, FIX (0) degraded, NO_FIX (-1) dropout.
-    pub status: i8,
-    /// `NavSatStatus.service` bit mask.
-    pub service: u16,
-    /// WGS84 latitude, degrees (NaN without a fix).
-    pub latitude: f64,
-    /// WGS84 longitude, degrees (NaN without a fix).
-    pub longitude: f64,
-    /// Ellipsoidal height, metres (NaN without a fix).
-    pub altitude: f64,
-    /// ENU position covariance, m², row-major 3×3: the zone's nominal σ, never the
-    /// unreported outliers.
-    pub position_covariance: [f64; 9],
-    /// `COVARIANCE_TYPE_*`.
-    pub position_covariance_type: u8,
-}
-
-/// One `geometry_msgs/TransformStamped` of `/tf_static`: `parent_from_child`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SimStaticTransform {
-    /// Header stamp.
-    pub stamp: Stamp,
-    /// Topic (`/tf_static`).
-    pub topic: String,
-    /// Parent frame (header frame).
-    pub frame_id: String,
-    /// Child frame.
-    pub child_frame_id: String,
-    /// Translation, metres.
-    pub translation: [f64; 3],
-    /// Rotation quaternion `(x, y, z, w)`.
-    pub rotation: [f64; 4],
 }
 
 impl SimStaticTransform {
     /// A mount as a static transform.
     pub fn from_mount(stamp: Stamp, topic: &str, parent: &str, child: &str, m: &Mount3) -> Self {
-        Self {
-            stamp,
-            topic: topic.into(),
-            frame_id: parent.into(),
-            child_frame_id: child.into(),
-            translation: [m.x, m.y, m.z],
-            rotation: rpy_to_quaternion(m.roll, m.pitch, m.yaw),
-        }
+        let transform = Transform {
+            translation: [m.x, m.y, m.z].into(),
+            rotation: rpy_to_quaternion(m.roll, m.pitch, m.yaw).into(),
+        };
+        OnTopic::new(
+            topic,
+            TransformStamped { header: Header::new(stamp, parent), child_frame_id: child.into(), transform },
+        )
     }
-}
-
-/// `sensor_msgs/Image`: an uncompressed image, row after row.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SimImage {
-    /// Header stamp: the camera clock at exposure.
-    pub stamp: Stamp,
-    /// Topic.
-    pub topic: String,
-    /// Header frame (the camera's optical frame).
-    pub frame_id: String,
-    /// Rows.
-    pub height: u32,
-    /// Columns.
-    pub width: u32,
-    /// `mono8`, `mono16` (labels), `32FC1`, `16UC1` (depth).
-    pub encoding: String,
-    /// 1 when multi-byte pixels are big-endian (here always 0).
-    pub is_bigendian: u8,
-    /// Bytes per row.
-    pub step: u32,
-    /// `step · height` bytes.
-    pub data: Vec<u8>,
-}
-
-/// `sensor_msgs/CameraInfo` of a pinhole camera.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SimCameraInfo {
-    /// Header stamp: that of the images it describes.
-    pub stamp: Stamp,
-    /// Topic.
-    pub topic: String,
-    /// Header frame (the camera's optical frame).
-    pub frame_id: String,
-    /// Rows.
-    pub height: u32,
-    /// Columns.
-    pub width: u32,
-    /// `plumb_bob`.
-    pub distortion_model: String,
-    /// Distortion coefficients (k1, k2, t1, t2, k3): all zero.
-    pub d: Vec<f64>,
-    /// Intrinsic matrix, row-major 3×3.
-    pub k: [f64; 9],
-    /// Rectification rotation, row-major 3×3 (identity).
-    pub r: [f64; 9],
-    /// Projection matrix, row-major 3×4.
-    pub p: [f64; 12],
 }
 
 /// Any message of a recording.
@@ -260,17 +128,22 @@ pub enum SimMessage {
 }
 
 impl SimMessage {
+    /// The message's header.
+    pub fn header(&self) -> &Header {
+        match self {
+            SimMessage::Scan(m) => &m.header,
+            SimMessage::Odometry(m) => &m.header,
+            SimMessage::Imu(m) => &m.header,
+            SimMessage::Fix(m) => &m.header,
+            SimMessage::StaticTransform(m) => &m.header,
+            SimMessage::Image(m) => &m.header,
+            SimMessage::CameraInfo(m) => &m.header,
+        }
+    }
+
     /// Header stamp.
     pub fn stamp(&self) -> Stamp {
-        match self {
-            SimMessage::Scan(m) => m.stamp,
-            SimMessage::Odometry(m) => m.stamp,
-            SimMessage::Imu(m) => m.stamp,
-            SimMessage::Fix(m) => m.stamp,
-            SimMessage::StaticTransform(m) => m.stamp,
-            SimMessage::Image(m) => m.stamp,
-            SimMessage::CameraInfo(m) => m.stamp,
-        }
+        self.header().stamp
     }
 
     /// Topic.
@@ -288,15 +161,7 @@ impl SimMessage {
 
     /// Header frame.
     pub fn frame_id(&self) -> &str {
-        match self {
-            SimMessage::Scan(m) => &m.frame_id,
-            SimMessage::Odometry(m) => &m.frame_id,
-            SimMessage::Imu(m) => &m.frame_id,
-            SimMessage::Fix(m) => &m.frame_id,
-            SimMessage::StaticTransform(m) => &m.frame_id,
-            SimMessage::Image(m) => &m.frame_id,
-            SimMessage::CameraInfo(m) => &m.frame_id,
-        }
+        &self.header().frame_id
     }
 }
 

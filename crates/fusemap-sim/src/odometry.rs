@@ -10,6 +10,9 @@ use crate::world::Rect;
 use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::sim::SplitMix64;
 use fusemap_core::time::Stamp;
+use fusemap_io::log::ros2::msgs::geometry_msgs::{Pose, PoseWithCovariance, Twist, TwistWithCovariance};
+use fusemap_io::log::ros2::msgs::nav_msgs::Odometry;
+use fusemap_io::log::ros2::msgs::std_msgs::Header;
 
 /// Dead-reckons the run and emits a message every `1 / rate_hz` seconds (at the first
 /// 200 Hz step at or after each due time). Returns the messages and the number of
@@ -33,18 +36,20 @@ pub fn simulate_odometry(
         while (next as f64) / cfg.rate_hz <= s.t + 1e-9 {
             next += 1;
             let stamp = Stamp(start.0 + ((s.t + cfg.time_offset_s) * 1e9).round() as i64);
-            out.push(SimOdometry {
-                stamp,
-                topic: cfg.topic.clone(),
-                frame_id: frames.0.into(),
-                child_frame_id: frames.1.into(),
-                position: [odom.x, odom.y, 0.0],
-                orientation: rpy_to_quaternion(0.0, 0.0, odom.theta),
-                pose_covariance: diagonal6(cfg.pose_covariance_diagonal),
-                linear: [v_m, 0.0, 0.0],
-                angular: [0.0, 0.0, w_m],
-                twist_covariance: diagonal6(cfg.twist_covariance_diagonal),
-            });
+            let pose = Pose {
+                position: [odom.x, odom.y, 0.0].into(),
+                orientation: rpy_to_quaternion(0.0, 0.0, odom.theta).into(),
+            };
+            let twist = Twist { linear: [v_m, 0.0, 0.0].into(), angular: [0.0, 0.0, w_m].into() };
+            out.push(SimOdometry::new(
+                &cfg.topic,
+                Odometry {
+                    header: Header::new(stamp, frames.0),
+                    child_frame_id: frames.1.into(),
+                    pose: PoseWithCovariance { pose, covariance: diagonal6(cfg.pose_covariance_diagonal) },
+                    twist: TwistWithCovariance { twist, covariance: diagonal6(cfg.twist_covariance_diagonal) },
+                },
+            ));
         }
         // The wheels' true ground speeds over the step that starts here.
         let (vl, vr) = (s.v - s.omega * half, s.v + s.omega * half);

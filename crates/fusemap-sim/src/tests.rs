@@ -5,6 +5,7 @@
 use super::*;
 use fusemap_core::geometry::Point2;
 use fusemap_core::grid::{CellIndex, GridGeometry};
+use fusemap_io::log::ros2::msgs::sensor_msgs::{NavSatFix, NavSatStatus};
 use std::sync::OnceLock;
 
 fn default_run() -> &'static SimRecording {
@@ -128,7 +129,7 @@ fn glass_passes_at_the_configured_rate_and_beams_are_deskewed() {
     let start = Stamp(s.world.start_time_s * 1_000_000_000);
     let (mut glass, mut passed, mut exact, mut other, mut skew_visible) = (0u64, 0u64, 0u64, 0u64, 0u64);
     for scan in run.messages.iter().filter_map(|m| if let SimMessage::Scan(x) = m { Some(x) } else { None }) {
-        let t0 = secs(scan.stamp, start) - s.lidar.time_offset_s;
+        let t0 = secs(scan.header.stamp, start) - s.lidar.time_offset_s;
         for (i, &r) in scan.ranges.iter().enumerate() {
             let t = t0 + i as f64 * scan.time_increment as f64;
             let pose = traj.pose_at(t);
@@ -212,15 +213,15 @@ fn fixes_in_dropouts_are_absent_or_no_fix() {
         let mut no_fix = 0;
         for m in &run.messages {
             if let SimMessage::Fix(f) = m {
-                let inside = run.dropouts.iter().any(|(a, b)| f.stamp >= *a && f.stamp <= *b);
+                let inside = run.dropouts.iter().any(|(a, b)| f.header.stamp >= *a && f.header.stamp <= *b);
                 if inside {
                     assert_eq!(mode, DropoutMode::NoFix);
-                    assert_eq!(f.status, STATUS_NO_FIX);
-                    assert!(f.latitude.is_nan() && f.position_covariance_type == COVARIANCE_TYPE_UNKNOWN);
+                    assert_eq!(f.status.status, NavSatStatus::STATUS_NO_FIX);
+                    assert!(f.latitude.is_nan() && f.position_covariance_type == NavSatFix::COVARIANCE_TYPE_UNKNOWN);
                     no_fix += 1;
                 } else {
-                    assert!(f.status >= STATUS_FIX && f.latitude.is_finite());
-                    assert_eq!(f.position_covariance_type, COVARIANCE_TYPE_DIAGONAL_KNOWN);
+                    assert!(f.status.status >= NavSatStatus::STATUS_FIX && f.latitude.is_finite());
+                    assert_eq!(f.position_covariance_type, NavSatFix::COVARIANCE_TYPE_DIAGONAL_KNOWN);
                 }
             }
         }
@@ -239,12 +240,12 @@ fn good_fixes_round_trip_to_the_antenna_within_a_millimetre() {
     let (mut good, mut worst) = (0, 0.0f64);
     for m in &run.messages {
         if let SimMessage::Fix(f) = m {
-            if f.status != STATUS_GBAS_FIX {
+            if f.status.status != NavSatStatus::STATUS_GBAS_FIX {
                 continue;
             }
             good += 1;
             let enu = run.datum.to_enu(f.latitude, f.longitude, f.altitude);
-            let antenna = traj.pose_at(secs(f.stamp, start)) * Point2::new(s.gnss.mount.x, s.gnss.mount.y);
+            let antenna = traj.pose_at(secs(f.header.stamp, start)) * Point2::new(s.gnss.mount.x, s.gnss.mount.y);
             let err = (enu[0] - antenna.x).hypot(enu[1] - antenna.y).hypot(enu[2] - s.gnss.mount.z);
             worst = worst.max(err);
         }
@@ -263,13 +264,13 @@ fn degraded_fixes_have_correlated_error_and_unreported_outliers() {
     for m in &run.messages {
         if let SimMessage::Fix(f) = m {
             let enu = run.datum.to_enu(f.latitude, f.longitude, f.altitude);
-            let antenna = traj.pose_at(secs(f.stamp, start)) * Point2::new(s.gnss.mount.x, s.gnss.mount.y);
+            let antenna = traj.pose_at(secs(f.header.stamp, start)) * Point2::new(s.gnss.mount.x, s.gnss.mount.y);
             let e = (enu[0] - antenna.x).hypot(enu[1] - antenna.y);
             let sigma = f.position_covariance[0].sqrt();
-            if run.injected_outliers.contains(&f.stamp) {
-                assert_eq!(f.status, STATUS_FIX, "outliers only in degraded zones");
+            if run.injected_outliers.contains(&f.header.stamp) {
+                assert_eq!(f.status.status, NavSatStatus::STATUS_FIX, "outliers only in degraded zones");
                 outlier_errs.push(e / sigma);
-            } else if f.status == STATUS_FIX {
+            } else if f.status.status == NavSatStatus::STATUS_FIX {
                 errs.push(e);
             } else {
                 assert!(e < 5.0 * sigma.max(1e-9) * 2.0, "good fix {e} m off");
@@ -298,7 +299,7 @@ fn odometry_ate(run: &SimRecording) -> (f64, f64) {
     let (mut sum, mut n, mut last) = (0.0, 0usize, 0.0);
     for m in &run.messages {
         if let SimMessage::Odometry(o) = m {
-            let Some(truth) = run.truth_at(o.stamp) else { continue };
+            let Some(truth) = run.truth_at(o.header.stamp) else { continue };
             let est = map_from_odom * o.pose2();
             let e = est.translation().distance(truth.translation());
             sum += e * e;
@@ -337,9 +338,9 @@ fn imu_reports_rate_plus_bias_and_gravity_without_orientation() {
     for m in &run.messages {
         if let SimMessage::Imu(i) = m {
             assert_eq!(i.orientation_covariance[0], -1.0);
-            let truth = traj.sample_at(secs(i.stamp, start));
-            bias_sum += i.angular_velocity[2] - truth.omega;
-            az_sum += i.linear_acceleration[2];
+            let truth = traj.sample_at(secs(i.header.stamp, start));
+            bias_sum += i.angular_velocity.z - truth.omega;
+            az_sum += i.linear_acceleration.z;
             n += 1;
         }
     }
@@ -407,12 +408,12 @@ fn time_offsets_move_stamps_not_measurements() {
         r.messages.iter().filter_map(|m| if let SimMessage::Scan(x) = m { Some(x.clone()) } else { None }).collect()
     };
     let imus = |r: &SimRecording| -> Vec<Stamp> {
-        r.messages.iter().filter_map(|m| if let SimMessage::Imu(x) = m { Some(x.stamp) } else { None }).collect()
+        r.messages.iter().filter_map(|m| if let SimMessage::Imu(x) = m { Some(x.header.stamp) } else { None }).collect()
     };
     let (a, b) = (scans(&base), scans(&shifted));
     assert_eq!(a.len(), b.len());
     for (x, y) in a.iter().zip(&b) {
-        assert_eq!(y.stamp.0 - x.stamp.0, 30_000_000);
+        assert_eq!(y.header.stamp.0 - x.header.stamp.0, 30_000_000);
         assert_eq!(format!("{:?}", x.ranges), format!("{:?}", y.ranges));
     }
     assert!(imus(&base).iter().zip(imus(&shifted)).all(|(x, y)| y.0 - x.0 == -10_000_000));
@@ -430,10 +431,10 @@ fn imu_lateral_acceleration_is_centripetal() {
     let (mut worst, mut turning) = (0.0f64, 0);
     for m in &run.messages {
         if let SimMessage::Imu(i) = m {
-            let t = traj.sample_at(secs(i.stamp, start));
+            let t = traj.sample_at(secs(i.header.stamp, start));
             // The IMU sits on the base's z axis: no lever-arm terms in the plane.
-            worst = worst.max((i.linear_acceleration[1] - t.v * t.omega).abs());
-            worst = worst.max((i.linear_acceleration[0] - t.accel).abs());
+            worst = worst.max((i.linear_acceleration.y - t.v * t.omega).abs());
+            worst = worst.max((i.linear_acceleration.x - t.accel).abs());
             turning += usize::from(t.omega.abs() > 0.2);
         }
     }
@@ -458,12 +459,12 @@ fn map_with_true_poses(s: &Scenario) -> (f64, f64, usize) {
     for m in &run.messages {
         if let SimMessage::Scan(x) = m {
             let scan = LaserScan {
-                stamp: x.stamp,
+                stamp: x.header.stamp,
                 angle_min: x.angle_min as f64,
                 angle_increment: x.angle_increment as f64,
                 ranges: x.ranges.clone(),
             };
-            let t0 = secs(x.stamp, start) - s.lidar.time_offset_s;
+            let t0 = secs(x.header.stamp, start) - s.lidar.time_offset_s;
             let ti = x.time_increment as f64;
             engine.insert_scan_with(laser, &scan, |i| traj.pose_at(t0 + i as f64 * ti)).unwrap();
         }
@@ -536,7 +537,7 @@ fn the_person_is_seen_by_lidar_and_camera_and_absent_from_the_truth() {
         if img.topic != s.camera.label_topic {
             continue;
         }
-        let t = secs(img.stamp, start) - s.camera.time_offset_s;
+        let t = secs(img.header.stamp, start) - s.camera.time_offset_s;
         let n = img.data.iter().filter(|&&l| u16::from(l) == CLASS_PERSON).count();
         match s.person.windows.iter().position(|w| t >= w[0] && t <= w[1]) {
             Some(k) => per_window[k] += n,

@@ -36,20 +36,20 @@ fn broken_messages_are_counted_and_the_log_still_maps() {
                 match fixes % 10 {
                     1 => f.latitude = f64::NAN,
                     2 => f.position_covariance = [0.0; 9],
-                    3 => f.status = -1,
+                    3 => f.status.status = -1,
                     _ => {}
                 }
             }
             SimMessage::Imu(i) => {
                 imus += 1;
                 if imus % 50 == 0 {
-                    i.angular_velocity = [f64::NAN; 3];
+                    i.angular_velocity = [f64::NAN; 3].into();
                 }
             }
             SimMessage::Odometry(o) => {
                 odoms += 1;
                 if odoms % 100 == 0 {
-                    o.orientation = [0.0; 4];
+                    o.pose.pose.orientation = [0.0; 4].into();
                 }
             }
             _ => {}
@@ -60,14 +60,13 @@ fn broken_messages_are_counted_and_the_log_still_maps() {
     for (parent, child) in [("laser", "loop_a"), ("loop_a", "laser")] {
         rec.messages.insert(
             0,
-            SimMessage::StaticTransform(SimStaticTransform {
-                stamp: t,
-                topic: "/tf_static".into(),
-                frame_id: parent.into(),
-                child_frame_id: child.into(),
-                translation: [0.1, 0.0, 0.0],
-                rotation: [0.0, 0.0, 0.0, 1.0],
-            }),
+            SimMessage::StaticTransform(SimStaticTransform::from_mount(
+                t,
+                "/tf_static",
+                parent,
+                child,
+                &fusemap_core::geometry::Mount3 { x: 0.1, ..Default::default() },
+            )),
         );
     }
     let run = map(&rec, "bad-pose-sensors", &Config::default()).expect("the log still maps");
@@ -91,7 +90,7 @@ fn a_gnss_topic_without_a_fix_says_so_and_maps_on_odometry_and_gyro() {
     let mut rec = short_run();
     for m in &mut rec.messages {
         if let SimMessage::Fix(f) = m {
-            f.status = -1;
+            f.status.status = -1;
             f.latitude = f64::NAN;
         }
     }
@@ -122,8 +121,8 @@ fn imu_orientation_is_used_when_the_message_provides_it() {
     };
     for m in &mut rec.messages {
         if let SimMessage::Imu(i) = m {
-            let yaw = at(i.stamp);
-            i.orientation = [0.0, 0.0, (yaw / 2.0).sin(), (yaw / 2.0).cos()];
+            let yaw = at(i.header.stamp);
+            i.orientation = [0.0, 0.0, (yaw / 2.0).sin(), (yaw / 2.0).cos()].into();
             i.orientation_covariance = [1e-4, 0.0, 0.0, 0.0, 1e-4, 0.0, 0.0, 0.0, 1e-4];
         }
     }
@@ -150,7 +149,7 @@ fn one_odometry_glitch_maps_like_the_log_without_it() {
         if let SimMessage::Odometry(o) = m {
             odoms += 1;
             if odoms == 300 {
-                o.position[0] += 1000.0;
+                o.pose.pose.position.x += 1000.0;
             }
         }
     }

@@ -63,14 +63,18 @@ fn bad_images_are_counted_and_skipped() {
         i.width /= 2;
         i.height /= 2;
         i.step = i.width;
-        i.data.truncate((i.width * i.height) as usize);
+        let n = (i.width * i.height) as usize;
+        i.data.to_mut().truncate(n);
     });
     // Every 7th label image carries an unknown class id (200) in its first row.
-    every(&mut rec, "/camera/labels", 7, |i| i.data[..i.width as usize].fill(200));
+    every(&mut rec, "/camera/labels", 7, |i| {
+        let w = i.width as usize;
+        i.data.to_mut()[..w].fill(200)
+    });
     // Every 5th depth image has NaN, 0 and negative depths in its last rows.
     every(&mut rec, "/camera/depth", 5, |i| {
-        let n = i.data.len();
-        for (k, px) in i.data[n - 3 * i.step as usize..].chunks_exact_mut(4).enumerate() {
+        let (n, step) = (i.data.len(), i.step as usize);
+        for (k, px) in i.data.to_mut()[n - 3 * step..].chunks_exact_mut(4).enumerate() {
             px.copy_from_slice(&[f32::NAN, 0.0, -1.0][k % 3].to_le_bytes());
         }
     });
@@ -102,7 +106,7 @@ fn frames_without_a_pose_are_counted() {
             .collect();
         let n = imgs.len();
         for (k, i) in imgs[n - 3..].iter_mut().enumerate() {
-            i.stamp = Stamp(last.0 + 60_000_000_000 + k as i64 * 100_000_000);
+            i.header.stamp = Stamp(last.0 + 60_000_000_000 + k as i64 * 100_000_000);
         }
     }
     rec.messages.sort_by_key(|m| m.stamp());
@@ -132,7 +136,7 @@ fn a_late_camera_info_is_noted_and_used() {
     let mut rec = short();
     // Only camera-info messages after the first five seconds survive.
     let start = rec.messages.iter().map(|m| m.stamp()).min().unwrap();
-    rec.messages.retain(|m| !matches!(m, SimMessage::CameraInfo(i) if i.stamp.0 < start.0 + 5_000_000_000));
+    rec.messages.retain(|m| !matches!(m, SimMessage::CameraInfo(i) if i.header.stamp.0 < start.0 + 5_000_000_000));
     let r = run("camera-late-info", &rec).unwrap();
     assert!(r.notes.iter().any(|n| n.contains("after the first image")), "{:?}", r.notes);
     assert_eq!(camera(&r).frames_used, camera(&r).labels_read);
@@ -166,8 +170,8 @@ fn a_scan_between_a_label_and_its_depth_image_is_fine() {
     let mut rec = short();
     for m in rec.messages.iter_mut() {
         match m {
-            SimMessage::Scan(s) => s.stamp = Stamp(s.stamp.0 + 1_000_000),
-            SimMessage::Image(i) if i.topic == "/camera/depth" => i.stamp = Stamp(i.stamp.0 + 3_000_000),
+            SimMessage::Scan(s) => s.header.stamp = Stamp(s.header.stamp.0 + 1_000_000),
+            SimMessage::Image(i) if i.topic == "/camera/depth" => i.header.stamp = Stamp(i.header.stamp.0 + 3_000_000),
             _ => {}
         }
     }

@@ -48,20 +48,25 @@ fn bag_with_tf_glitch(tag: &str, base: &str, localiser: bool, glitch: Option<usi
             SimMessage::Odometry(o) => {
                 // odom → base_link from the odometry, and a localiser's map → odom at 10 Hz:
                 // 10 m east, turned 90°.
-                let yaw = fusemap_core::geometry::quaternion_yaw(o.orientation);
+                let yaw = fusemap_core::geometry::quaternion_yaw(o.pose.pose.orientation.to_array());
                 let off = if glitch == Some(n_odom) { 1000.0 } else { 0.0 };
-                let odom_tf = tf(o.stamp, "odom", base, o.position[0] + off, o.position[1], yaw);
-                w.write(o.stamp, "/tf", &odom_tf).unwrap();
+                let p = o.pose.pose.position;
+                let odom_tf = tf(o.header.stamp, "odom", base, p.x + off, p.y, yaw);
+                w.write(o.header.stamp, "/tf", &odom_tf).unwrap();
                 if n_odom == 0 && base != "base_link" {
-                    let mut t = tf(o.stamp, base, "base_link", 0.0, 0.0, 0.0);
+                    let mut t = tf(o.header.stamp, base, "base_link", 0.0, 0.0, 0.0);
                     if let OutMessage::Tf { is_static, .. } = &mut t {
                         *is_static = true;
                     }
-                    w.write(o.stamp, "/tf_static", &t).unwrap();
+                    w.write(o.header.stamp, "/tf_static", &t).unwrap();
                 }
                 if localiser && n_odom % 5 == 0 {
-                    w.write(o.stamp, "/tf", &tf(o.stamp, "map", "odom", 10.0, 0.0, std::f64::consts::FRAC_PI_2))
-                        .unwrap();
+                    w.write(
+                        o.header.stamp,
+                        "/tf",
+                        &tf(o.header.stamp, "map", "odom", 10.0, 0.0, std::f64::consts::FRAC_PI_2),
+                    )
+                    .unwrap();
                 }
                 n_odom += 1;
             }

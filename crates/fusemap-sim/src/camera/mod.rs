@@ -19,13 +19,16 @@ mod tests;
 
 pub use config::{optical_rotation, BacklightConfig, CameraConfig, DepthEncoding, LabelEncoding, MAX_CAMERA_BYTES};
 
-use super::messages::{SimCameraInfo, SimImage, SimMessage, SimStaticTransform};
-use super::path::Trajectory;
-use super::person::PersonConfig;
-use super::world::{Caster, WorldObject};
+use crate::messages::{SimCameraInfo, SimImage, SimMessage, SimStaticTransform};
+use crate::path::Trajectory;
+use crate::person::PersonConfig;
+use crate::world::{Caster, WorldObject};
 use fusemap_core::geometry::{normalize_angle, Point2, Pose2};
 use fusemap_core::sim::SplitMix64;
 use fusemap_core::time::Stamp;
+use fusemap_io::log::ros2::msgs::geometry_msgs::{Transform, TransformStamped};
+use fusemap_io::log::ros2::msgs::sensor_msgs::{CameraInfo, Image};
+use fusemap_io::log::ros2::msgs::std_msgs::Header;
 use render::{Frame, Renderer};
 
 /// Class id of unlabelled pixels.
@@ -267,14 +270,15 @@ impl CameraRun<'_> {
     /// The static transform `base_link → camera_optical`.
     pub fn mount_message(&self) -> SimStaticTransform {
         let p = self.cfg.base_from_optical();
-        SimStaticTransform {
-            stamp: self.start,
-            topic: "/tf_static".into(),
-            frame_id: self.base_link.into(),
-            child_frame_id: self.frame_id.into(),
-            translation: p.translation,
-            rotation: p.rotation,
-        }
+        let transform = Transform { translation: p.translation.into(), rotation: p.rotation.into() };
+        SimStaticTransform::new(
+            "/tf_static",
+            TransformStamped {
+                header: Header::new(self.start, self.base_link),
+                child_frame_id: self.frame_id.into(),
+                transform,
+            },
+        )
     }
 
     /// Every frame of the run, split over the machine's cores (frames are independent:
@@ -359,16 +363,19 @@ impl CameraRun<'_> {
                     threshold = bottom_k(&mut part.sample, MAX_BACKLIT_POINTS);
                 }
             }
-            let image = |topic: &str, encoding: &str, bytes: u32, data: Vec<u8>| SimImage {
-                stamp,
-                topic: topic.into(),
-                frame_id: self.frame_id.into(),
-                height: h,
-                width: w,
-                encoding: encoding.into(),
-                is_bigendian: 0,
-                step: w * bytes,
-                data,
+            let image = |topic: &str, encoding: &str, bytes: u32, data: Vec<u8>| {
+                SimImage::new(
+                    topic,
+                    Image {
+                        header: Header::new(stamp, self.frame_id),
+                        height: h,
+                        width: w,
+                        encoding: encoding.into(),
+                        is_bigendian: 0,
+                        step: w * bytes,
+                        data: data.into(),
+                    },
+                )
             };
             part.messages.push(SimMessage::Image(image(
                 &cfg.label_topic,
@@ -382,18 +389,20 @@ impl CameraRun<'_> {
                 depth_bytes,
                 encode_depth(&frame.depth, cfg.depth_encoding),
             )));
-            part.messages.push(SimMessage::CameraInfo(Box::new(SimCameraInfo {
-                stamp,
-                topic: cfg.info_topic.clone(),
-                frame_id: self.frame_id.into(),
-                height: h,
-                width: w,
-                distortion_model: "plumb_bob".into(),
-                d: vec![0.0; 5],
-                k,
-                r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-                p: [k[0], 0.0, k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0],
-            })));
+            part.messages.push(SimMessage::CameraInfo(Box::new(SimCameraInfo::new(
+                &cfg.info_topic,
+                CameraInfo {
+                    header: Header::new(stamp, self.frame_id),
+                    height: h,
+                    width: w,
+                    distortion_model: "plumb_bob".into(),
+                    d: vec![0.0; 5],
+                    k,
+                    r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                    p: [k[0], 0.0, k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0],
+                    ..CameraInfo::default()
+                },
+            ))));
         }
         part
     }

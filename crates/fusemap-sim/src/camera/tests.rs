@@ -265,20 +265,20 @@ fn same_seed_same_images_and_stamps_carry_the_offset() {
         format!("{:?}", images(&b, "/camera/depth").collect::<Vec<_>>())
     );
     for (img, (truth, stamp)) in la.iter().zip(&a.camera_truth.stamps) {
-        assert_eq!(img.stamp, *stamp);
+        assert_eq!(img.header.stamp, *stamp);
         assert_eq!(stamp.0 - truth.0, 30_000_000);
         assert_eq!((img.encoding.as_str(), img.step, img.data.len()), ("mono8", 96, 96 * 72));
     }
     let info = a.messages.iter().find_map(|m| if let SimMessage::CameraInfo(c) = m { Some(c) } else { None }).unwrap();
     assert_eq!(
-        (info.stamp, info.distortion_model.as_str(), info.d.as_slice()),
-        (la[0].stamp, "plumb_bob", &[0.0; 5][..])
+        (info.header.stamp, info.distortion_model.as_str(), info.d.as_slice()),
+        (la[0].header.stamp, "plumb_bob", &[0.0; 5][..])
     );
     let tf = a.messages.iter().find_map(|m| match m {
         SimMessage::StaticTransform(t) if t.child_frame_id == "camera_optical" => Some(t),
         _ => None,
     });
-    assert_eq!(tf.unwrap().frame_id, "base_link");
+    assert_eq!(tf.unwrap().header.frame_id, "base_link");
     s.world.seed += 1;
     let c = simulate(&s).unwrap();
     assert_ne!(la, images(&c, "/camera/labels").collect::<Vec<_>>());

@@ -46,12 +46,12 @@ fn map_and_score(s: &Scenario, pass_through: PassThroughParams, filters: ScanFil
     for m in &run.messages {
         if let SimMessage::Scan(x) = m {
             let scan = LaserScan {
-                stamp: x.stamp,
+                stamp: x.header.stamp,
                 angle_min: x.angle_min as f64,
                 angle_increment: x.angle_increment as f64,
                 ranges: x.ranges.clone(),
             };
-            let t0 = (x.stamp.0 - start_ns) as f64 * 1e-9 - s.lidar.time_offset_s;
+            let t0 = (x.header.stamp.0 - start_ns) as f64 * 1e-9 - s.lidar.time_offset_s;
             let ti = x.time_increment as f64;
             engine.insert_scan_with(laser, &scan, |i| traj.pose_at(t0 + i as f64 * ti)).unwrap();
         }
