@@ -19,9 +19,10 @@ use std::time::Instant;
 /// about.
 #[derive(Debug, thiserror::Error)]
 pub enum JobError {
-    /// A file could not be read or is not valid (the error names it, and the line).
+    /// A file could not be read or written, or is not valid (the error names it, and the
+    /// line).
     #[error(transparent)]
-    Read(#[from] fusemap_io::Error),
+    File(#[from] fusemap_io::Error),
     /// The built-in configuration is not valid (a `[limits]` or `[map]` default changed
     /// without its checks).
     #[error("configuration: {0}")]
@@ -35,6 +36,23 @@ pub enum JobError {
     /// The run's report could not be put into `summary.json`.
     #[error("cannot write the run report as JSON: {0}")]
     Report(#[from] serde_json::Error),
+    /// The simulator refused its scenario.
+    #[error("scenario: {0}")]
+    Scenario(#[from] fusemap_sim::SimError),
+    /// The simulated recording could not be written.
+    #[error("writing the simulation to {}: {source}", dir.display())]
+    Simulation {
+        /// Where it was to go.
+        dir: PathBuf,
+        /// Why it could not.
+        source: fusemap_io::Error,
+    },
+    /// The simulator's ground truth does not fit the grid.
+    #[error(transparent)]
+    Truth(#[from] fusemap_sim::TruthRasterError),
+    /// The mapping refused or failed (a run of the simulator's own recording).
+    #[error(transparent)]
+    Pipeline(#[from] PipelineError),
     /// The mapping refused or failed; `input` names the log or the world.
     #[error("{input}: {error}")]
     Run {
@@ -48,9 +66,14 @@ pub enum JobError {
 /// The validated plan of a configuration file, or of the built-in defaults without one:
 /// the file is read and validated once (its errors name the file and the line).
 pub fn plan_of(config: Option<&Path>) -> Result<Plan, JobError> {
+    plan_of_or(config, || Config::default().validate().map_err(JobError::Config))
+}
+
+/// The validated plan of a configuration file, or `default()` without one.
+pub fn plan_of_or(config: Option<&Path>, default: impl FnOnce() -> Result<Plan, JobError>) -> Result<Plan, JobError> {
     match config {
         Some(p) => Ok(fusemap_io::config_file::load_plan(p)?),
-        None => Config::default().validate().map_err(JobError::Config),
+        None => default(),
     }
 }
 
@@ -152,7 +175,7 @@ impl MapJob {
                 // engine's refusals (a map past limits.map_cells) and the pipeline's (a log
                 // with no scans, a lidar topic the log lacks) do not: named here.
                 let run = crate::map_log(&self.plan, path, progress).map_err(|error| match error {
-                    PipelineError::Read(e) => JobError::Read(e),
+                    PipelineError::Read(e) => JobError::File(e),
                     error => JobError::Run { input: input.clone(), error },
                 })?;
                 let log = Some(serde_json::to_value(&run.report)?);

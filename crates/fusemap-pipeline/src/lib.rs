@@ -20,12 +20,14 @@
 //! | the run report | [`report`] |
 //! | the output files and `summary.json` | [`outputs`] |
 //! | a command's arguments checked and resolved into a run | [`job`] |
+//! | the production-line demo: simulated, mapped three ways, scored, drawn | [`demo`] |
 //! | the log doctor's figures | [`doctor`] |
 //! | GNSS quality over time, odometry against the gyro | [`pose_sensors_report`] |
 
 #![warn(missing_docs)]
 
 pub mod camera;
+pub mod demo;
 pub mod doctor;
 pub mod estimation;
 pub mod estimation_report;

@@ -5,26 +5,11 @@
 //! document's §3.3 corridor instead.
 
 use crate::progress;
-use anyhow::{Context, Result};
-use fusemap_core::config::Plan;
-use fusemap_core::fusion::{Engine, MapEntry};
-use fusemap_core::grid::{CellBox, CellIndex, Raster};
+use anyhow::Result;
 use fusemap_core::sim::{ScannerSpec, SimulatedRun};
-use fusemap_io::comparison::{write_comparison_png, Panel};
+use fusemap_pipeline::demo::{scores_table, DemoJob};
 use fusemap_pipeline::job::MapJob;
-use fusemap_pipeline::outputs::{self, finish, layers_of, ExportOptions, OutputFiles, RunRecord};
-use fusemap_pipeline::recording::Inventory;
-use fusemap_pipeline::scenario::{production_line_plan, score, three_maps, MapScore, Truth};
-use fusemap_sim::{simulate, Scenario};
-use std::path::{Path, PathBuf};
-use std::time::Instant;
-
-fn plan_of(config: Option<&Path>, default: impl FnOnce() -> Result<Plan>) -> Result<Plan> {
-    match config {
-        Some(p) => Ok(fusemap_io::config_file::load_plan(p)?),
-        None => default(),
-    }
-}
+use std::path::Path;
 
 /// `fusemap demo --corridor`: the design document's corridor with the default config.
 pub fn corridor(out: &Path, config: Option<&Path>) -> Result<()> {
@@ -39,173 +24,19 @@ pub fn corridor(out: &Path, config: Option<&Path>) -> Result<()> {
 
 /// `fusemap demo`: the production line, lidar-only, camera-only and fused.
 pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
-    let started = Instant::now();
-    let plan = plan_of(config, || Ok(production_line_plan()?))?;
-    let inputs: Vec<PathBuf> = config.map(Path::to_path_buf).into_iter().collect();
-    let mut files = outputs::prepare(out, &inputs)?;
-    let rec = simulate(&Scenario::default()).map_err(|e| anyhow::anyhow!("scenario: {e}"))?;
-    // Everything the demo writes — the simulated bag it reads back, the three maps, the
-    // comparison — is staged in the one output set and moves into `out` at its commit.
-    files.own_dir("sim");
-    let sim_dir = files.staged("sim");
-    let sim = fusemap_sim::bag::write_simulation(&rec, &sim_dir, plan.geometry.resolution(), true)
-        .with_context(|| format!("writing the simulation to {}", sim_dir.display()))?;
-    let inv = Inventory::read_with(&sim.bag.dir, &plan.limits)?;
-    let (bound, chosen, track_s) = fusemap_pipeline::run::prepare(&plan, &inv)?;
-    let run = fusemap_pipeline::map_with_track(
-        &plan,
-        &inv,
-        &bound,
-        chosen,
-        track_s,
-        Some(three_maps(&plan)),
-        &mut progress::reporter(),
-    )?;
-    let truth_occupancy = rec.truth_occupancy(plan.geometry)?;
-    let truth_semantic = rec.truth_semantic(plan.geometry)?;
-    let truth = Truth {
-        occupancy: &truth_occupancy,
-        semantic: &truth_semantic,
-        person: &rec.person_track,
-        person_radius_m: rec.person_radius_m,
-    };
-    let scores: Vec<MapScore> =
-        run.engine.maps().iter().map(|m| score(m.name(), m.grid(), &plan.classes, &truth)).collect();
-
-    // The fused map (the primary) with every output; the other two beside it.
-    let mut log = serde_json::to_value(&run.report)?;
-    log["scenario_scores"] = serde_json::to_value(&scores)?;
-    let bag_in_out = out.join(sim.bag.dir.strip_prefix(files.staged("")).unwrap_or(&sim.bag.dir));
-    let source = format!("built-in production line, simulated to {}", bag_in_out.display());
-    for m in run.engine.maps().iter().skip(1) {
-        files.own_dir(m.name());
-        write_map_files(&files.staged(m.name()), &run.engine, m)?;
-    }
-    write_comparison(&files.staged("comparison.png"), &run.engine, &scores, &truth_occupancy, &plan)?;
-    let record = RunRecord {
-        source_kind: "rosbag2 (simulated production line)",
-        source: &source,
-        started,
-        notes: run.notes.clone(),
-        log: Some(log),
-        trajectory: Some(&run.trajectory),
-    };
-    let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
-    let summary = finish(&run.engine, files, &export, record)?;
-    let picture = out.join("comparison.png");
-    print!("{summary}");
-    print_scores(&scores, &plan);
-    println!("comparison    {}", picture.display());
+    let job = DemoJob::plan(config, out)?;
+    let plan = job.plan.clone();
+    let run = job.run(&mut progress::reporter())?;
+    print!("{}", run.summary);
+    print!("{}", scores_table(&run.scores, &plan));
+    println!("comparison    {}", out.join("comparison.png").display());
     let others: Vec<String> = run
-        .engine
-        .maps()
+        .other_maps
         .iter()
-        .skip(1)
-        .map(|m| m.name())
+        .map(String::as_str)
         .chain(["sim"])
         .map(|name| out.join(name).display().to_string())
         .collect();
     println!("outputs       {} (fused), {}", out.display(), others.join(", "));
     Ok(())
-}
-
-/// Writes a map of the set (not the primary) as map.npz, map.pgm + map.yaml, map.png, and
-/// its semantic and dynamic layers when it has them.
-fn write_map_files(dir: &Path, engine: &Engine, m: &MapEntry) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let files = OutputFiles::in_dir(dir);
-    let Some(raster) = m.grid().known_raster() else { return Ok(()) };
-    let layers = layers_of(engine, m.grid(), &raster).filter(|l| l.semantic.best.iter().any(|&b| b >= 0));
-    match &layers {
-        Some(l) => {
-            let with = fusemap_io::npz::NpzLayers { semantic: Some(&l.semantic), dynamic: Some(&l.dynamic) };
-            fusemap_io::npz::write_map_npz_with(&files.npz, &raster, &with)?;
-            fusemap_io::semantic::write_semantic(&files.semantic, &l.semantic)?;
-            fusemap_io::semantic::write_dynamic_png(&files.dynamic, &l.dynamic)?;
-        }
-        None => fusemap_io::npz::write_map_npz(&files.npz, &raster)?,
-    }
-    fusemap_io::map_server::write_map_server(&files.yaml, &raster)?;
-    fusemap_io::picture::write_map_png(&files.png, &raster)?;
-    Ok(())
-}
-
-/// Ground truth, the three maps and the fused map's classes, side by side over the hall.
-fn write_comparison(
-    path: &Path,
-    engine: &Engine,
-    scores: &[MapScore],
-    truth: &fusemap_sim::TruthRaster,
-    plan: &Plan,
-) -> Result<()> {
-    let area = CellBox {
-        min: truth.first_cell,
-        max: CellIndex::new(truth.first_cell.x + truth.width as i64 - 1, truth.first_cell.y + truth.height as i64 - 1),
-    };
-    let occupied = plan.occupancy.clamp_max;
-    let truth_raster = Raster {
-        width: truth.width,
-        height: truth.height,
-        resolution: plan.geometry.resolution(),
-        origin: plan.geometry.cell_corner(truth.first_cell),
-        first_cell: truth.first_cell,
-        log_odds: truth
-            .occupied
-            .iter()
-            .map(|&o| fusemap_core::grid::logodds::logit(if o { occupied } else { plan.occupancy.clamp_min }) as f32)
-            .collect(),
-        known: vec![true; truth.occupied.len()],
-        params: plan.occupancy,
-    };
-    let mut panels = vec![Panel::occupancy(vec!["ground truth".into()], &truth_raster)];
-    let mut fused_semantic = None;
-    for (m, s) in engine.maps().iter().zip(scores) {
-        let raster = m.grid().raster(area);
-        let mut caption = vec![format!("{} map", s.name), format!("F1 {:.3}", s.occupied.f1)];
-        if let Some(a) = s.semantic.total.accuracy() {
-            caption.push(format!("classes {:.3}", a));
-        }
-        panels.push(Panel::occupancy(caption, &raster));
-        if m.name() == "fused" {
-            fused_semantic = layers_of(engine, m.grid(), &raster);
-        }
-    }
-    if let Some(l) = fused_semantic {
-        let rgb = l
-            .semantic
-            .best
-            .iter()
-            .map(|&b| if b >= 0 { l.semantic.classes[b as usize].color } else { fusemap_io::semantic::UNKNOWN_COLOR })
-            .collect();
-        panels.push(Panel {
-            caption: vec!["fused classes".into()],
-            width: l.semantic.width,
-            height: l.semantic.height,
-            rgb,
-        });
-    }
-    write_comparison_png(path, &panels)?;
-    Ok(())
-}
-
-fn print_scores(scores: &[MapScore], plan: &Plan) {
-    println!("scores against the simulator's ground truth (1-cell tolerance):");
-    println!("  map      F1 occ  glass  backlit  pillar free  machine free  person  classes  wall  glass  pillar");
-    for s in scores {
-        let acc = |n: &str| s.semantic_of(&plan.classes, n).map_or("   -".to_string(), |a| format!("{a:.2}"));
-        println!(
-            "  {:<7}  {:>6.3}  {:>5.2}  {:>7}  {:>11.3}  {:>12.3}  {:>6}  {:>7}  {:>4}  {:>5}  {:>6}",
-            s.name,
-            s.occupied.f1,
-            s.glass_occupied_share,
-            s.backlit_occupied_cells,
-            s.pillar_body_free_share,
-            s.machine_body_free_share,
-            s.person_static_cells,
-            s.semantic.total.accuracy().map_or("-".to_string(), |a| format!("{a:.3}")),
-            acc("wall"),
-            acc("glass"),
-            acc("pillar"),
-        );
-    }
 }
