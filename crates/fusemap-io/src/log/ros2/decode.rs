@@ -97,156 +97,176 @@ pub fn decode_known_with(
     payload: &[u8],
     pixels: bool,
 ) -> std::result::Result<LogMessage, CdrError> {
-    use msgs::{geometry_msgs, nav_msgs, sensor_msgs, tf2_msgs};
+    use msgs::sensor_msgs::Image;
+    let on = On { topic, receive_stamp };
     Ok(match kind {
-        KnownType::LaserScan => {
-            let m: sensor_msgs::LaserScan = decode_cdr(payload)?;
-            LogMessage::Scan(ScanMessage {
-                topic: topic.to_owned(),
-                frame_id: m.header.frame_id,
-                receive_stamp,
-                scan: LaserScan {
-                    stamp: m.header.stamp,
-                    angle_min: f64::from(m.angle_min),
-                    angle_increment: f64::from(m.angle_increment),
-                    ranges: m.ranges,
-                },
-                angle_max: m.angle_max,
-                time_increment: m.time_increment,
-                scan_time: m.scan_time,
-                range_min: m.range_min,
-                range_max: m.range_max,
-                pose: None,
-                odom_pose: None,
-                laser_pose: None,
-            })
-        }
-        KnownType::Odometry => {
-            let m: nav_msgs::Odometry = decode_cdr(payload)?;
-            let p = m.pose.pose;
-            let t = m.twist.twist;
-            LogMessage::Odometry(OdomMessage {
-                topic: topic.to_owned(),
+        KnownType::LaserScan => LogMessage::Scan(on.scan(decode_cdr(payload)?)),
+        KnownType::Odometry => LogMessage::Odometry(on.odometry(decode_cdr(payload)?)),
+        KnownType::TfMessage => LogMessage::Tf(on.tf(decode_cdr(payload)?)),
+        KnownType::Imu => LogMessage::Imu(on.imu(decode_cdr(payload)?)),
+        KnownType::NavSatFix => LogMessage::Gnss(on.fix(decode_cdr(payload)?)),
+        KnownType::PoseWithCovarianceStamped => LogMessage::Pose(on.pose(decode_cdr(payload)?)),
+        KnownType::Image => on.image(Image::from_payload(payload)?, pixels),
+        KnownType::CameraInfo => LogMessage::CameraInfo(on.camera_info(decode_cdr(payload)?)),
+    })
+}
+
+/// Where a decoded ROS 2 message arrived: its topic and, when the container says, when it
+/// was logged. Its methods turn each message struct into fusemap's message type.
+struct On<'a> {
+    topic: &'a str,
+    receive_stamp: Option<Stamp>,
+}
+
+impl On<'_> {
+    fn scan(&self, m: msgs::sensor_msgs::LaserScan) -> ScanMessage {
+        ScanMessage {
+            topic: self.topic.to_owned(),
+            frame_id: m.header.frame_id,
+            receive_stamp: self.receive_stamp,
+            scan: LaserScan {
                 stamp: m.header.stamp,
-                receive_stamp,
-                frame_id: m.header.frame_id,
-                child_frame_id: m.child_frame_id,
-                pose: planar_pose([p.position.x, p.position.y, p.position.z], p.orientation.to_array()),
-                pose_covariance: m.pose.covariance,
-                twist: [t.linear.x, t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z],
-                twist_covariance: m.twist.covariance,
-            })
+                angle_min: f64::from(m.angle_min),
+                angle_increment: f64::from(m.angle_increment),
+                ranges: m.ranges,
+            },
+            angle_max: m.angle_max,
+            time_increment: m.time_increment,
+            scan_time: m.scan_time,
+            range_min: m.range_min,
+            range_max: m.range_max,
+            pose: None,
+            odom_pose: None,
+            laser_pose: None,
         }
-        KnownType::TfMessage => {
-            let m: tf2_msgs::TfMessage = decode_cdr(payload)?;
-            LogMessage::Tf(TfMessage {
-                topic: topic.to_owned(),
-                is_static: topic == "/tf_static",
-                receive_stamp,
-                transforms: m
-                    .transforms
-                    .into_iter()
-                    .map(|t| Transform {
-                        stamp: t.header.stamp,
-                        parent: t.header.frame_id,
-                        child: t.child_frame_id,
-                        translation: t.transform.translation.to_array(),
-                        rotation: t.transform.rotation.to_array(),
-                    })
-                    .collect(),
-            })
+    }
+
+    fn odometry(&self, m: msgs::nav_msgs::Odometry) -> OdomMessage {
+        let p = m.pose.pose;
+        let t = m.twist.twist;
+        OdomMessage {
+            topic: self.topic.to_owned(),
+            stamp: m.header.stamp,
+            receive_stamp: self.receive_stamp,
+            frame_id: m.header.frame_id,
+            child_frame_id: m.child_frame_id,
+            pose: planar_pose(p.position.to_array(), p.orientation.to_array()),
+            pose_covariance: m.pose.covariance,
+            twist: [t.linear.x, t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z],
+            twist_covariance: m.twist.covariance,
         }
-        KnownType::Imu => {
-            let m: sensor_msgs::Imu = decode_cdr(payload)?;
-            LogMessage::Imu(ImuMessage {
-                topic: topic.to_owned(),
-                stamp: m.header.stamp,
-                receive_stamp,
-                frame_id: m.header.frame_id,
-                orientation: m.orientation.to_array(),
-                angular_velocity: m.angular_velocity.to_array(),
-                linear_acceleration: m.linear_acceleration.to_array(),
-                orientation_covariance: m.orientation_covariance,
-                angular_velocity_covariance: m.angular_velocity_covariance,
-                linear_acceleration_covariance: m.linear_acceleration_covariance,
-            })
-        }
-        KnownType::NavSatFix => {
-            let m: sensor_msgs::NavSatFix = decode_cdr(payload)?;
-            LogMessage::Gnss(GnssMessage {
-                topic: topic.to_owned(),
-                stamp: m.header.stamp,
-                receive_stamp,
-                frame_id: m.header.frame_id,
-                status: m.status.status,
-                service: m.status.service,
-                latitude: m.latitude,
-                longitude: m.longitude,
-                altitude: m.altitude,
-                position_covariance: m.position_covariance,
-                position_covariance_type: m.position_covariance_type,
-            })
-        }
-        KnownType::PoseWithCovarianceStamped => {
-            let m: geometry_msgs::PoseWithCovarianceStamped = decode_cdr(payload)?;
-            let p = m.pose.pose;
-            LogMessage::Pose(PoseMessage {
-                topic: topic.to_owned(),
-                stamp: m.header.stamp,
-                receive_stamp,
-                frame_id: m.header.frame_id,
-                position: [p.position.x, p.position.y, p.position.z],
-                orientation: p.orientation.to_array(),
-                covariance: m.pose.covariance,
-            })
-        }
-        KnownType::Image => {
-            let m = sensor_msgs::Image::from_payload(payload)?;
-            let stamp = m.header.stamp;
-            let is_bigendian = m.is_bigendian != 0;
-            if pixels {
-                LogMessage::Image(ImageMessage {
-                    topic: topic.to_owned(),
-                    stamp,
-                    receive_stamp,
-                    frame_id: m.header.frame_id,
-                    width: m.width,
-                    height: m.height,
-                    encoding: m.encoding,
-                    is_bigendian,
-                    step: m.step,
-                    data: m.data.to_vec(),
+    }
+
+    fn tf(&self, m: msgs::tf2_msgs::TfMessage) -> TfMessage {
+        TfMessage {
+            topic: self.topic.to_owned(),
+            is_static: self.topic == "/tf_static",
+            receive_stamp: self.receive_stamp,
+            transforms: m
+                .transforms
+                .into_iter()
+                .map(|t| Transform {
+                    stamp: t.header.stamp,
+                    parent: t.header.frame_id,
+                    child: t.child_frame_id,
+                    translation: t.transform.translation.to_array(),
+                    rotation: t.transform.rotation.to_array(),
                 })
-            } else {
-                LogMessage::ImageHeader(ImageHeader {
-                    topic: topic.to_owned(),
-                    stamp,
-                    receive_stamp,
-                    frame_id: m.header.frame_id,
-                    width: m.width,
-                    height: m.height,
-                    encoding: m.encoding,
-                    is_bigendian,
-                    step: m.step,
-                    data_len: m.data.len() as u64,
-                })
-            }
+                .collect(),
         }
-        KnownType::CameraInfo => {
-            let m: sensor_msgs::CameraInfo = decode_cdr(payload)?;
-            LogMessage::CameraInfo(CameraInfoMessage {
-                topic: topic.to_owned(),
-                stamp: m.header.stamp,
+    }
+
+    fn imu(&self, m: msgs::sensor_msgs::Imu) -> ImuMessage {
+        ImuMessage {
+            topic: self.topic.to_owned(),
+            stamp: m.header.stamp,
+            receive_stamp: self.receive_stamp,
+            frame_id: m.header.frame_id,
+            orientation: m.orientation.to_array(),
+            angular_velocity: m.angular_velocity.to_array(),
+            linear_acceleration: m.linear_acceleration.to_array(),
+            orientation_covariance: m.orientation_covariance,
+            angular_velocity_covariance: m.angular_velocity_covariance,
+            linear_acceleration_covariance: m.linear_acceleration_covariance,
+        }
+    }
+
+    fn fix(&self, m: msgs::sensor_msgs::NavSatFix) -> GnssMessage {
+        GnssMessage {
+            topic: self.topic.to_owned(),
+            stamp: m.header.stamp,
+            receive_stamp: self.receive_stamp,
+            frame_id: m.header.frame_id,
+            status: m.status.status,
+            service: m.status.service,
+            latitude: m.latitude,
+            longitude: m.longitude,
+            altitude: m.altitude,
+            position_covariance: m.position_covariance,
+            position_covariance_type: m.position_covariance_type,
+        }
+    }
+
+    fn pose(&self, m: msgs::geometry_msgs::PoseWithCovarianceStamped) -> PoseMessage {
+        let p = m.pose.pose;
+        PoseMessage {
+            topic: self.topic.to_owned(),
+            stamp: m.header.stamp,
+            receive_stamp: self.receive_stamp,
+            frame_id: m.header.frame_id,
+            position: p.position.to_array(),
+            orientation: p.orientation.to_array(),
+            covariance: m.pose.covariance,
+        }
+    }
+
+    /// An image with its pixels, or only its header without `pixels`.
+    fn image(&self, m: msgs::sensor_msgs::Image<'_>, pixels: bool) -> LogMessage {
+        let (topic, stamp, receive_stamp) = (self.topic.to_owned(), m.header.stamp, self.receive_stamp);
+        let is_bigendian = m.is_bigendian != 0;
+        let frame_id = m.header.frame_id;
+        if pixels {
+            LogMessage::Image(ImageMessage {
+                topic,
+                stamp,
                 receive_stamp,
-                frame_id: m.header.frame_id,
+                frame_id,
                 width: m.width,
                 height: m.height,
-                distortion_model: m.distortion_model,
-                d: m.d,
-                k: m.k,
+                encoding: m.encoding,
+                is_bigendian,
+                step: m.step,
+                data: m.data.into_owned(),
+            })
+        } else {
+            LogMessage::ImageHeader(ImageHeader {
+                topic,
+                stamp,
+                receive_stamp,
+                frame_id,
+                width: m.width,
+                height: m.height,
+                encoding: m.encoding,
+                is_bigendian,
+                step: m.step,
+                data_len: m.data.len() as u64,
             })
         }
-    })
+    }
+
+    fn camera_info(&self, m: msgs::sensor_msgs::CameraInfo) -> CameraInfoMessage {
+        CameraInfoMessage {
+            topic: self.topic.to_owned(),
+            stamp: m.header.stamp,
+            receive_stamp: self.receive_stamp,
+            frame_id: m.header.frame_id,
+            width: m.width,
+            height: m.height,
+            distortion_model: m.distortion_model,
+            d: m.d,
+            k: m.k,
+        }
+    }
 }
 
 /// Decodes a payload by its ROS type name: `Ok(None)` for a type fusemap does not use.
