@@ -92,6 +92,7 @@ pub use semantic_truth::TruthSemantic;
 pub use sensors::{DropoutMode, GnssConfig, GnssZone, ImuConfig, LidarConfig, OdometryConfig, ZoneKind};
 pub use world::{production_hall_objects, Caster, EdgeHit, Hit, Material, Rect, Shape, WorldObject};
 
+use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::sim::SplitMix64;
 use fusemap_core::time::Stamp;
 
@@ -105,6 +106,40 @@ pub enum SimError {
 
 /// Rate of [`SimRecording::truth_trajectory`], Hz.
 pub const TRUTH_OUTPUT_RATE_HZ: f64 = 50.0;
+
+/// The `/tf_static` mounts of the lidar, the IMU and the GNSS antenna on the base.
+fn static_mounts(scenario: &Scenario, start: Stamp) -> Vec<SimMessage> {
+    let f = &scenario.frames;
+    [(&f.laser, &scenario.lidar.mount), (&f.imu_link, &scenario.imu.mount), (&f.gps, &scenario.gnss.mount)]
+        .into_iter()
+        .map(|(child, mount)| {
+            SimMessage::StaticTransform(SimStaticTransform::from_mount(start, "/tf_static", &f.base_link, child, mount))
+        })
+        .collect()
+}
+
+/// The true trajectory at [`TRUTH_OUTPUT_RATE_HZ`].
+fn truth_trajectory(traj: &Trajectory, start: Stamp) -> Vec<(Stamp, Pose2)> {
+    let mut out = Vec::new();
+    let mut k = 0usize;
+    while k as f64 / TRUTH_OUTPUT_RATE_HZ <= traj.duration() {
+        let t = k as f64 / TRUTH_OUTPUT_RATE_HZ;
+        out.push((Stamp(start.0 + (t * 1e9).round() as i64), traj.pose_at(t)));
+        k += 1;
+    }
+    out
+}
+
+/// The person's true track at [`TRUTH_OUTPUT_RATE_HZ`], while they walk.
+fn person_track(scenario: &Scenario, traj: &Trajectory, start: Stamp) -> Vec<(Stamp, Point2)> {
+    (0..=(traj.duration() * TRUTH_OUTPUT_RATE_HZ).floor() as usize)
+        .filter_map(|k| {
+            let t = k as f64 / TRUTH_OUTPUT_RATE_HZ;
+            let p = scenario.person.position_at(t)?;
+            Some((Stamp(start.0 + (t * 1e9).round() as i64), p))
+        })
+        .collect()
+}
 
 /// Runs the scenario.
 pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
@@ -123,19 +158,7 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
     let camera_seed = seeds.next_u64();
     let f = &scenario.frames;
 
-    let mut messages = Vec::new();
-    let tf = "/tf_static";
-    for (child, mount) in
-        [(&f.laser, &scenario.lidar.mount), (&f.imu_link, &scenario.imu.mount), (&f.gps, &scenario.gnss.mount)]
-    {
-        messages.push(SimMessage::StaticTransform(SimStaticTransform::from_mount(
-            start,
-            tf,
-            &f.base_link,
-            child,
-            mount,
-        )));
-    }
+    let mut messages = static_mounts(scenario, start);
     let camera_run = camera::CameraRun {
         cfg: &scenario.camera,
         frame_id: &f.camera_optical,
@@ -173,24 +196,9 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
         CameraTruth::default()
     };
     messages.sort_by_key(|m| m.stamp());
-
-    let mut truth_trajectory = Vec::new();
-    let mut k = 0usize;
-    while k as f64 / TRUTH_OUTPUT_RATE_HZ <= traj.duration() {
-        let t = k as f64 / TRUTH_OUTPUT_RATE_HZ;
-        truth_trajectory.push((Stamp(start.0 + (t * 1e9).round() as i64), traj.pose_at(t)));
-        k += 1;
-    }
-    let person_track = (0..=(traj.duration() * TRUTH_OUTPUT_RATE_HZ).floor() as usize)
-        .filter_map(|k| {
-            let t = k as f64 / TRUTH_OUTPUT_RATE_HZ;
-            let p = scenario.person.position_at(t)?;
-            Some((Stamp(start.0 + (t * 1e9).round() as i64), p))
-        })
-        .collect();
     Ok(SimRecording {
         messages,
-        truth_trajectory,
+        truth_trajectory: truth_trajectory(&traj, start),
         injected_outliers: gnss.outliers,
         dropouts: gnss.dropouts,
         gyro_bias_radps: scenario.imu.gyro_bias_radps,
@@ -200,7 +208,7 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
         datum,
         objects: scenario.world.objects.clone(),
         extent: scenario.world.extent,
-        person_track,
+        person_track: person_track(scenario, &traj, start),
         person_radius_m: scenario.person.radius_m,
         camera_truth,
     })
