@@ -150,12 +150,6 @@ impl<'a> Cursor<'a> {
         let (chunks, _) = bytes.as_chunks::<8>();
         Ok(chunks.iter().map(|c| f64::from_le_bytes(*c)).collect())
     }
-
-    /// Skips a variable-length `float32[]`, checking that it fits.
-    pub(super) fn skip_f32_array(&mut self, what: &str) -> Result<(), Malformed> {
-        let n = self.array_len(4, what)?;
-        self.take(n * 4, what).map(drop)
-    }
 }
 
 #[cfg(test)]

@@ -53,10 +53,10 @@ mod record;
 #[cfg(test)]
 mod tests;
 
+use crate::log::ros2::KnownType;
 use crate::log::{LogMessage, LogReader, ReadOptions, ReadStats};
 use crate::{Error, Location, Result};
 use cursor::{Cursor, Malformed};
-use messages::Kind;
 use record::RecordHeader;
 use std::collections::HashMap;
 use std::fs::File;
@@ -120,7 +120,7 @@ struct Decoder {
 struct Connection {
     topic: String,
     ty: String,
-    kind: Option<Kind>,
+    kind: Option<KnownType>,
 }
 
 /// Where a record is, for container errors.
@@ -507,7 +507,7 @@ impl Decoder {
         let topic = String::from_utf8_lossy(topic).into_owned();
         let (ty, md5) = record::parse_connection_data(data)?;
         let ty = String::from_utf8_lossy(ty).into_owned();
-        let kind = match Kind::from_type(ty.as_bytes()) {
+        let kind = match messages::known_type(ty.as_bytes()) {
             Some((kind, expected)) if md5 == expected.as_bytes() => Some(kind),
             Some((_, expected)) => {
                 return Err(Malformed(format!(

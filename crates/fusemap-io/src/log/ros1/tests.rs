@@ -263,6 +263,9 @@ fn malformed_payloads_name_the_field() {
     huge_tf[..4].copy_from_slice(&u32::MAX.to_le_bytes());
     let mut short_imu = imu_payload((1, 0));
     short_imu.pop();
+    let identity = [0.0, 0.0, 0.0, 1.0];
+    let mut short_tf = tf_payload(&[((1, 0), "a", "b", [0.0; 3], identity), ((1, 0), "a", "c", [0.0; 3], identity)]);
+    short_tf.truncate(short_tf.len() - 8);
     let mut long_frame = Vec::new();
     ros_header(&mut long_frame, 0, (1, 0), "x");
     long_frame[12..16].copy_from_slice(&1000u32.to_le_bytes());
@@ -277,6 +280,7 @@ fn malformed_payloads_name_the_field() {
         (ODOM, short_odom, "Odometry: twist.covariance: needs 288 bytes but 280 remain"),
         (TF, huge_tf, "TFMessage: transforms array claims 4294967295 elements but 0 bytes remain"),
         (IMU, short_imu, "Imu: linear_acceleration_covariance: needs 72 bytes but 71 remain"),
+        (TF, short_tf, "TFMessage: transforms[1].transform.rotation.w: needs 8 bytes but 0 remain"),
         (SCAN, long_frame, "LaserScan: header.frame_id: claims 1000 bytes but 1 remain"),
     ];
     for (conn, payload, expected) in cases {

@@ -9,9 +9,12 @@
 //!
 //! [`CdrReader`] is a bounds-checked cursor over such a payload: every read checks the
 //! remaining length first, so a truncated or corrupt payload gives a [`CdrError`] naming
-//! the field and the byte offset, never a panic. Message types implement [`CdrDecode`];
-//! [`decode_cdr`] checks the header and decodes one.
+//! the field and the byte offset, never a panic. It is ROS 2's [`FieldReader`]: the
+//! message structs ([`RosMsg`]) read themselves through it, and [`decode_cdr`] checks
+//! the header and decodes one.
 
+use crate::log::ros2::msgs::wire::{FieldPath, FieldReader, RosMsg};
+use fusemap_core::time::Stamp;
 use std::fmt;
 
 /// Length of the encapsulation header in front of every CDR payload.
@@ -97,47 +100,30 @@ pub fn check_encapsulation(payload: &[u8]) -> Result<&[u8], CdrError> {
     }
 }
 
-/// A message type that can be read from little-endian CDR.
-pub trait CdrDecode: Sized {
-    /// Reads the fields in declaration order from `r`.
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError>;
-}
-
 /// Decodes a whole payload (encapsulation header included) as a `T`.
 ///
 /// Bytes after the message are ignored: writers may pad the payload to a multiple of 4.
-pub fn decode_cdr<T: CdrDecode>(payload: &[u8]) -> Result<T, CdrError> {
+pub fn decode_cdr<T: RosMsg>(payload: &[u8]) -> Result<T, CdrError> {
     let body = check_encapsulation(payload)?;
     let mut r = CdrReader::new(body);
-    T::decode(&mut r)
-}
-
-/// One step of a field path: a field name or a sequence index.
-#[derive(Clone, Copy, Debug)]
-enum PathPart {
-    Field(&'static str),
-    Index(usize),
+    T::read(&mut r)
 }
 
 /// A bounds-checked little-endian CDR cursor over a message body (the bytes after the
-/// encapsulation header). It remembers the path of nested fields being read, so errors
-/// name `transforms[1].header.frame_id` rather than just `frame_id`.
+/// encapsulation header): the [`FieldReader`] of ROS 2. It remembers the path of nested
+/// fields being read, so errors name `transforms[1].header.frame_id` rather than just
+/// `frame_id`.
 pub struct CdrReader<'a> {
     body: &'a [u8],
     pos: usize,
-    path: Vec<PathPart>,
+    path: FieldPath,
 }
 
 impl<'a> CdrReader<'a> {
     /// A cursor at the start of `body`, which must *not* include the encapsulation header
     /// (alignment counts from its first byte).
     pub fn new(body: &'a [u8]) -> Self {
-        Self { body, pos: 0, path: Vec::new() }
-    }
-
-    /// Bytes consumed so far.
-    pub fn position(&self) -> usize {
-        self.pos
+        Self { body, pos: 0, path: FieldPath::default() }
     }
 
     /// Bytes not yet consumed.
@@ -145,64 +131,11 @@ impl<'a> CdrReader<'a> {
         self.body.len() - self.pos
     }
 
-    /// Reads a nested struct field: errors inside name it as `name.inner`.
-    pub fn field<T>(
-        &mut self,
-        name: &'static str,
-        read: impl FnOnce(&mut Self) -> Result<T, CdrError>,
-    ) -> Result<T, CdrError> {
-        self.path.push(PathPart::Field(name));
-        let value = read(self)?;
-        self.path.pop();
-        Ok(value)
-    }
-
-    /// Reads a nested struct that implements [`CdrDecode`].
-    pub fn decode_field<T: CdrDecode>(&mut self, name: &'static str) -> Result<T, CdrError> {
-        self.field(name, T::decode)
-    }
-
-    fn path_to(&self, leaf: &str) -> String {
-        let mut s = String::new();
-        for part in &self.path {
-            match part {
-                PathPart::Field(f) => {
-                    if !s.is_empty() {
-                        s.push('.');
-                    }
-                    s.push_str(f);
-                }
-                PathPart::Index(i) => {
-                    s.push('[');
-                    s.push_str(&i.to_string());
-                    s.push(']');
-                }
-            }
-        }
-        if !leaf.is_empty() {
-            if !s.is_empty() {
-                s.push('.');
-            }
-            s.push_str(leaf);
-        }
-        s
-    }
-
     /// The error for `field` at the current position.
     pub fn invalid(&self, field: &str, what: impl fmt::Display) -> CdrError {
         CdrError::Invalid {
-            field: self.path_to(field),
+            field: self.path.to(field),
             offset: ENCAPSULATION_HEADER_LEN + self.pos,
-            what: what.to_string(),
-        }
-    }
-
-    /// The error for `field`, which started at `position` (a value of [`Self::position`]
-    /// taken before it was read).
-    pub fn invalid_at(&self, field: &str, position: usize, what: impl fmt::Display) -> CdrError {
-        CdrError::Invalid {
-            field: self.path_to(field),
-            offset: ENCAPSULATION_HEADER_LEN + position,
             what: what.to_string(),
         }
     }
@@ -218,7 +151,7 @@ impl<'a> CdrReader<'a> {
                 Ok(&self.body[start..start + n])
             }
             _ => Err(CdrError::Truncated {
-                field: self.path_to(field),
+                field: self.path.to(field),
                 offset: ENCAPSULATION_HEADER_LEN + self.pos,
                 needed: needed.unwrap_or(usize::MAX),
                 available: self.remaining(),
@@ -226,6 +159,7 @@ impl<'a> CdrReader<'a> {
         }
     }
 
+    /// `N` bytes aligned to `N`.
     fn array<const N: usize>(&mut self, field: &str) -> Result<[u8; N], CdrError> {
         let bytes = self.take(field, N, N)?;
         let mut out = [0u8; N];
@@ -233,66 +167,22 @@ impl<'a> CdrReader<'a> {
         Ok(out)
     }
 
-    /// An `int8` (no alignment).
-    pub fn i8(&mut self, field: &str) -> Result<i8, CdrError> {
-        self.array(field).map(i8::from_le_bytes)
-    }
-
-    /// A `uint8` (no alignment).
-    pub fn u8(&mut self, field: &str) -> Result<u8, CdrError> {
-        self.array(field).map(u8::from_le_bytes)
-    }
-
-    /// A `uint16` (aligned to 2).
-    pub fn u16(&mut self, field: &str) -> Result<u16, CdrError> {
-        self.array(field).map(u16::from_le_bytes)
-    }
-
     /// An `int32`.
     pub fn i32(&mut self, field: &str) -> Result<i32, CdrError> {
         self.array(field).map(i32::from_le_bytes)
-    }
-
-    /// A `uint32`.
-    pub fn u32(&mut self, field: &str) -> Result<u32, CdrError> {
-        self.array(field).map(u32::from_le_bytes)
-    }
-
-    /// A `float32`.
-    pub fn f32(&mut self, field: &str) -> Result<f32, CdrError> {
-        self.array(field).map(f32::from_le_bytes)
-    }
-
-    /// A `float64` (aligned to 8).
-    pub fn f64(&mut self, field: &str) -> Result<f64, CdrError> {
-        self.array(field).map(f64::from_le_bytes)
-    }
-
-    /// A fixed-size `float64[N]` array (no length prefix).
-    pub fn f64_array<const N: usize>(&mut self, field: &str) -> Result<[f64; N], CdrError> {
-        let mut out = [0.0; N];
-        if N > 0 {
-            let bytes = self.take(field, 8, N * 8)?;
-            for (o, b) in out.iter_mut().zip(bytes.chunks_exact(8)) {
-                let mut a = [0u8; 8];
-                a.copy_from_slice(b);
-                *o = f64::from_le_bytes(a);
-            }
-        }
-        Ok(out)
     }
 
     /// A sequence length, checked against the bytes left for elements of at least
     /// `min_element_size` bytes each, so a corrupt count never allocates.
     pub fn sequence_len(&mut self, field: &str, min_element_size: usize) -> Result<usize, CdrError> {
         let at = self.pos;
-        let n = self.u32(field)? as usize;
+        let n = u32::from_le_bytes(self.array(field)?) as usize;
         let fits = n.checked_mul(min_element_size.max(1)).is_some_and(|bytes| bytes <= self.remaining());
         if fits {
             Ok(n)
         } else {
             Err(CdrError::Truncated {
-                field: self.path_to(field),
+                field: self.path.to(field),
                 offset: ENCAPSULATION_HEADER_LEN + at,
                 needed: n.saturating_mul(min_element_size.max(1)),
                 available: self.remaining(),
@@ -306,41 +196,94 @@ impl<'a> CdrReader<'a> {
         crate::bounded::vec_with_capacity(n)
             .map_err(|e| self.invalid(field, format!("no memory for its {n} elements ({e})")))
     }
+}
 
-    /// A `float32[]` sequence, bit for bit.
-    pub fn f32_seq(&mut self, field: &str) -> Result<Vec<f32>, CdrError> {
-        let n = self.sequence_len(field, 4)?;
-        let mut out = self.room_for(field, n)?;
-        let bytes = self.take(field, 4, n * 4)?;
-        out.extend(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])));
-        Ok(out)
+impl<'a> FieldReader<'a> for CdrReader<'a> {
+    type Error = CdrError;
+
+    /// ROS 2's header has no `seq`.
+    fn header_seq(&mut self) -> Result<(), CdrError> {
+        Ok(())
     }
 
-    /// A `float64[]` sequence (the count, then elements aligned to 8).
-    pub fn f64_seq(&mut self, field: &str) -> Result<Vec<f64>, CdrError> {
-        let n = self.sequence_len(field, 8)?;
-        let mut out = self.room_for(field, n)?;
-        if n > 0 {
-            let bytes = self.take(field, 8, n * 8)?;
-            for b in bytes.chunks_exact(8) {
-                let mut a = [0u8; 8];
-                a.copy_from_slice(b);
-                out.push(f64::from_le_bytes(a));
+    /// A `builtin_interfaces/Time`: `int32 sec`, `uint32 nanosec`.
+    fn time(&mut self, field: &'static str) -> Result<Stamp, CdrError> {
+        self.field(field, |r| {
+            let sec = r.i32("sec")?;
+            let nanosec = r.u32("nanosec")?;
+            Ok(Stamp::from_sec_nsec(i64::from(sec), nanosec))
+        })
+    }
+
+    /// An `int8` (no alignment).
+    fn i8(&mut self, field: &'static str) -> Result<i8, CdrError> {
+        self.array(field).map(i8::from_le_bytes)
+    }
+
+    /// A `uint8` (no alignment).
+    fn u8(&mut self, field: &'static str) -> Result<u8, CdrError> {
+        self.array(field).map(u8::from_le_bytes)
+    }
+
+    /// A `uint16` (aligned to 2).
+    fn u16(&mut self, field: &'static str) -> Result<u16, CdrError> {
+        self.array(field).map(u16::from_le_bytes)
+    }
+
+    /// A `uint32` (aligned to 4).
+    fn u32(&mut self, field: &'static str) -> Result<u32, CdrError> {
+        self.array(field).map(u32::from_le_bytes)
+    }
+
+    /// A `float32` (aligned to 4).
+    fn f32(&mut self, field: &'static str) -> Result<f32, CdrError> {
+        self.array(field).map(f32::from_le_bytes)
+    }
+
+    /// A `float64` (aligned to 8).
+    fn f64(&mut self, field: &'static str) -> Result<f64, CdrError> {
+        self.array(field).map(f64::from_le_bytes)
+    }
+
+    fn f64_array<const N: usize>(&mut self, field: &'static str) -> Result<[f64; N], CdrError> {
+        let mut out = [0.0; N];
+        if N > 0 {
+            let bytes = self.take(field, 8, N * 8)?;
+            for (o, b) in out.iter_mut().zip(bytes.as_chunks::<8>().0) {
+                *o = f64::from_le_bytes(*b);
             }
         }
         Ok(out)
     }
 
-    /// A `uint8[]` sequence, borrowed from the payload (not copied: an image's pixels
-    /// are copied only when wanted).
-    pub fn u8_seq(&mut self, field: &str) -> Result<&'a [u8], CdrError> {
+    /// A `float32[]` sequence, bit for bit.
+    fn f32_seq(&mut self, field: &'static str) -> Result<Vec<f32>, CdrError> {
+        let n = self.sequence_len(field, 4)?;
+        let mut out = self.room_for(field, n)?;
+        let bytes = self.take(field, 4, n * 4)?;
+        out.extend(bytes.as_chunks::<4>().0.iter().map(|b| f32::from_le_bytes(*b)));
+        Ok(out)
+    }
+
+    /// A `float64[]` sequence (the count, then elements aligned to 8).
+    fn f64_seq(&mut self, field: &'static str) -> Result<Vec<f64>, CdrError> {
+        let n = self.sequence_len(field, 8)?;
+        let mut out = self.room_for(field, n)?;
+        if n > 0 {
+            let bytes = self.take(field, 8, n * 8)?;
+            out.extend(bytes.as_chunks::<8>().0.iter().map(|b| f64::from_le_bytes(*b)));
+        }
+        Ok(out)
+    }
+
+    fn u8_seq(&mut self, field: &'static str) -> Result<&'a [u8], CdrError> {
         let n = self.sequence_len(field, 1)?;
         self.take(field, 1, n)
     }
 
     /// A `string`: `u32` length including the NUL terminator, the bytes, the NUL.
     /// A length of 0 (written by some encoders for the empty string) is accepted.
-    pub fn string(&mut self, field: &str) -> Result<String, CdrError> {
+    fn string(&mut self, field: &'static str) -> Result<String, CdrError> {
         let n = self.sequence_len(field, 1)?;
         let at = self.pos;
         let bytes = self.take(field, 1, n)?;
@@ -361,9 +304,18 @@ impl<'a> CdrReader<'a> {
         }
     }
 
-    /// A sequence of structs: the count, then `read` for each element, which errors name
-    /// `field[i]`. `min_element_size` bounds the count by the bytes left.
-    pub fn seq<T>(
+    fn field<T>(
+        &mut self,
+        name: &'static str,
+        read: impl FnOnce(&mut Self) -> Result<T, CdrError>,
+    ) -> Result<T, CdrError> {
+        self.path.push_field(name);
+        let value = read(self)?;
+        self.path.pop();
+        Ok(value)
+    }
+
+    fn seq<T>(
         &mut self,
         field: &'static str,
         min_element_size: usize,
@@ -371,14 +323,26 @@ impl<'a> CdrReader<'a> {
     ) -> Result<Vec<T>, CdrError> {
         let n = self.sequence_len(field, min_element_size)?;
         let mut out = self.room_for(field, n)?;
-        self.path.push(PathPart::Field(field));
+        self.path.push_field(field);
         for i in 0..n {
-            self.path.push(PathPart::Index(i));
+            self.path.push_index(i);
             out.push(read(self)?);
             self.path.pop();
         }
         self.path.pop();
         Ok(out)
+    }
+
+    fn position(&self) -> usize {
+        self.pos
+    }
+
+    fn invalid_at(&self, field: &'static str, position: usize, what: impl fmt::Display) -> CdrError {
+        CdrError::Invalid {
+            field: self.path.to(field),
+            offset: ENCAPSULATION_HEADER_LEN + position,
+            what: what.to_string(),
+        }
     }
 }
 

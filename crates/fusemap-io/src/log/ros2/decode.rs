@@ -1,8 +1,9 @@
-//! Decoding the CDR payloads of the ROS 2 messages fusemap uses, by their type name, into
-//! [`LogMessage`]s.
+//! Decoding the messages fusemap uses into [`LogMessage`]s: CDR payloads of ROS 2 by
+//! their type name here, and ROS 1 payloads through the same [`On::read`].
 
-use super::cdr::{decode_cdr, CdrError};
+use super::cdr::{check_encapsulation, CdrError, CdrReader};
 use super::msgs;
+use super::msgs::wire::{FieldReader, RosMsg};
 use crate::log::{
     planar_pose, CameraInfoMessage, GnssMessage, ImageHeader, ImageMessage, ImuMessage, LogMessage, OdomMessage,
     PoseMessage, ScanMessage, TfMessage, Transform,
@@ -97,25 +98,41 @@ pub fn decode_known_with(
     payload: &[u8],
     pixels: bool,
 ) -> std::result::Result<LogMessage, CdrError> {
-    use msgs::sensor_msgs::Image;
-    let on = On { topic, receive_stamp };
-    Ok(match kind {
-        KnownType::LaserScan => LogMessage::Scan(on.scan(decode_cdr(payload)?)),
-        KnownType::Odometry => LogMessage::Odometry(on.odometry(decode_cdr(payload)?)),
-        KnownType::TfMessage => LogMessage::Tf(on.tf(decode_cdr(payload)?)),
-        KnownType::Imu => LogMessage::Imu(on.imu(decode_cdr(payload)?)),
-        KnownType::NavSatFix => LogMessage::Gnss(on.fix(decode_cdr(payload)?)),
-        KnownType::PoseWithCovarianceStamped => LogMessage::Pose(on.pose(decode_cdr(payload)?)),
-        KnownType::Image => on.image(Image::from_payload(payload)?, pixels),
-        KnownType::CameraInfo => LogMessage::CameraInfo(on.camera_info(decode_cdr(payload)?)),
-    })
+    let body = check_encapsulation(payload)?;
+    On { topic, receive_stamp }.read(kind, &mut CdrReader::new(body), pixels)
 }
 
-/// Where a decoded ROS 2 message arrived: its topic and, when the container says, when it
-/// was logged. Its methods turn each message struct into fusemap's message type.
-struct On<'a> {
-    topic: &'a str,
-    receive_stamp: Option<Stamp>,
+/// Where a decoded ROS message arrived: its topic and, when the container says, when it
+/// was logged. Its methods turn each message struct into fusemap's message type; the ROS 1
+/// and ROS 2 readers both use them.
+pub(crate) struct On<'a> {
+    /// The topic it was published on.
+    pub(crate) topic: &'a str,
+    /// When the log recorded it.
+    pub(crate) receive_stamp: Option<Stamp>,
+}
+
+impl On<'_> {
+    /// Reads one message of `kind` from `r` (whichever its wire format) into fusemap's
+    /// message type; an image's pixels are copied only with `pixels`.
+    pub(crate) fn read<'a, R: FieldReader<'a>>(
+        &self,
+        kind: KnownType,
+        r: &mut R,
+        pixels: bool,
+    ) -> Result<LogMessage, R::Error> {
+        use msgs::sensor_msgs::Image;
+        Ok(match kind {
+            KnownType::LaserScan => LogMessage::Scan(self.scan(RosMsg::read(r)?)),
+            KnownType::Odometry => LogMessage::Odometry(self.odometry(RosMsg::read(r)?)),
+            KnownType::TfMessage => LogMessage::Tf(self.tf(RosMsg::read(r)?)),
+            KnownType::Imu => LogMessage::Imu(self.imu(RosMsg::read(r)?)),
+            KnownType::NavSatFix => LogMessage::Gnss(self.fix(RosMsg::read(r)?)),
+            KnownType::PoseWithCovarianceStamped => LogMessage::Pose(self.pose(RosMsg::read(r)?)),
+            KnownType::Image => self.image(Image::read(r)?, pixels),
+            KnownType::CameraInfo => LogMessage::CameraInfo(self.camera_info(RosMsg::read(r)?)),
+        })
+    }
 }
 
 impl On<'_> {

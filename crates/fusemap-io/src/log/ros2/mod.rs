@@ -46,6 +46,7 @@ pub mod writer;
 
 use crate::error::{Error, Location, Result};
 use crate::log::{LogMessage, LogReader, ReadOptions, ReadStats};
+pub(crate) use decode::On;
 pub use decode::{decode_known, decode_known_with, decode_message, KnownType};
 use fusemap_core::time::Stamp;
 use std::collections::VecDeque;

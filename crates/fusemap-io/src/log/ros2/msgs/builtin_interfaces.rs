@@ -1,33 +1,10 @@
-//! `builtin_interfaces`: the time type every header carries, read into and written from
-//! fusemap's nanosecond stamps.
+//! `builtin_interfaces`: the time type every header carries, written from fusemap's
+//! nanosecond stamps (each [`FieldReader`](super::wire::FieldReader) reads it as its
+//! format's time primitive).
 
-use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
 use crate::log::ros2::writer::cdr_write::{CdrWriteError, CdrWriter};
 use crate::log::ros2::writer::definition::MsgDef;
 use fusemap_core::time::Stamp;
-
-/// `builtin_interfaces/msg/Time`: a point in time as whole seconds plus nanoseconds.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Time {
-    /// Whole seconds (since the Unix epoch for wall-clock stamps).
-    pub sec: i32,
-    /// Nanoseconds to add to `sec`; a well-formed stamp keeps it below 1e9.
-    pub nanosec: u32,
-}
-
-impl Time {
-    /// fusemap's stamp: `sec * 1e9 + nanosec` nanoseconds, exactly (any `sec` and
-    /// `nanosec` fit, so reading loses nothing).
-    pub fn to_stamp(self) -> Stamp {
-        Stamp::from_sec_nsec(i64::from(self.sec), self.nanosec)
-    }
-}
-
-impl CdrDecode for Time {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        Ok(Self { sec: r.i32("sec")?, nanosec: r.u32("nanosec")? })
-    }
-}
 
 /// `builtin_interfaces/Time`: whole seconds plus nanoseconds.
 pub static TIME: MsgDef = MsgDef { name: "builtin_interfaces/Time", text: "int32 sec\nuint32 nanosec\n", deps: &[] };

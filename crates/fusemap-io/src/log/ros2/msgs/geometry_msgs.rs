@@ -1,7 +1,7 @@
 //! `geometry_msgs`: points, rotations, poses, velocities and frame transforms.
 
 use super::std_msgs::{Header, HEADER};
-use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
+use super::wire::{FieldReader, RosMsg};
 use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
 use crate::log::ros2::writer::definition::MsgDef;
 
@@ -217,66 +217,66 @@ pub struct TransformStamped {
     pub transform: Transform,
 }
 
-impl CdrDecode for Point {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for Point {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self { x: r.f64("x")?, y: r.f64("y")?, z: r.f64("z")? })
     }
 }
 
-impl CdrDecode for Vector3 {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for Vector3 {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self { x: r.f64("x")?, y: r.f64("y")?, z: r.f64("z")? })
     }
 }
 
-impl CdrDecode for Quaternion {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for Quaternion {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self { x: r.f64("x")?, y: r.f64("y")?, z: r.f64("z")?, w: r.f64("w")? })
     }
 }
 
-impl CdrDecode for Pose {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        Ok(Self { position: r.decode_field("position")?, orientation: r.decode_field("orientation")? })
+impl RosMsg for Pose {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
+        Ok(Self { position: r.message("position")?, orientation: r.message("orientation")? })
     }
 }
 
-impl CdrDecode for PoseWithCovariance {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        Ok(Self { pose: r.decode_field("pose")?, covariance: r.f64_array("covariance")? })
+impl RosMsg for PoseWithCovariance {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
+        Ok(Self { pose: r.message("pose")?, covariance: r.f64_array("covariance")? })
     }
 }
 
-impl CdrDecode for PoseWithCovarianceStamped {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        Ok(Self { header: r.decode_field("header")?, pose: r.decode_field("pose")? })
+impl RosMsg for PoseWithCovarianceStamped {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
+        Ok(Self { header: r.message("header")?, pose: r.message("pose")? })
     }
 }
 
-impl CdrDecode for Twist {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        Ok(Self { linear: r.decode_field("linear")?, angular: r.decode_field("angular")? })
+impl RosMsg for Twist {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
+        Ok(Self { linear: r.message("linear")?, angular: r.message("angular")? })
     }
 }
 
-impl CdrDecode for TwistWithCovariance {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        Ok(Self { twist: r.decode_field("twist")?, covariance: r.f64_array("covariance")? })
+impl RosMsg for TwistWithCovariance {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
+        Ok(Self { twist: r.message("twist")?, covariance: r.f64_array("covariance")? })
     }
 }
 
-impl CdrDecode for Transform {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        Ok(Self { translation: r.decode_field("translation")?, rotation: r.decode_field("rotation")? })
+impl RosMsg for Transform {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
+        Ok(Self { translation: r.message("translation")?, rotation: r.message("rotation")? })
     }
 }
 
-impl CdrDecode for TransformStamped {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for TransformStamped {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self {
-            header: r.decode_field("header")?,
+            header: r.message("header")?,
             child_frame_id: r.string("child_frame_id")?,
-            transform: r.decode_field("transform")?,
+            transform: r.message("transform")?,
         })
     }
 }

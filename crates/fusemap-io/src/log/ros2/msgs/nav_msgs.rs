@@ -2,7 +2,7 @@
 
 use super::geometry_msgs::{PoseWithCovariance, TwistWithCovariance, POSE_WITH_COVARIANCE, TWIST_WITH_COVARIANCE};
 use super::std_msgs::{Header, HEADER};
-use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
+use super::wire::{FieldReader, RosMsg};
 use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
 use crate::log::ros2::writer::definition::MsgDef;
 
@@ -28,13 +28,13 @@ pub struct Odometry {
     pub twist: TwistWithCovariance,
 }
 
-impl CdrDecode for Odometry {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for Odometry {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self {
-            header: r.decode_field("header")?,
+            header: r.message("header")?,
             child_frame_id: r.string("child_frame_id")?,
-            pose: r.decode_field("pose")?,
-            twist: r.decode_field("twist")?,
+            pose: r.message("pose")?,
+            twist: r.message("twist")?,
         })
     }
 }

@@ -3,8 +3,8 @@
 
 use super::geometry_msgs::{Quaternion, Vector3, QUATERNION, VECTOR3};
 use super::std_msgs::{Header, HEADER};
+use super::wire::{FieldReader, RosMsg};
 use crate::log::check_image_layout;
-use crate::log::ros2::cdr::{check_encapsulation, CdrDecode, CdrError, CdrReader};
 use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
 use crate::log::ros2::writer::definition::MsgDef;
 use std::borrow::Cow;
@@ -94,10 +94,10 @@ pub struct LaserScan {
     pub intensities: Vec<f32>,
 }
 
-impl CdrDecode for LaserScan {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for LaserScan {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self {
-            header: r.decode_field("header")?,
+            header: r.message("header")?,
             angle_min: r.f32("angle_min")?,
             angle_max: r.f32("angle_max")?,
             angle_increment: r.f32("angle_increment")?,
@@ -134,15 +134,15 @@ pub struct Imu {
     pub linear_acceleration_covariance: [f64; 9],
 }
 
-impl CdrDecode for Imu {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for Imu {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self {
-            header: r.decode_field("header")?,
-            orientation: r.decode_field("orientation")?,
+            header: r.message("header")?,
+            orientation: r.message("orientation")?,
             orientation_covariance: r.f64_array("orientation_covariance")?,
-            angular_velocity: r.decode_field("angular_velocity")?,
+            angular_velocity: r.message("angular_velocity")?,
             angular_velocity_covariance: r.f64_array("angular_velocity_covariance")?,
-            linear_acceleration: r.decode_field("linear_acceleration")?,
+            linear_acceleration: r.message("linear_acceleration")?,
             linear_acceleration_covariance: r.f64_array("linear_acceleration_covariance")?,
         })
     }
@@ -207,17 +207,17 @@ impl NavSatFix {
     pub const COVARIANCE_TYPE_KNOWN: u8 = 3;
 }
 
-impl CdrDecode for NavSatStatus {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for NavSatStatus {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self { status: r.i8("status")?, service: r.u16("service")? })
     }
 }
 
-impl CdrDecode for NavSatFix {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for NavSatFix {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self {
-            header: r.decode_field("header")?,
-            status: r.decode_field("status")?,
+            header: r.message("header")?,
+            status: r.message("status")?,
             latitude: r.f64("latitude")?,
             longitude: r.f64("longitude")?,
             altitude: r.f64("altitude")?,
@@ -253,8 +253,8 @@ impl<'a> Image<'a> {
     /// Reads the fields in declaration order and checks the layout
     /// ([`check_image_layout`]): an image whose sizes do not fit its data is an error at
     /// its `data` field.
-    pub fn decode(r: &mut CdrReader<'a>) -> Result<Self, CdrError> {
-        let header = r.decode_field("header")?;
+    pub fn read<R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
+        let header = r.message("header")?;
         let height = r.u32("height")?;
         let width = r.u32("width")?;
         let encoding = r.string("encoding")?;
@@ -265,12 +265,6 @@ impl<'a> Image<'a> {
         check_image_layout(width, height, &encoding, step, data.len() as u64)
             .map_err(|e| r.invalid_at("data", at, e))?;
         Ok(Self { header, height, width, encoding, is_bigendian, step, data: Cow::Borrowed(data) })
-    }
-
-    /// Decodes a whole payload (encapsulation header included).
-    pub fn from_payload(payload: &'a [u8]) -> Result<Self, CdrError> {
-        let body = check_encapsulation(payload)?;
-        Self::decode(&mut CdrReader::new(body))
     }
 }
 
@@ -289,8 +283,8 @@ pub struct RegionOfInterest {
     pub do_rectify: bool,
 }
 
-impl CdrDecode for RegionOfInterest {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for RegionOfInterest {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self {
             x_offset: r.u32("x_offset")?,
             y_offset: r.u32("y_offset")?,
@@ -348,10 +342,10 @@ impl Default for CameraInfo {
     }
 }
 
-impl CdrDecode for CameraInfo {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+impl RosMsg for CameraInfo {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
         Ok(Self {
-            header: r.decode_field("header")?,
+            header: r.message("header")?,
             height: r.u32("height")?,
             width: r.u32("width")?,
             distortion_model: r.string("distortion_model")?,
@@ -361,7 +355,7 @@ impl CdrDecode for CameraInfo {
             p: r.f64_array("p")?,
             binning_x: r.u32("binning_x")?,
             binning_y: r.u32("binning_y")?,
-            roi: r.decode_field("roi")?,
+            roi: r.message("roi")?,
         })
     }
 }

@@ -1,7 +1,7 @@
 //! `std_msgs`: the header shared by stamped messages.
 
-use super::builtin_interfaces::{write_time, Time, TIME};
-use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
+use super::builtin_interfaces::{write_time, TIME};
+use super::wire::{FieldReader, RosMsg};
 use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
 use crate::log::ros2::writer::definition::MsgDef;
 use fusemap_core::time::Stamp;
@@ -11,7 +11,7 @@ pub static HEADER: MsgDef =
     MsgDef { name: "std_msgs/Header", text: "builtin_interfaces/Time stamp\nstring frame_id\n", deps: &[&TIME] };
 
 /// `std_msgs/msg/Header`: when the data was taken and in which coordinate frame.
-/// (ROS 2 dropped the ROS 1 `seq` counter.)
+/// (ROS 2 dropped the ROS 1 `seq` counter; a ROS 1 reader reads past it.)
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Header {
     /// Acquisition time of the data (`builtin_interfaces/Time` on the wire).
@@ -27,10 +27,11 @@ impl Header {
     }
 }
 
-impl CdrDecode for Header {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        let stamp: Time = r.decode_field("stamp")?;
-        Ok(Self { stamp: stamp.to_stamp(), frame_id: r.string("frame_id")? })
+impl RosMsg for Header {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
+        r.header_seq()?;
+        let stamp = r.time("stamp")?;
+        Ok(Self { stamp, frame_id: r.string("frame_id")? })
     }
 }
 

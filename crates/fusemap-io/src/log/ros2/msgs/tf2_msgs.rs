@@ -1,7 +1,7 @@
 //! `tf2_msgs`: batches of frame transforms (`/tf`, `/tf_static`).
 
 use super::geometry_msgs::{TransformStamped, TRANSFORM_STAMPED};
-use crate::log::ros2::cdr::{CdrDecode, CdrError, CdrReader};
+use super::wire::{FieldReader, RosMsg};
 use crate::log::ros2::writer::cdr_write::{CdrEncode, CdrWriteError, CdrWriter};
 use crate::log::ros2::writer::definition::MsgDef;
 
@@ -19,13 +19,14 @@ pub struct TfMessage {
     pub transforms: Vec<TransformStamped>,
 }
 
-/// The fewest bytes one serialised `TransformStamped` can take: stamp (8), two string
-/// lengths (8) and seven doubles (56). Bounds a corrupt count before allocating.
+/// The fewest bytes one serialised `TransformStamped` can take in either format: stamp
+/// (8), two string lengths (8) and seven doubles (56; ROS 1 adds a 4-byte `seq`). Bounds
+/// a corrupt count before allocating.
 const MIN_TRANSFORM_STAMPED_LEN: usize = 8 + 8 + 56;
 
-impl CdrDecode for TfMessage {
-    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
-        Ok(Self { transforms: r.seq("transforms", MIN_TRANSFORM_STAMPED_LEN, TransformStamped::decode)? })
+impl RosMsg for TfMessage {
+    fn read<'a, R: FieldReader<'a>>(r: &mut R) -> Result<Self, R::Error> {
+        Ok(Self { transforms: r.seq("transforms", MIN_TRANSFORM_STAMPED_LEN, TransformStamped::read)? })
     }
 }
 

@@ -218,6 +218,7 @@ impl CdrWriter {
 mod tests {
     use super::*;
     use crate::log::ros2::cdr::CdrReader;
+    use crate::log::ros2::msgs::wire::FieldReader;
     use proptest::prelude::*;
 
     #[test]
