@@ -35,7 +35,7 @@ def ros_messages(lines: list[str], tmp: Path):
 def write_ros1(out: Path, messages, static_stamp: int, compression, mutate=None, raw=()) -> None:
     """A ROS 1 bag of `messages`; `mutate(topic, n, message dict)`, when given, returns
     the dicts to write in place of the n-th message of `topic` (none drops it). `raw`:
-    (topic, type, log time, serialized bytes) written first, each on its own connection."""
+    (topic, type, log time, serialized bytes) written first, one connection per topic and type."""
     writer = ros.Rosbag1Writer(out)
     if compression is not None:
         writer.set_compression(compression)
@@ -43,9 +43,12 @@ def write_ros1(out: Path, messages, static_stamp: int, compression, mutate=None,
     try:
         conns = {t: writer.add_connection(t, ty, typestore=ros.ROS1_TYPESTORE, callerid="/corpus")
                  for t, ty in ros.TOPICS.items()}
+        raw_conns = {}
         for topic, ty, t, data in raw:
-            conn = writer.add_connection(topic, ty, typestore=ros.ROS1_TYPESTORE, callerid="/corpus")
-            writer.write(conn, t, data)
+            if (topic, ty) not in raw_conns:
+                raw_conns[topic, ty] = writer.add_connection(topic, ty, typestore=ros.ROS1_TYPESTORE,
+                                                             callerid="/corpus")
+            writer.write(raw_conns[topic, ty], t, data)
         seq = dict.fromkeys(ros.TOPICS, 0)
         for m in messages:
             ty = ros.TOPICS[m.topic]
@@ -221,6 +224,57 @@ def ros1_message_cases(tmp: Path, messages, static: int) -> None:
     p = tmp / "odom-jump.bag"
     write_ros1(p, messages, static, None, odom_jump)
     log_case("ros1/odometry-jumps-1e8m", "room.bag", p.read_bytes(), "map", notes=["glitch"])
+
+    pose_sensor_cases(tmp, messages, static)
+
+
+def ros1_header(seq: int, stamp_ns: int, frame: bytes) -> bytes:
+    return struct.pack("<III", seq, stamp_ns // 10**9, stamp_ns % 10**9) + struct.pack("<I", len(frame)) + frame
+
+
+def nav_sat_fix(seq: int, stamp_ns: int, lat: float, lon: float, alt: float, status: int = 2,
+                covariance_type: int = 2) -> bytes:
+    """A ROS 1 `sensor_msgs/NavSatFix`: 2 cm RTK unless told otherwise."""
+    cov = [4e-4, 0, 0, 0, 4e-4, 0, 0, 0, 1e-3]
+    return (ros1_header(seq, stamp_ns, b"gps") + struct.pack("<bH", status, 1) + struct.pack("<3d", lat, lon, alt)
+            + struct.pack("<9d", *cov) + struct.pack("<B", covariance_type))
+
+
+def imu(seq: int, stamp_ns: int, yaw_rate: float) -> bytes:
+    """A ROS 1 `sensor_msgs/Imu` with no orientation (covariance[0] = -1) and a yaw rate."""
+    return (ros1_header(seq, stamp_ns, b"base_link") + struct.pack("<4d", 0, 0, 0, 1) + struct.pack("<9d", -1, *[0] * 8)
+            + struct.pack("<3d", 0, 0, yaw_rate) + struct.pack("<9d", 1e-4, 0, 0, 0, 1e-4, 0, 0, 0, 1e-4)
+            + struct.pack("<3d", 0, 0, 9.81) + struct.pack("<9d", *[0] * 9))
+
+
+def pose_sensor_cases(tmp: Path, messages, static: int) -> None:
+    """GNSS fixes and gyro rates no sensor can produce, beside the room's odometry and
+    scans: each is dropped and counted by reason, and the room maps."""
+    odom_times = [m.log_time for m in messages if m.topic == "/odom"]
+    lat0, lon0, alt0 = 48.137, 11.575, 520.0
+    gnss = "log.estimator.gnss_input.0."
+    fix_cases = {
+        "gnss-latitude-91": (dict(lat=91.0), {gnss + "out_of_range": len(odom_times)}),
+        "gnss-latitude-1e308": (dict(lat=1e308), {gnss + "out_of_range": len(odom_times)}),
+        "gnss-longitude-minus-181": (dict(lon=-181.0), {gnss + "out_of_range": len(odom_times)}),
+        "gnss-altitude-1e6": (dict(alt=1e6), {gnss + "out_of_range": len(odom_times)}),
+        "gnss-status-5": (dict(status=5), {gnss + "invalid_field": len(odom_times)}),
+        "gnss-covariance-type-9": (dict(covariance_type=9), {gnss + "invalid_field": len(odom_times)}),
+    }
+    for what, (fault, summary) in fix_cases.items():
+        raw = []
+        for i, t in enumerate(odom_times):
+            f = {**dict(lat=lat0, lon=lon0, alt=alt0), **fault}
+            raw.append(("/fix", "sensor_msgs/msg/NavSatFix", t, nav_sat_fix(i, t, **f)))
+        p = tmp / f"{what}.bag"
+        write_ros1(p, messages, static, None, raw=raw)
+        log_case(f"ros1/{what}", "room.bag", p.read_bytes(), "map",
+                 summary={"scans": 40, gnss + "passed": 0, **summary}, notes=["receiver faults"])
+    raw = [("/imu", "sensor_msgs/msg/Imu", t, imu(i, t, 1e30 if i == 5 else 0.0)) for i, t in enumerate(odom_times)]
+    p = tmp / "gyro-1e30.bag"
+    write_ros1(p, messages, static, None, raw=raw)
+    log_case("ros1/gyro-rate-1e30", "room.bag", p.read_bytes(), "map",
+             summary={"scans": 40, "log.estimator.estimator.gyro.implausible": 1})
 
 
 # ---------------------------------------------------------------------------------------

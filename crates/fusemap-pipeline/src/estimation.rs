@@ -6,9 +6,11 @@
 //! * the IMU's gyro, rotated from the IMU's frame into `base_link` with its mount (TF or
 //!   config), as the yaw rate; its orientation only when the message provides one (REP 145:
 //!   `orientation_covariance[0] = -1` means none) and the sensor table allows it;
-//! * GNSS fixes converted exactly (WGS84 → ECEF → ENU) into one local map frame around the
-//!   datum — configured, or the first good fix — x east, y north, never UTM zones (whose
-//!   borders make robot_localization's UTM track jump); `NO_FIX` ignored; the covariance by
+//! * GNSS fixes ([`gnss_fixes`](crate::gnss_fixes)) converted exactly (WGS84 → ECEF → ENU)
+//!   into one local map frame around the datum — configured, or the first good fix the
+//!   next ones agree with — x east, y north, never UTM zones (whose borders make
+//!   robot_localization's UTM track jump); `NO_FIX` and receiver faults (a latitude of 91°,
+//!   a status NavSatFix does not define) dropped and counted; the covariance by
 //!   `position_covariance_type`, floored per fix status (an RTK fixed solution earns a
 //!   tighter floor than a plain fix); the antenna's lever arm from TF or config;
 //! * absolute poses (`PoseWithCovarianceStamped`) with their covariance.
@@ -17,20 +19,19 @@
 //! reason in the report, beside the estimator's own figures.
 
 pub use crate::estimation_report::{EstimationReport, GnssInputReport};
-use crate::extrinsics::{frame_tree, from_tf, resolve};
+use crate::extrinsics::{frame_tree, sensor_mount};
+use crate::gnss_fixes;
 use crate::recording::{planar_covariance, Inventory};
 use crate::sensors::{Bound, BoundSensor};
 use crate::track::{glitch_note, ChosenTrack, Track, TrackCounts};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SensorKind};
 use fusemap_core::estimator::{
-    base_yaw_rate, estimate, odometry_increment_covariance, EstimatorConfig, EstimatorInput, FixQuality,
-    GnssCovarianceKind,
+    base_yaw_rate, estimate, odometry_increment_covariance, Estimate, EstimatorConfig, EstimatorError, EstimatorInput,
 };
 use fusemap_core::frames::FrameTree;
-use fusemap_core::geometry::{geodetic::Datum, quaternion_yaw, Mount3, Point2, Pose2, Pose3};
+use fusemap_core::geometry::{quaternion_yaw, Pose2, Pose3};
 use fusemap_core::time::{plausible_samples, Stamp};
-use fusemap_io::log::GnssMessage;
 
 /// The estimator's inputs from `inv`.
 pub struct Inputs {
@@ -46,35 +47,6 @@ pub struct Inputs {
     pub odometry_glitches: u64,
 }
 
-fn offset(t: Stamp, s: &BoundSensor) -> Stamp {
-    Stamp(t.0.saturating_add(crate::offset_ns(s.sensor.time_offset_s)))
-}
-
-/// The sensor's mount, resolved as a lidar's is: `log.extrinsics` decides between the
-/// config and the log's TF, and a config mount that disagrees with TF is reported.
-fn mount(
-    s: &BoundSensor,
-    cfg: &LogConfig,
-    tree: &FrameTree,
-    frame: &str,
-    stamp: Option<Stamp>,
-    notes: &mut Vec<String>,
-) -> Result<Mount3, PipelineError> {
-    let log_mount = from_tf(tree, &cfg.base_frame, frame, stamp);
-    let name = if frame.is_empty() { s.sensor.name.as_str() } else { frame };
-    Ok(resolve(name, cfg, s.sensor.base_from_sensor, log_mount, notes)?.base_from_sensor)
-}
-
-/// The quality of a fix, for the report and the floor.
-fn quality(f: &GnssMessage) -> FixQuality {
-    match f.status {
-        GnssMessage::STATUS_GBAS_FIX => FixQuality::RtkFixed,
-        GnssMessage::STATUS_SBAS_FIX => FixQuality::Sbas,
-        GnssMessage::STATUS_FIX => FixQuality::Fix,
-        _ => FixQuality::Unknown,
-    }
-}
-
 /// Builds the estimator's inputs from the bound pose sensors.
 pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, PipelineError> {
     let cfg = &plan.log;
@@ -86,7 +58,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
         notes: Vec::new(),
         odometry_glitches: 0,
     };
-    let datum = shared_datum(inv, bound);
+    let datum = gnss_fixes::shared_datum(inv, bound);
     let odometers: Vec<&str> =
         bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::WheelOdometry).map(|s| s.topic.as_str()).collect();
     if odometers.len() > 1 {
@@ -101,7 +73,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
             SensorKind::WheelOdometry => odometry_inputs(s, inv, cfg, &mut all),
             SensorKind::Imu => imu_inputs(s, inv, cfg, &tree, &mut all)?,
             SensorKind::Gnss => {
-                let (inputs, mut report, n) = gnss_inputs(s, inv, &tree, cfg, datum)?;
+                let (inputs, mut report, n) = gnss_fixes::gnss_inputs(s, inv, &tree, cfg, datum)?;
                 all.inputs.extend(inputs);
                 all.notes.extend(n);
                 report.topic = s.topic.clone();
@@ -117,7 +89,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                 }
                 for m in &inv.poses[&s.topic] {
                     let cov = planar_covariance(&m.covariance).unwrap_or([[0.0; 3]; 3]);
-                    let (stamp, pose) = (offset(m.stamp, s), m.pose2());
+                    let (stamp, pose) = (s.stamp(m.stamp), m.pose2());
                     all.inputs.push(EstimatorInput::Pose { stamp, pose, covariance: cov });
                 }
             }
@@ -144,7 +116,7 @@ fn odometry_inputs(s: &BoundSensor, inv: &Inventory, cfg: &LogConfig, all: &mut 
         all.config.odometry_rotation_noise_per_m = v;
     }
     let msgs = &inv.odom[&s.topic];
-    let samples: Vec<(Stamp, Pose2)> = msgs.iter().map(|m| (offset(m.stamp, s), m.pose)).collect();
+    let samples: Vec<(Stamp, Pose2)> = msgs.iter().map(|m| (s.stamp(m.stamp), m.pose)).collect();
     let keep = plausible_samples(&samples, &cfg.motion_limits());
     let glitches = keep.iter().filter(|k| !**k).count() as u64;
     if glitches > 0 {
@@ -158,7 +130,7 @@ fn odometry_inputs(s: &BoundSensor, inv: &Inventory, cfg: &LogConfig, all: &mut 
             _ => None,
         };
         prev = m.covariance.map(|c| (c, m.pose.theta));
-        all.inputs.push(EstimatorInput::Odometry { stamp: offset(m.stamp, s), pose: m.pose, covariance });
+        all.inputs.push(EstimatorInput::Odometry { stamp: s.stamp(m.stamp), pose: m.pose, covariance });
     }
 }
 
@@ -176,11 +148,11 @@ fn imu_inputs(
     }
     let msgs = &inv.imu[&s.topic];
     let frame = s.sensor.frame.clone().or_else(|| inv.frames.get(&s.topic).cloned()).unwrap_or_default();
-    let m3 = mount(s, cfg, tree, &frame, msgs.first().map(|m| m.stamp), &mut all.notes)?;
+    let m3 = sensor_mount(s, cfg, tree, &frame, msgs.first().map(|m| m.stamp), &mut all.notes)?;
     let r = m3.rotation();
     let q_mount = m3.quaternion();
     for m in msgs {
-        let stamp = offset(m.stamp, s);
+        let stamp = s.stamp(m.stamp);
         // `angular_velocity_covariance[0] = -1`: no rate in this message.
         if m.rate_covariance[0] != -1.0 {
             let (yaw_rate, variance) = base_yaw_rate(&r, m.angular_velocity, &m.rate_covariance);
@@ -199,109 +171,45 @@ fn imu_inputs(
     Ok(())
 }
 
-/// The GNSS fixes as the estimator is given them: antenna positions in its map frame
-/// (the shared local ENU frame), covariances floored per fix quality, lever arms.
-pub fn gnss_positions(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Vec<EstimatorInput>, PipelineError> {
-    let (tree, _) = frame_tree(&plan.log, &inv.tf_static, &inv.tf_dynamic);
-    let datum = shared_datum(inv, bound);
-    let mut out = Vec::new();
-    for s in bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::Gnss) {
-        out.extend(gnss_inputs(s, inv, &tree, &plan.log, datum)?.0);
-    }
-    Ok(out)
-}
-
-/// One map frame for every GNSS sensor: the first configured datum, else the earliest good
-/// fix of any GNSS topic (two receivers must not get two ENU frames metres apart).
-fn shared_datum(inv: &Inventory, bound: &Bound) -> Option<((f64, f64, f64), &'static str)> {
-    let gnss = bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::Gnss);
-    if let Some([lat, lon, alt]) = gnss.clone().find_map(|s| s.sensor.datum) {
-        return Some(((lat, lon, alt), "config"));
-    }
-    gnss.flat_map(|s| inv.gnss[&s.topic].iter())
-        .filter(|f| usable_fix(f) && f.altitude.is_finite())
-        .min_by_key(|f| f.stamp)
-        .map(|f| ((f.latitude, f.longitude, f.altitude), "first good fix"))
-}
-
-/// A fix with a position: not `NO_FIX`, latitude and longitude finite (the doctor's rule
-/// too).
-pub fn usable_fix(f: &GnssMessage) -> bool {
-    f.status != GnssMessage::STATUS_NO_FIX && f.latitude.is_finite() && f.longitude.is_finite()
-}
-
-fn gnss_inputs(
-    s: &BoundSensor,
-    inv: &Inventory,
-    tree: &FrameTree,
-    cfg: &LogConfig,
-    datum: Option<((f64, f64, f64), &'static str)>,
-) -> Result<(Vec<EstimatorInput>, GnssInputReport, Vec<String>), PipelineError> {
-    let msgs = &inv.gnss[&s.topic];
-    let mut r = GnssInputReport { read: msgs.len() as u64, ..Default::default() };
-    let mut notes = Vec::new();
-    let good = |f: &&GnssMessage| usable_fix(f) && f.altitude.is_finite();
-    if let Some((_, src)) = datum {
-        r.datum_source = src.to_string();
-    }
-    let datum = datum.map(|d| d.0);
-    let Some((lat0, lon0, alt0)) = datum else {
-        notes.push(format!(
-            "GNSS `{}`: {} messages but no usable fix and no datum configured: the fixes are not used",
-            s.topic,
-            msgs.len()
-        ));
-        r.no_fix = msgs.iter().filter(|f| f.status == GnssMessage::STATUS_NO_FIX).count() as u64;
-        return Ok((Vec::new(), r, notes));
-    };
-    let datum =
-        Datum::new(lat0, lon0, alt0).map_err(|e| PipelineError::Refused(format!("GNSS `{}`: datum: {e}", s.topic)))?;
-    r.datum = Some([lat0, lon0, alt0]);
-    let frame = s.sensor.frame.clone().or_else(|| msgs.first().map(|m| m.frame_id.clone())).unwrap_or_default();
-    let lever = mount(s, cfg, tree, &frame, msgs.first().map(|m| m.stamp), &mut notes)?;
-    r.lever_arm = Some([lever.x, lever.y]);
-    let floors = s.sensor.gnss;
-    let mut out = Vec::new();
-    for f in msgs {
-        if f.status == GnssMessage::STATUS_NO_FIX {
-            r.no_fix += 1;
-            continue;
+/// Runs the estimator, and returns its estimate with the number of inputs it used. When
+/// fixes exist but never make the heading observable (all too imprecise, or the robot
+/// never drove far enough between them), the fixes are dropped with a note and the track
+/// is estimated from the other sensors: one unusable stream does not sink the run.
+fn estimate_without_unusable_fixes(
+    inputs: Vec<EstimatorInput>,
+    config: &EstimatorConfig,
+    notes: &mut Vec<String>,
+) -> Result<(Estimate, usize), PipelineError> {
+    let refused = |e: EstimatorError| PipelineError::Refused(format!("pose estimator: {e}"));
+    match estimate(&inputs, config) {
+        Err(EstimatorError::HeadingNotObservable { travelled_m, needed_m }) => {
+            let is_fix = |i: &EstimatorInput| matches!(i, EstimatorInput::Position { .. });
+            let fixes = inputs.iter().filter(|i| is_fix(i)).count();
+            let rest: Vec<EstimatorInput> = inputs.into_iter().filter(|i| !is_fix(i)).collect();
+            notes.push(format!(
+                "GNSS: {fixes} fixes, but they never made the heading observable (the fixes precise \
+                 enough to use, heading_init_max_fix_sigma_m = {:.2} m, span {travelled_m:.2} m; \
+                 heading_init_distance_m = {needed_m:.2} m): the track is estimated without them",
+                config.heading_init_max_fix_sigma_m
+            ));
+            let e = estimate(&rest, config).map_err(refused)?;
+            Ok((e, rest.len()))
         }
-        if !good(&f) {
-            r.not_finite += 1;
-            continue;
+        r => {
+            let n = inputs.len();
+            r.map(|e| (e, n)).map_err(refused)
         }
-        let enu = datum.to_enu(f.latitude, f.longitude, f.altitude);
-        let q = quality(f);
-        // NavSatFix's covariance is ENU (east, north, up), m².
-        let kind = match f.position_covariance_type {
-            GnssMessage::COVARIANCE_TYPE_UNKNOWN => GnssCovarianceKind::Unknown,
-            GnssMessage::COVARIANCE_TYPE_KNOWN => GnssCovarianceKind::Known,
-            _ => GnssCovarianceKind::Diagonal,
-        };
-        let cov = floors.covariance(&f.position_covariance, kind, q);
-        r.unknown_covariance += u64::from(cov.unknown);
-        r.floored += u64::from(cov.floored);
-        r.passed += 1;
-        out.push(EstimatorInput::Position {
-            stamp: offset(f.stamp, s),
-            enu: [enu[0], enu[1]],
-            covariance: cov.enu,
-            antenna: Point2::new(lever.x, lever.y),
-            quality: q,
-        });
     }
-    Ok((out, r, notes))
 }
 
 /// Runs the estimator and its smoother over the log's pose sensors.
 pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<ChosenTrack, PipelineError> {
-    let Inputs { inputs, gnss, config, notes, odometry_glitches } = inputs(plan, inv, bound)?;
-    let e = estimate(&inputs, &config).map_err(|e| PipelineError::Refused(format!("pose estimator: {e}")))?;
+    let Inputs { inputs, gnss, config, mut notes, odometry_glitches } = inputs(plan, inv, bound)?;
+    let (e, inputs) = estimate_without_unusable_fixes(inputs, &config, &mut notes)?;
     let odom = bound.first(SensorKind::WheelOdometry);
     let names: Vec<String> =
         bound.sensors.iter().map(|s| format!("{} `{}`", s.sensor.kind.as_str().replace('_', " "), s.topic)).collect();
-    let report = EstimationReport { estimator: e.report.clone(), gnss_input: gnss, inputs: inputs.len() };
+    let report = EstimationReport { estimator: e.report.clone(), gnss_input: gnss, inputs };
     let stamps: Vec<Stamp> = odom.map(|o| inv.odom[&o.topic].iter().map(|m| m.stamp).collect()).unwrap_or_default();
     let receive = odom.map(|o| inv.odom[&o.topic].iter().map(|m| m.receive_stamp).collect()).unwrap_or_default();
     // The track's own counters are the odometry's: the samples the track is built on.

@@ -18,9 +18,18 @@ pub struct GnssInputReport {
     pub no_fix: u64,
     /// NaN or infinite latitude, longitude or altitude.
     pub not_finite: u64,
+    /// Latitude beyond ±90°, longitude beyond ±180° or altitude outside the sensor's
+    /// `altitude_range_m`: receiver faults, dropped.
+    pub out_of_range: u64,
+    /// A status or covariance type `NavSatFix` does not define: dropped.
+    pub invalid_field: u64,
+    /// Early fixes that the fixes after them contradicted (far from the datum's fix):
+    /// dropped.
+    pub contradicted: u64,
     /// The datum `[lat°, lon°, alt m]` of the map frame (ENU at it).
     pub datum: Option<[f64; 3]>,
-    /// `config` or `first good fix`.
+    /// `config`, `first good fix` or `first consistent fix` (the first the next two
+    /// agree with).
     pub datum_source: String,
     /// Fixes whose σ was raised to the floor of their status.
     pub floored: u64,

@@ -6,6 +6,7 @@
 //! log's beyond the tolerances is reported.
 
 use crate::recording::ScanTopic;
+use crate::sensors::BoundSensor;
 use crate::PipelineError;
 use fusemap_core::config::{ExtrinsicsSource, LogConfig};
 use fusemap_core::frames::{FrameTree, FrameTreeLimits, LookupError};
@@ -146,4 +147,19 @@ pub fn lidar_mount_from_log(
             (Mount3 { x: p.x, y: p.y, yaw: p.theta, ..Default::default() }, "scan_line")
         })
     })
+}
+
+/// The sensor's mount, resolved as a lidar's is: `log.extrinsics` decides between the
+/// config and the log's TF, and a config mount that disagrees with TF is reported.
+pub(crate) fn sensor_mount(
+    s: &BoundSensor,
+    cfg: &LogConfig,
+    tree: &FrameTree,
+    frame: &str,
+    stamp: Option<Stamp>,
+    notes: &mut Vec<String>,
+) -> Result<Mount3, PipelineError> {
+    let log_mount = from_tf(tree, &cfg.base_frame, frame, stamp);
+    let name = if frame.is_empty() { s.sensor.name.as_str() } else { frame };
+    Ok(resolve(name, cfg, s.sensor.base_from_sensor, log_mount, notes)?.base_from_sensor)
 }

@@ -32,6 +32,7 @@ pub mod doctor;
 pub mod estimation;
 pub mod estimation_report;
 pub mod extrinsics;
+pub mod gnss_fixes;
 mod insert;
 pub mod job;
 mod lidar_frames;

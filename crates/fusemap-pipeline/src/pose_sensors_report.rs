@@ -24,7 +24,7 @@ pub fn gnss_quality(inv: &Inventory, out: &mut String, findings: &mut Vec<String
         let mut bins = [[0u64; 4]; 10];
         for f in fixes {
             let b = (((f.stamp.0 - first.0) as i128 * 10 / span as i128) as usize).min(9);
-            let k = if !crate::estimation::usable_fix(f) {
+            let k = if !crate::gnss_fixes::usable_fix(f) {
                 3
             } else {
                 match f.status {
@@ -39,10 +39,10 @@ pub fn gnss_quality(inv: &Inventory, out: &mut String, findings: &mut Vec<String
             let (a, z) = (span as f64 * i as f64 / 10.0 * 1e-9, span as f64 * (i + 1) as f64 / 10.0 * 1e-9);
             writeln!(out, "| {a:.1} | {z:.1} | {} | {} | {} | {} |", b[0], b[1], b[2], b[3])?;
         }
-        let mut good: Vec<Stamp> = fixes.iter().filter(|f| crate::estimation::usable_fix(f)).map(|f| f.stamp).collect();
+        let mut good: Vec<Stamp> = fixes.iter().filter(|f| crate::gnss_fixes::usable_fix(f)).map(|f| f.stamp).collect();
         good.sort_unstable();
         if good.is_empty() {
-            findings.push(format!("{topic}: no usable fix at all (every one NO_FIX or NaN)"));
+            findings.push(format!("{topic}: no usable fix at all (every one NO_FIX, NaN or out of range)"));
             continue;
         }
         let gaps = good.windows(2).map(|w| (w[1].secs_since(w[0]), w[0]));

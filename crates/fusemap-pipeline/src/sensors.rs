@@ -8,6 +8,7 @@
 
 use crate::PipelineError;
 use fusemap_core::config::{auto_sensor, Plan, PlannedLidar, PlannedSensor, SensorKind};
+use fusemap_core::time::Stamp;
 use std::collections::BTreeMap;
 
 /// A lidar bound to its topic.
@@ -26,6 +27,13 @@ pub struct BoundSensor {
     pub sensor: PlannedSensor,
     /// The topic it reads.
     pub topic: String,
+}
+
+impl BoundSensor {
+    /// `t` on the common clock: the sensor's `time_offset_s` added.
+    pub fn stamp(&self, t: Stamp) -> Stamp {
+        Stamp(t.0.saturating_add(crate::offset_ns(self.sensor.time_offset_s)))
+    }
 }
 
 /// Every sensor of a run, bound to the log's topics.

@@ -284,7 +284,7 @@ fn fixes(
     if chosen.source != PoseSource::Estimator || !plan.slam.fixes {
         return Ok(Vec::new());
     }
-    let inputs = crate::estimation::gnss_positions(plan, inv, bound)?;
+    let inputs = crate::gnss_fixes::gnss_positions(plan, inv, bound)?;
     // The estimator's rule for which fixes are RTK fixed (white errors) and which share a
     // correlated error.
     let e = &plan.estimator;

@@ -169,6 +169,11 @@ pub struct SensorConfig {
     /// GNSS: σ used when the message says its covariance is unknown, metres.
     #[serde(default)]
     pub sigma_unknown_m: Option<f64>,
+    /// GNSS: the altitudes a fix may have, `[lowest, highest]` metres above the WGS 84
+    /// ellipsoid; fixes outside are dropped as receiver faults (default
+    /// [`DEFAULT_ALTITUDE_RANGE_M`]).
+    #[serde(default)]
+    pub altitude_range_m: Option<[f64; 2]>,
 
     /// Pose: position σ where the message's covariance is zero or unusable, metres
     /// (default: the estimator's `fallback_pose_sigma_m`).
@@ -250,6 +255,7 @@ impl SensorConfig {
             sigma_floor_sbas_m: None,
             sigma_floor_fix_m: None,
             sigma_unknown_m: None,
+            altitude_range_m: None,
             position_noise_m: None,
             yaw_noise_deg: None,
             depth_topic: None,
@@ -294,6 +300,7 @@ impl SensorConfig {
         check(self.sigma_floor_sbas_m.is_some(), "sigma_floor_sbas_m", g);
         check(self.sigma_floor_fix_m.is_some(), "sigma_floor_fix_m", g);
         check(self.sigma_unknown_m.is_some(), "sigma_unknown_m", g);
+        check(self.altitude_range_m.is_some(), "altitude_range_m", g);
         check(self.position_noise_m.is_some(), "position_noise_m", SensorKind::Pose);
         check(self.yaw_noise_deg.is_some(), "yaw_noise_deg", SensorKind::Pose);
         let c = SensorKind::Camera;
@@ -329,6 +336,7 @@ pub struct OdometryNoise {
 
 /// GNSS σ floors by fix status (the estimator's measurement model).
 pub use crate::estimator::GnssNoise;
+use crate::estimator::DEFAULT_ALTITUDE_RANGE_M;
 
 /// What a sensor adds to a run, validated.
 #[derive(Clone, Debug, PartialEq)]
@@ -355,6 +363,8 @@ pub struct PlannedSensor {
     pub datum: Option<[f64; 3]>,
     /// GNSS σ floors.
     pub gnss: GnssNoise,
+    /// The altitudes a GNSS fix may have, `[lowest, highest]` metres.
+    pub altitude_range_m: [f64; 2],
     /// Pose σ fallbacks: position m, yaw rad (`None`: the estimator's defaults).
     pub pose_noise: (Option<f64>, Option<f64>),
     /// `true` when the table was written in the config, `false` when auto-detected.
@@ -474,6 +484,11 @@ pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<Planne
                 return Err(err(f(k), format!("must be > 0 metres, got {v}")));
             }
         }
+        let altitude_range_m = s.altitude_range_m.unwrap_or(DEFAULT_ALTITUDE_RANGE_M);
+        let [low, high] = altitude_range_m;
+        if finite(&f("altitude_range_m"), low)? >= finite(&f("altitude_range_m"), high)? {
+            return Err(err(f("altitude_range_m"), format!("must be [lowest, highest], got [{low}, {high}]")));
+        }
         let pose_noise =
             (pos("position_noise_m", s.position_noise_m)?, pos("yaw_noise_deg", s.yaw_noise_deg)?.map(f64::to_radians));
         if let Some(m) = &s.base_from_sensor {
@@ -493,6 +508,7 @@ pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<Planne
             use_orientation: s.use_orientation.unwrap_or(true),
             datum: s.datum,
             gnss,
+            altitude_range_m,
             pose_noise,
             explicit: true,
         });

@@ -49,6 +49,10 @@ pub struct EstimatorConfig {
     pub gap_speed_sigma_mps: f64,
     /// Gyro rate noise per sample when the message carries no variance, rad/s.
     pub gyro_rate_sigma: f64,
+    /// Yaw rates beyond this are a sensor or driver fault and are dropped (counted), rad/s.
+    /// The default, 35 rad/s (2000 °/s), is the full scale of common MEMS gyros and far
+    /// above any ground robot's turn rate.
+    pub max_gyro_rate_rad_s: f64,
     /// Gyro samples further apart than this leave a gap in which the odometry heading is
     /// used instead, seconds.
     pub max_gyro_gap_s: f64,
@@ -136,6 +140,7 @@ impl Default for EstimatorConfig {
             max_odometry_gap_s: 0.25,
             gap_speed_sigma_mps: 1.0,
             gyro_rate_sigma: 0.01,
+            max_gyro_rate_rad_s: 35.0,
             max_gyro_gap_s: 0.1,
             heading_noise_per_sqrt_s: 0.002,
             gyro_bias_random_walk: 1e-4,
@@ -177,6 +182,7 @@ impl EstimatorConfig {
             ("heading_init_max_residual_m", self.heading_init_max_residual_m),
             ("max_odometry_gap_s", self.max_odometry_gap_s),
             ("gyro_rate_sigma", self.gyro_rate_sigma),
+            ("max_gyro_rate_rad_s", self.max_gyro_rate_rad_s),
             ("max_gyro_gap_s", self.max_gyro_gap_s),
             ("initial_position_sigma_m", self.initial_position_sigma_m),
             ("initial_gyro_bias_sigma", self.initial_gyro_bias_sigma),

@@ -232,6 +232,10 @@ pub(crate) fn sort_inputs(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> (
                     counts.gyro.not_finite += 1;
                     continue;
                 }
+                if yaw_rate.abs() > cfg.max_gyro_rate_rad_s {
+                    counts.gyro.implausible += 1;
+                    continue;
+                }
                 if gyro.stamps.last() == Some(&stamp) {
                     continue;
                 }

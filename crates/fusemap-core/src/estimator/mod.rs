@@ -82,7 +82,10 @@ pub use report::{
     CorrectionReport, EstimatorReport, FixQualityCount, FixRejection, GyroReport, HeadingInit, HeadingSource,
     InnovationStats, OdometryReport, RejectedFix, SlipStretch,
 };
-pub use sensor_models::{base_yaw_rate, odometry_increment_covariance, GnssCovariance, GnssCovarianceKind, GnssNoise};
+pub use sensor_models::{
+    base_yaw_rate, check_fix, odometry_increment_covariance, FixProblem, GnssCovariance, GnssCovarianceKind, GnssNoise,
+    DEFAULT_ALTITUDE_RANGE_M,
+};
 
 use crate::geometry::Pose2;
 use filter::{StepRecord, N};

@@ -116,6 +116,8 @@ pub struct GyroReport {
     pub used: usize,
     /// Samples with a NaN or infinite rate (or an absurd stamp), skipped.
     pub not_finite: usize,
+    /// Samples whose yaw rate exceeds `max_gyro_rate_rad_s`, skipped.
+    pub implausible: usize,
     /// Variances present but not finite or not positive: `gyro_rate_sigma` was used.
     pub variance_fallbacks: usize,
     /// Filter steps whose heading came from the odometry because no gyro covered them.

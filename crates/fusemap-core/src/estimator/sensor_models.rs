@@ -60,6 +60,50 @@ pub fn base_yaw_rate(
     (yaw_rate, (var.is_finite() && var > 0.0).then_some(var))
 }
 
+/// Why a GNSS fix gives no position (`sensor_msgs/NavSatFix` checked against its
+/// definition and the Earth), in the order the checks run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FixProblem {
+    /// A `status` outside -1..=2 or a `position_covariance_type` outside 0..=3: values
+    /// the message definition does not have, so the rest cannot be trusted either.
+    InvalidField,
+    /// `STATUS_NO_FIX`.
+    NoFix,
+    /// A NaN or infinite latitude, longitude or altitude.
+    NotFinite,
+    /// A latitude beyond ±90°, a longitude beyond ±180° or an altitude outside the
+    /// configured band: a receiver or driver fault, not a place.
+    OutOfRange,
+}
+
+/// The altitude band a fix must lie in when the config gives none, metres above the
+/// WGS 84 ellipsoid: from below the Dead Sea shore (geoid undulation included) to above
+/// the highest road; a ground robot outside it has a faulty receiver.
+pub const DEFAULT_ALTITUDE_RANGE_M: [f64; 2] = [-1000.0, 10000.0];
+
+/// Checks a fix's fields: `Ok` when it gives a position.
+pub fn check_fix(
+    status: i8,
+    covariance_type: u8,
+    [latitude, longitude, altitude]: [f64; 3],
+    altitude_range_m: [f64; 2],
+) -> Result<(), FixProblem> {
+    if !(-1..=2).contains(&status) || covariance_type > 3 {
+        return Err(FixProblem::InvalidField);
+    }
+    if status == -1 {
+        return Err(FixProblem::NoFix);
+    }
+    if !(latitude.is_finite() && longitude.is_finite() && altitude.is_finite()) {
+        return Err(FixProblem::NotFinite);
+    }
+    let [low, high] = altitude_range_m;
+    if latitude.abs() > 90.0 || longitude.abs() > 180.0 || !(low..=high).contains(&altitude) {
+        return Err(FixProblem::OutOfRange);
+    }
+    Ok(())
+}
+
 /// GNSS σ floors by fix status: a receiver's own covariance is often optimistic, and
 /// below its floor a fix would pin the track harder than its real error allows.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -132,6 +176,22 @@ impl GnssNoise {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fixes_are_checked_against_the_definition_and_the_earth() {
+        let band = DEFAULT_ALTITUDE_RANGE_M;
+        assert_eq!(check_fix(2, 2, [48.1, 11.5, 500.0], band), Ok(()));
+        assert_eq!(check_fix(-1, 2, [f64::NAN, 11.5, 500.0], band), Err(FixProblem::NoFix));
+        assert_eq!(check_fix(3, 2, [48.1, 11.5, 500.0], band), Err(FixProblem::InvalidField));
+        assert_eq!(check_fix(0, 4, [48.1, 11.5, 500.0], band), Err(FixProblem::InvalidField));
+        assert_eq!(check_fix(0, 0, [48.1, f64::INFINITY, 500.0], band), Err(FixProblem::NotFinite));
+        assert_eq!(check_fix(0, 0, [48.1, 11.5, f64::NAN], band), Err(FixProblem::NotFinite));
+        for bad in [[91.0, 11.5, 500.0], [1e308, 11.5, 500.0], [48.1, -180.5, 500.0], [48.1, 11.5, 1e6]] {
+            assert_eq!(check_fix(0, 0, bad, band), Err(FixProblem::OutOfRange), "{bad:?}");
+        }
+        assert_eq!(check_fix(0, 0, [-90.0, 180.0, -1000.0], band), Ok(()));
+        assert_eq!(check_fix(0, 0, [48.1, 11.5, 500.0], [0.0, 100.0]), Err(FixProblem::OutOfRange));
+    }
 
     #[test]
     fn a_constant_odometry_covariance_gives_no_increment_covariance() {

@@ -6,6 +6,7 @@ mod camera_bad_input;
 mod camera_scenario;
 mod frames;
 mod hour_loop;
+mod implausible_pose_sensors;
 mod production_line;
 mod scan_angles;
 mod scan_frames;
