@@ -151,6 +151,14 @@ impl Error {
     pub fn is_skippable(&self) -> bool {
         matches!(self, Error::Format { location: Location::Message { .. }, .. })
     }
+
+    /// The topic of the message a skippable error is about.
+    pub fn message_topic(&self) -> Option<&str> {
+        match self {
+            Error::Format { location: Location::Message { topic, .. }, .. } => Some(topic),
+            _ => None,
+        }
+    }
 }
 
 /// fusemap-io's result type.

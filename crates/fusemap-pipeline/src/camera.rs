@@ -111,6 +111,9 @@ pub(crate) fn build_camera(
         ))
     })?;
     for t in [&c.topic, &c.depth_topic] {
+        if let (false, Some((n, first))) = (inv.images.contains_key(t), inv.stats.malformed_by_topic.get(t)) {
+            return Err(refuse(format!("the log's {n} messages on `{t}` are all malformed; the first: {first}")));
+        }
         if !inv.images.contains_key(t) {
             return Err(refuse(format!(
                 "the log has no images on `{t}`; log image topics: {}",

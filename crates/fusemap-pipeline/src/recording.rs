@@ -258,7 +258,13 @@ fn next(
             Ok(m) => return Some(Ok(m)),
             // One message that does not decode (a corrupt payload, a big-endian CDR
             // message) is skipped and counted: a user wants the rest of the log.
-            Err(e) if e.is_skippable() => undecodable.malformed(e.to_string()),
+            Err(e) if e.is_skippable() => {
+                let description = e.to_string();
+                if let Some(topic) = e.message_topic() {
+                    undecodable.malformed_on(topic, &description);
+                }
+                undecodable.malformed(description);
+            }
             Err(e) => return Some(Err(e)),
         }
     }
@@ -271,6 +277,10 @@ fn merged_stats(reader: &ReadStats, undecodable: ReadStats) -> ReadStats {
         stats.malformed(e);
     }
     stats.malformed += undecodable.malformed - undecodable.malformed.min(10);
+    for (topic, (n, first)) in undecodable.malformed_by_topic {
+        let (m, _) = stats.malformed_by_topic.entry(topic).or_insert((0, first));
+        *m += n;
+    }
     stats
 }
 

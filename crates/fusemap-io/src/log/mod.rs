@@ -390,12 +390,21 @@ pub struct ReadStats {
     pub malformed: u64,
     /// Up to 10 messages describing malformed records (file, line/record, reason).
     pub malformed_examples: Vec<String>,
+    /// Malformed messages by topic, with the first one's description: a topic whose
+    /// every message was malformed is then refused for that reason, not as missing.
+    pub malformed_by_topic: BTreeMap<String, (u64, String)>,
 }
 
 impl ReadStats {
     /// Counts a skipped record of type `t`.
     pub fn skip_type(&mut self, t: &str) {
         *self.skipped_by_type.entry(t.to_string()).or_default() += 1;
+    }
+
+    /// Counts a malformed message of `topic`, keeping the topic's first description.
+    pub fn malformed_on(&mut self, topic: &str, description: &str) {
+        let (n, _) = self.malformed_by_topic.entry(topic.to_owned()).or_insert_with(|| (0, description.to_owned()));
+        *n += 1;
     }
 
     /// Counts a malformed record and keeps its description if fewer than 10 are kept.

@@ -90,6 +90,20 @@ fn bad_images_are_counted_and_skipped() {
     assert!(c.frames_used > 0 && c.frames_used < c.labels_read);
 }
 
+/// When every label image is malformed, the refusal says so and why, rather than that
+/// the log has none.
+#[test]
+fn a_topic_of_only_malformed_images_is_refused_for_that_reason() {
+    let mut rec = short();
+    let n = every(&mut rec, "/camera/labels", 1, |i| {
+        i.data.to_mut().pop();
+    });
+    let e = run("camera-all-labels-malformed", &rec).map(|_| ()).unwrap_err().to_string();
+    assert!(e.contains(&format!("{n} messages on `/camera/labels` are all malformed")), "{e}");
+    assert!(e.contains("data"), "the first message's fault is given: {e}");
+    println!("{e}");
+}
+
 #[test]
 fn frames_without_a_pose_are_counted() {
     let mut rec = short();
