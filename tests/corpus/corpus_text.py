@@ -222,7 +222,7 @@ def config_cases() -> None:
                                        "{case}/out"], "error", names=["{case}/robot.toml"])
     (d / "robot.toml").write_bytes(bytes(random.Random(7).randrange(256) for _ in range(2048)))
     d = case("config/sparse-2gib", ["map", "--config", "{case}/big.toml", "--world", WORLD, "--out", "{case}/out"],
-             "error", names=["{case}/big.toml"])
+             "error", names=["{case}/big.toml", "larger than 4 MiB"], max_seconds=1.0)
     with open(d / "big.toml", "wb") as f:
         f.truncate(2 << 30)  # sparse: no disk used
     d = case("config/a-directory", ["map", "--config", "{case}/dir", "--world", WORLD, "--out", "{case}/out"],
@@ -289,6 +289,15 @@ def world_cases() -> None:
     os.mkfifo(d / "pipe")
     case("world/missing", ["map", "--world", "{case}/none.toml", "--out", "{case}/out"], "error",
          names=["{case}/none.toml"])
+    # Files read whole are refused past 4 MiB before they are read.
+    d = case("world/sparse-2gib", ["map", "--world", "{case}/big.toml", "--out", "{case}/out"], "error",
+             names=["{case}/big.toml", "larger than 4 MiB"], max_seconds=1.0)
+    with open(d / "big.toml", "wb") as f:
+        f.truncate(2 << 30)  # sparse: no disk used
+    d = case("simulate/scenario-sparse-2gib", ["simulate", "{case}/big.toml", "--out", "{case}/out"],
+             "error", names=["{case}/big.toml", "larger than 4 MiB"], max_seconds=1.0)
+    with open(d / "big.toml", "wb") as f:
+        f.truncate(2 << 30)
 
 
 # ---------------------------------------------------------------------------------------

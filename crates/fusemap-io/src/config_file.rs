@@ -65,15 +65,12 @@ pub fn parse_plan_str(text: &str, path: &Path) -> Result<(Config, Plan)> {
     Ok((config, plan))
 }
 
-/// Reads a UTF-8 text file; invalid UTF-8 is a format error at the line where it starts.
+/// Reads a config, world or scenario file as UTF-8 text, refusing one past
+/// [`MAX_DESCRIPTION_BYTES`](crate::input_file::MAX_DESCRIPTION_BYTES); invalid UTF-8 is
+/// a format error at the line where it starts.
 pub fn read_text(path: &Path) -> Result<String> {
-    crate::input_file::refuse_special_file(path)?;
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        let line = line_of(e.as_bytes(), at);
-        Error::format(path, Location::Line(line), "the file is not valid UTF-8 text")
-    })
+    use crate::input_file::{read_text_within, MAX_DESCRIPTION_BYTES};
+    read_text_within(path, MAX_DESCRIPTION_BYTES, "a config, world or scenario file")
 }
 
 /// The 1-based line holding byte `offset` of `text`.

@@ -1,8 +1,32 @@
 //! Inputs are files: a FIFO, socket or device named as a log, config or world would block
-//! a read forever or never end, so it is refused before it is opened.
+//! a read forever or never end, so it is refused before it is opened. Text inputs read
+//! whole (configs, worlds, scenarios, trajectories, YAML) are read within a size budget,
+//! so a 2 GB file named as a config is one error, not an allocation of 2 GB.
 
 use crate::error::{Error, Location, Result};
 use std::path::Path;
+
+/// The largest config, world or scenario file read, bytes: a hundred times the annotated
+/// example config.
+pub const MAX_DESCRIPTION_BYTES: u64 = 4 << 20;
+
+/// Reads `path` as UTF-8 text of at most `max_bytes` (a special file refused first); a
+/// larger file is a format error saying it is not `what`, invalid UTF-8 one at the line
+/// where it starts.
+pub fn read_text_within(path: &Path, max_bytes: u64, what: &str) -> Result<String> {
+    refuse_special_file(path)?;
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut bytes = Vec::new();
+    let read = crate::bounded::read_to_end_bounded(file, max_bytes, &mut bytes).map_err(|e| Error::io(path, e))?;
+    if read == crate::bounded::Bounded::OverLimit {
+        let mib = max_bytes as f64 / f64::from(1 << 20);
+        return Err(Error::format(path, Location::File, format!("larger than {mib} MiB; not {what}")));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let line = crate::config_file::line_of(e.as_bytes(), e.utf8_error().valid_up_to());
+        Error::format(path, Location::Line(line), "the file is not valid UTF-8 text")
+    })
+}
 
 /// An error when `path` is a FIFO, socket or device (after following symbolic links);
 /// anything else, including a missing path, is left to the caller's own open.
@@ -43,6 +67,25 @@ fn special_kind(_: &std::fs::FileType) -> Option<&'static str> {
 #[cfg(all(test, unix))]
 mod tests {
     use super::*;
+
+    #[test]
+    fn text_past_the_budget_or_not_utf8_is_refused() {
+        let dir = crate::testdata::temp_dir("text-within");
+        let big = dir.join("big.toml");
+        // Sparse: 2 GB of nothing on disk.
+        std::fs::File::create(&big).unwrap().set_len(2 << 30).unwrap();
+        let e = read_text_within(&big, MAX_DESCRIPTION_BYTES, "a config").unwrap_err().to_string();
+        assert!(e.contains("big.toml") && e.contains("larger than 4 MiB; not a config"), "{e}");
+        let latin1 = dir.join("latin1.toml");
+        std::fs::write(&latin1, b"a = 1\nb = \"caf\xe9\"\n").unwrap();
+        let e = read_text_within(&latin1, 100, "a config").unwrap_err().to_string();
+        assert!(e.contains("latin1.toml:2") && e.contains("UTF-8"), "{e}");
+        assert!(read_text_within(&dir.join("missing"), 10, "x").unwrap_err().to_string().contains("missing"));
+        let exact = dir.join("exact.toml");
+        std::fs::write(&exact, "x = 1\n").unwrap();
+        assert_eq!(read_text_within(&exact, 6, "a config").unwrap(), "x = 1\n");
+        assert!(read_text_within(&exact, 5, "a config").is_err());
+    }
 
     #[test]
     fn devices_and_fifos_are_refused_files_are_not() {

@@ -3,7 +3,7 @@
 //! `#` comments. A planar pose is written with z = 0 and the rotation about z.
 
 use crate::atomic::write_atomic;
-use crate::config_file::read_text;
+use crate::input_file::read_text_within;
 use crate::{Error, Location, Result};
 use fusemap_core::geometry::{quaternion_yaw, Pose2};
 use fusemap_core::time::Stamp;
@@ -33,9 +33,12 @@ pub fn write_tum(path: &Path, poses: &[(Stamp, Pose2)]) -> Result<()> {
     })
 }
 
+/// The largest TUM trajectory read, bytes: a day of poses at 100 Hz.
+pub const MAX_TUM_BYTES: u64 = 1 << 30;
+
 /// Reads a TUM trajectory as planar poses (yaw from the quaternion).
 pub fn read_tum(path: &Path) -> Result<Vec<(Stamp, Pose2)>> {
-    let text = read_text(path)?;
+    let text = read_text_within(path, MAX_TUM_BYTES, "a TUM trajectory")?;
     let mut out = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.trim();

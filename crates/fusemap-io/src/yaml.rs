@@ -15,7 +15,7 @@
 //!
 //! Every node keeps its line, so an error names the line of the value it is about.
 
-use crate::error::{Error, Location, Result};
+use crate::error::Result;
 use saphyr::{LoadableYamlNode, MarkedYaml, Scalar, YamlData};
 use std::path::Path;
 
@@ -31,20 +31,7 @@ pub type YamlError = (u64, String);
 
 /// Reads a YAML file as UTF-8 text, refusing one past [`MAX_YAML_BYTES`].
 pub(crate) fn read_text(path: &Path) -> Result<String> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut bytes = Vec::new();
-    let read = crate::bounded::read_to_end_bounded(file, MAX_YAML_BYTES, &mut bytes).map_err(|e| Error::io(path, e))?;
-    if read == crate::bounded::Bounded::OverLimit {
-        return Err(Error::format(
-            path,
-            Location::File,
-            format!("larger than {} MiB; not a YAML description file", MAX_YAML_BYTES >> 20),
-        ));
-    }
-    String::from_utf8(bytes).map_err(|e| {
-        let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()].iter().filter(|&&b| b == b'\n').count() as u64;
-        Error::format(path, Location::Line(line), "not UTF-8 text".to_string())
-    })
+    crate::input_file::read_text_within(path, MAX_YAML_BYTES, "a YAML description file")
 }
 
 /// Parses the first document of `text`; an empty file or one of comments only is an error.
