@@ -12,6 +12,7 @@
 //!   (`lidar[0].p_occ`) and, when the key is written in the file, its line. A field the
 //!   file leaves at its default has no line.
 
+use crate::input_file::line_of;
 use crate::{Error, Location, Result};
 use fusemap_core::config::{Config, Plan};
 use std::ops::Range;
@@ -71,12 +72,6 @@ pub fn parse_plan_str(text: &str, path: &Path) -> Result<(Config, Plan)> {
 pub fn read_text(path: &Path) -> Result<String> {
     use crate::input_file::{read_text_within, MAX_DESCRIPTION_BYTES};
     read_text_within(path, MAX_DESCRIPTION_BYTES, "a config, world or scenario file")
-}
-
-/// The 1-based line holding byte `offset` of `text`.
-pub(crate) fn line_of(text: &[u8], offset: usize) -> u64 {
-    let end = offset.min(text.len());
-    text[..end].iter().filter(|&&b| b == b'\n').count() as u64 + 1
 }
 
 /// Turns a `toml` error into an [`Error::Format`] at the line its span starts on, with

@@ -15,15 +15,23 @@ pub const MAX_DESCRIPTION_BYTES: u64 = 4 << 20;
 /// where it starts.
 pub fn read_text_within(path: &Path, max_bytes: u64, what: &str) -> Result<String> {
     refuse_special_file(path)?;
+    let too_large = || {
+        let mib = max_bytes as f64 / f64::from(1 << 20);
+        Error::format(path, Location::File, format!("larger than {mib} MiB; not {what}"))
+    };
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    // The length first, so a huge regular file is refused without reading it; the bounded
+    // read then holds for pipes and growing files too.
+    if file.metadata().map_err(|e| Error::io(path, e))?.len() > max_bytes {
+        return Err(too_large());
+    }
     let mut bytes = Vec::new();
     let read = crate::bounded::read_to_end_bounded(file, max_bytes, &mut bytes).map_err(|e| Error::io(path, e))?;
     if read == crate::bounded::Bounded::OverLimit {
-        let mib = max_bytes as f64 / f64::from(1 << 20);
-        return Err(Error::format(path, Location::File, format!("larger than {mib} MiB; not {what}")));
+        return Err(too_large());
     }
     String::from_utf8(bytes).map_err(|e| {
-        let line = crate::config_file::line_of(e.as_bytes(), e.utf8_error().valid_up_to());
+        let line = line_of(e.as_bytes(), e.utf8_error().valid_up_to());
         Error::format(path, Location::Line(line), "the file is not valid UTF-8 text")
     })
 }
@@ -41,6 +49,12 @@ pub fn refuse_special_file(path: &Path) -> Result<()> {
         )),
         None => Ok(()),
     }
+}
+
+/// The 1-based line holding byte `offset` of `text`.
+pub(crate) fn line_of(text: &[u8], offset: usize) -> u64 {
+    let end = offset.min(text.len());
+    text[..end].iter().filter(|&&b| b == b'\n').count() as u64 + 1
 }
 
 #[cfg(unix)]

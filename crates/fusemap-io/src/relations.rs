@@ -3,10 +3,9 @@
 //! between the robot poses at two scan stamps. The format and the metric live in
 //! [`fusemap_core::metrics`]; this module reads the file and names it in errors.
 
-use crate::config_file::line_of;
+use crate::input_file::read_text_within;
 use crate::{Error, Location, Result};
 use fusemap_core::metrics::{parse_relations, Relation};
-use std::io::Read;
 use std::path::Path;
 
 /// The largest relations file read, bytes (256 MiB). The benchmark's largest file
@@ -18,28 +17,7 @@ pub const MAX_RELATIONS_BYTES: u64 = 256 << 20;
 /// and what was wrong; a file over [`MAX_RELATIONS_BYTES`] or without a single relation
 /// is refused.
 pub fn read_relations(path: &Path) -> Result<Vec<Relation>> {
-    let too_large = || {
-        Error::format(
-            path,
-            Location::File,
-            format!("larger than {} MiB: not a relations file", MAX_RELATIONS_BYTES >> 20),
-        )
-    };
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    // The length first, so a huge regular file is refused without reading it; then read at
-    // most one byte past the limit, so the check also holds for pipes and growing files.
-    if file.metadata().map_err(|e| Error::io(path, e))?.len() > MAX_RELATIONS_BYTES {
-        return Err(too_large());
-    }
-    let mut bytes = Vec::new();
-    file.take(MAX_RELATIONS_BYTES + 1).read_to_end(&mut bytes).map_err(|e| Error::io(path, e))?;
-    if bytes.len() as u64 > MAX_RELATIONS_BYTES {
-        return Err(too_large());
-    }
-    let text = String::from_utf8(bytes).map_err(|e| {
-        let line = line_of(e.as_bytes(), e.utf8_error().valid_up_to());
-        Error::format(path, Location::Line(line), "the file is not valid UTF-8 text")
-    })?;
+    let text = read_text_within(path, MAX_RELATIONS_BYTES, "a relations file")?;
     let relations =
         parse_relations(&text).map_err(|e| Error::format(path, Location::Line(e.line as u64), e.message))?;
     if relations.is_empty() {
