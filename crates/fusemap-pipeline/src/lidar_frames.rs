@@ -26,6 +26,15 @@ pub(crate) fn lidar_setup(
     let topic = &inv.scans[&b.topic];
     let frame = b.lidar.frame.clone().or_else(|| topic.frame().map(str::to_string)).unwrap_or_default();
     let (ext, model) = frame_model(b, &frame, inv, tree, cfg, notes)?;
+    if ext.source == "identity" && !frame.is_empty() && frame != cfg.base_frame {
+        notes.push(format!(
+            "lidar `{}`: no mount in the config or the log for `{}`; assumed at `{}`'s origin, facing forward \
+             (give [sensor.base_from_sensor] if it is not)",
+            b.lidar.name,
+            printable(&frame),
+            printable(&cfg.base_frame)
+        ));
+    }
     Ok((frame, ext, model))
 }
 

@@ -96,3 +96,27 @@ fn scans_of_two_frames_on_one_topic_are_each_placed_from_their_own_mount() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A lidar frame the log has no transform for, and the config no mount: it is mapped at
+/// the base's origin (identity), and a note says so, as it does for a camera.
+#[test]
+fn a_lidar_frame_without_a_mount_is_noted() {
+    let mut s = Scenario::default();
+    s.robot.duration_s = 10.0;
+    s.camera.enabled = false;
+    let mut rec = simulate(&s).unwrap();
+    let laser = s.frames.laser.clone();
+    rec.messages.retain(|m| !matches!(m, SimMessage::StaticTransform(t) if t.child_frame_id == laser));
+    let dir = fusemap_io::testdata::temp_dir("lidar-without-mount");
+    let bag = dir.join("bag");
+    fusemap_sim::bag::write_bag(&rec, &bag, true).unwrap();
+    let (_, notes) = occupied(&bag, SlamMode::Off);
+    let note = notes.iter().find(|n| n.contains("no mount in the config or the log")).expect("a note on the mount");
+    assert!(note.contains(&format!("`{laser}`")) && note.contains("lidar `laser`"), "{note}");
+    // With its mount in the log, no such note.
+    let whole = simulate(&s).unwrap();
+    let bag = dir.join("whole");
+    fusemap_sim::bag::write_bag(&whole, &bag, true).unwrap();
+    let (_, notes) = occupied(&bag, SlamMode::Off);
+    assert!(!notes.iter().any(|n| n.contains("no mount in the config or the log")), "{notes:?}");
+}
