@@ -163,14 +163,15 @@ impl PoseBuffer {
             return Ok(self.poses[i]);
         }
         let (t0, t1) = (self.stamps[i - 1], self.stamps[i]);
-        let gap = t1.0 - t0.0;
+        // In i128: two stamps of a hostile log can be further apart than i64 holds.
+        let gap = i128::from(t1.0) - i128::from(t0.0);
         let (p0, p1) = (self.poses[i - 1], self.poses[i]);
         let small_motion = p0.translation().distance(p1.translation()) <= self.bridge_translation
             && crate::geometry::normalize_angle(p1.theta - p0.theta).abs() <= self.bridge_rotation;
-        if gap > self.max_gap_ns && !small_motion {
+        if gap > i128::from(self.max_gap_ns) && !small_motion {
             return Err(NoPose::Gap { gap_s: gap as f64 * 1e-9, limit_s: self.max_gap_ns as f64 * 1e-9 });
         }
-        let f = (t.0 - t0.0) as f64 / gap as f64;
+        let f = (i128::from(t.0) - i128::from(t0.0)) as f64 / gap as f64;
         Ok(self.poses[i - 1].interpolate(self.poses[i], f))
     }
 
@@ -214,6 +215,15 @@ mod tests {
             assert_eq!(b.push(s(t), Pose2::new(x, 0.0, x)), PushOutcome::Added);
         }
         b
+    }
+
+    #[test]
+    fn stamps_further_apart_than_i64_holds_are_a_gap() {
+        let mut b = PoseBuffer::new(1.0);
+        b.push(Stamp(i64::MIN), Pose2::new(0.0, 0.0, 0.0));
+        b.push(Stamp(i64::MAX), Pose2::new(1.0, 0.0, 0.0));
+        assert!(matches!(b.interpolate(Stamp(0)), Err(NoPose::Gap { .. })));
+        assert_eq!(b.interpolate(Stamp(i64::MAX)).unwrap().x, 1.0);
     }
 
     #[test]
