@@ -18,7 +18,7 @@ pub fn corridor(out: &Path, config: Option<&Path>) -> Result<()> {
     let job = MapJob::world(config, fusemap_core::sim::corridor(), ScannerSpec::document(), run.poses, name, out)?;
     let summary = job.run(&mut progress::reporter())?;
     print!("{summary}");
-    println!("outputs       {}", out.display());
+    println!("outputs       {}", super::shown(out));
     Ok(())
 }
 
@@ -29,14 +29,9 @@ pub fn production(out: &Path, config: Option<&Path>) -> Result<()> {
     let run = job.run(&mut progress::reporter())?;
     print!("{}", run.summary);
     print!("{}", scores_table(&run.scores, &plan));
-    println!("comparison    {}", out.join("comparison.png").display());
-    let others: Vec<String> = run
-        .other_maps
-        .iter()
-        .map(String::as_str)
-        .chain(["sim"])
-        .map(|name| out.join(name).display().to_string())
-        .collect();
-    println!("outputs       {} (fused), {}", out.display(), others.join(", "));
+    println!("comparison    {}", super::shown(&out.join("comparison.png")));
+    let others: Vec<String> =
+        run.other_maps.iter().map(String::as_str).chain(["sim"]).map(|name| super::shown(&out.join(name))).collect();
+    println!("outputs       {} (fused), {}", super::shown(out), others.join(", "));
     Ok(())
 }

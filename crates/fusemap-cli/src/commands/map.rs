@@ -19,7 +19,7 @@ pub fn map(
     let job = MapJob::plan(config, world, log, out, crop)?;
     let summary = job.run(&mut progress::reporter())?;
     print!("{summary}");
-    println!("outputs       {}", out.display());
+    println!("outputs       {}", super::shown(out));
     // A run that observed no cell wrote only its summary: that is a failure a script must
     // see, with the reason.
     if summary.entropy.is_none() {

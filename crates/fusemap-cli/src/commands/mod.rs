@@ -13,3 +13,9 @@ pub mod slam_bench;
 pub fn plan_of(config: Option<&std::path::Path>) -> anyhow::Result<fusemap_core::config::Plan> {
     Ok(fusemap_pipeline::job::plan_of(config)?)
 }
+
+/// A path as printed to a terminal: control characters in it (a name holding an escape
+/// sequence or a newline) shown as visible escapes, as every string from a log is.
+pub fn shown(path: &std::path::Path) -> String {
+    fusemap_io::text::printable(&path.display().to_string()).into_owned()
+}

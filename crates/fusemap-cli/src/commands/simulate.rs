@@ -18,17 +18,17 @@ pub fn run(scenario: Option<&Path>, out: &Path, resolution: f64, overwrite: bool
     let rec = simulate(&s).map_err(|e| anyhow::anyhow!("scenario: {e}"))?;
     let files = fusemap_sim::bag::write_simulation(&rec, out, resolution, overwrite)
         .with_context(|| format!("writing the simulation to {}", out.display()))?;
-    println!("bag           {} ({} messages)", files.bag.dir.display(), files.bag.message_count);
+    println!("bag           {} ({} messages)", super::shown(&files.bag.dir), files.bag.message_count);
     for t in &files.bag.topics {
         println!("  {:<12}  {:<28} {}", t.name, t.type_name, t.message_count);
     }
     if let Some(m) = &files.truth_map {
-        println!("true map      {}", m.display());
+        println!("true map      {}", super::shown(m));
     }
     if let Some(m) = &files.truth_semantic {
-        println!("true classes  {}", m.display());
+        println!("true classes  {}", super::shown(m));
     }
-    println!("true track    {}", files.truth_trajectory.display());
+    println!("true track    {}", super::shown(&files.truth_trajectory));
     println!(
         "injected      gyro bias {:.4} rad/s, odometry scale {:.3}, {} GNSS outliers, {} GNSS dropouts",
         rec.gyro_bias_radps,

@@ -536,6 +536,12 @@ fn log_strings_are_escaped_before_they_reach_the_terminal() {
     let odd = write_file(&dir, "bad\u{1b}[2Jname.log", "\0\0\0\0");
     let line = one_line_error(&run(&["map", "--out", path_str(&out), path_str(&odd)]));
     assert!(!line.contains('\u{1b}') && line.contains("bad\\u{1b}[2Jname.log"), "{line:?}");
+    // And the output directory's name as `map` prints it.
+    let odd_out = dir.join("out\u{1b}]0;pwned\u{7}");
+    let o = run(&["map", "--out", path_str(&odd_out), path_str(&log)]);
+    assert_success(&o);
+    let text = stdout(&o);
+    assert!(!text.contains('\u{1b}') && text.contains("out\\u{1b}]0;pwned\\u{7}"), "{text:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
