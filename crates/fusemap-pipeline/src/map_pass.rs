@@ -367,6 +367,27 @@ impl Streams {
     }
 }
 
+/// A lidar's contradictory stamps: all scans at one stamp, or scans sharing the stamp of
+/// the scan before them with other ranges (a repeat, same ranges, has its own note).
+fn stamp_notes(r: &crate::report::LidarReport, notes: &mut Vec<String>) {
+    let (n, shared) = (r.timing.count, r.timing.duplicates);
+    if n > 2 && shared + 1 == n {
+        notes.push(format!(
+            "every one of the {n} scans of `{}` carries the same header stamp: where the scans carry no pose of \
+             their own, each is placed at the pose of that one instant",
+            r.topic
+        ));
+    } else if shared > r.scans_skipped.repeated {
+        notes.push(format!(
+            "{} scans of `{}` carry the stamp of the scan before them but other ranges (two scans at one \
+             instant: a second lidar on the topic, or a driver's stamping fault); both are placed at that \
+             instant's pose",
+            shared - r.scans_skipped.repeated,
+            r.topic
+        ));
+    }
+}
+
 /// The lidars' notes (stamps going backwards, refused, repeated, late and unposed scans);
 /// the skipped scans of all of them.
 fn lidar_notes(lidars: &[Mapped], cfg: &LogConfig, notes: &mut Vec<String>) -> Skipped {
@@ -382,6 +403,7 @@ fn lidar_notes(lidars: &[Mapped], cfg: &LogConfig, notes: &mut Vec<String>) -> S
             };
             notes.push(format!("`{}` stamps go backwards {} times{order}", r.topic, r.timing.regressions));
         }
+        stamp_notes(r, notes);
         if r.scans_skipped.bad_angles > 0 {
             notes.push(format!(
                 "{} scans of `{}` refused: their beam angles cannot be placed (first: {})",

@@ -120,3 +120,40 @@ fn a_lidar_frame_without_a_mount_is_noted() {
     let (_, notes) = occupied(&bag, SlamMode::Off);
     assert!(!notes.iter().any(|n| n.contains("no mount in the config or the log")), "{notes:?}");
 }
+
+/// Contradictory scan stamps are noted: every scan at one instant, or scans at the
+/// instant of the scan before them with other ranges.
+#[test]
+fn scans_sharing_a_stamp_are_noted() {
+    let mut s = Scenario::default();
+    s.robot.duration_s = 10.0;
+    s.camera.enabled = false;
+    let rec = simulate(&s).unwrap();
+    let dir = fusemap_io::testdata::temp_dir("shared-stamps");
+    let restamped = |name: &str, every: usize| {
+        let mut r = rec.clone();
+        let (mut k, mut previous) = (0, None);
+        for m in &mut r.messages {
+            if let SimMessage::Scan(scan) = m {
+                if k % every == 0 {
+                    if let Some(p) = previous {
+                        scan.header.stamp = p;
+                    }
+                }
+                previous = Some(scan.header.stamp);
+                k += 1;
+            }
+        }
+        let bag = dir.join(name);
+        fusemap_sim::bag::write_bag(&r, &bag, true).unwrap();
+        occupied(&bag, SlamMode::Off).1
+    };
+    let notes = restamped("pairs", 10);
+    assert!(notes.iter().any(|n| n.contains("carry the stamp of the scan before them")), "{notes:?}");
+    let notes = restamped("all", 1);
+    assert!(notes.iter().any(|n| n.contains("carries the same header stamp")), "{notes:?}");
+    let whole = dir.join("whole");
+    fusemap_sim::bag::write_bag(&rec, &whole, true).unwrap();
+    let notes = occupied(&whole, SlamMode::Off).1;
+    assert!(!notes.iter().any(|n| n.contains("header stamp") || n.contains("stamp of the scan before")), "{notes:?}");
+}
