@@ -215,6 +215,8 @@ def config_cases() -> None:
                 names=["search_linear_window_m"])
     config_case("config/integer-overflow", "[slam]\nscans_per_submap = 99999999999999999999\n", names=[":2:"])
     config_case("config/duplicate-key", "[map]\nresolution = 0.05\nresolution = 0.1\n", names=[":3:"])
+    gnss = '[[sensor]]\nkind = "gnss"\ntopic = "/fix"\n'
+    config_case("config/1001-gnss-sensors-on-one-topic", gnss * 1001, names=[":6:", "sensor[1].topic", "per topic"])
     config_case("config/not-utf8-bytes", "[map]\nresolution = 0.05\n# \udcff\n".encode("utf-8", "surrogateescape")
                 .decode("latin-1"), "either")
     config_case("config/empty", "", "map")

@@ -494,6 +494,17 @@ mod tests {
         let mut c = Config::default();
         c.sensor.push(SensorConfig { p_occ: Some(0.45), ..SensorConfig::new(SensorKind::Lidar) });
         assert_eq!(field_of(c), "sensor[0].p_occ");
+        // Two tables of one kind on one topic (a thousand GNSS sensors on `/fix`).
+        let mut c = Config::default();
+        let fix = SensorConfig { topic: Some("/fix".into()), ..SensorConfig::new(SensorKind::Gnss) };
+        c.sensor.extend([
+            fix.clone(),
+            SensorConfig { topic: Some("/odom".into()), ..SensorConfig::new(SensorKind::WheelOdometry) },
+            fix.clone(),
+        ]);
+        assert_eq!(field_of(c.clone()), "sensor[2].topic");
+        c.sensor[0].enabled = false;
+        assert!(c.validate().is_ok(), "a disabled table reads nothing");
         let lidar = |f: fn(&mut SensorConfig)| {
             let mut c = Config::default();
             let mut s = SensorConfig::new(SensorKind::Lidar);

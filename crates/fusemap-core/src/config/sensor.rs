@@ -429,6 +429,13 @@ pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<Planne
             if t.trim().is_empty() {
                 return Err(err(f("topic"), "must not be empty (leave it out to look for the usual topic)"));
             }
+            let same = |o: &SensorConfig| o.enabled && o.kind == s.kind && o.topic.as_ref() == Some(t);
+            if let Some(j) = tables[..i].iter().position(same).filter(|_| s.enabled) {
+                return Err(err(
+                    f("topic"),
+                    format!("`{t}` is read by sensor[{j}] already: one `{}` table per topic", s.kind.as_str()),
+                ));
+            }
         }
         let offset = finite(&f("time_offset_s"), s.time_offset_s)?;
         if offset.abs() > 3600.0 {
