@@ -6,7 +6,7 @@
 //! * the IMU's gyro, rotated from the IMU's frame into `base_link` with its mount (TF or
 //!   config), as the yaw rate; its orientation only when the message provides one (REP 145:
 //!   `orientation_covariance[0] = -1` means none) and the sensor table allows it;
-//! * GNSS fixes ([`gnss_fixes`](crate::gnss_fixes)) converted exactly (WGS84 → ECEF → ENU)
+//! * GNSS fixes ([`gnss_fixes`]) converted exactly (WGS84 → ECEF → ENU)
 //!   into one local map frame around the datum — configured, or the first good fix the
 //!   next ones agree with — x east, y north, never UTM zones (whose borders make
 //!   robot_localization's UTM track jump); `NO_FIX` and receiver faults (a latitude of 91°,
