@@ -215,6 +215,12 @@ def config_cases() -> None:
                 names=["search_linear_window_m"])
     config_case("config/integer-overflow", "[slam]\nscans_per_submap = 99999999999999999999\n", names=[":2:"])
     config_case("config/duplicate-key", "[map]\nresolution = 0.05\nresolution = 0.1\n", names=[":3:"])
+    config_case("config/lidar-mount-1e300", '[[sensor]]\nkind = "lidar"\n[sensor.base_from_sensor]\nx = 1e300\n',
+                names=[":4:", "base_from_sensor.x", "1000 m"])
+    # A mount far from everything the lidar could see: no cell observed, no map, exit 1.
+    d = case("demo/corridor-lidar-900m-away", ["demo", "--corridor", "--config", "{case}/robot.toml", "--out",
+                                               "{case}/out"], "no_map", names=["no map was written"])
+    (d / "robot.toml").write_text('[[sensor]]\nkind = "lidar"\n[sensor.base_from_sensor]\nx = 900.0\n')
     gnss = '[[sensor]]\nkind = "gnss"\ntopic = "/fix"\n'
     config_case("config/1001-gnss-sensors-on-one-topic", gnss * 1001, names=[":6:", "sensor[1].topic", "per topic"])
     config_case("config/not-utf8-bytes", "[map]\nresolution = 0.05\n# \udcff\n".encode("utf-8", "surrogateescape")

@@ -19,7 +19,7 @@ pub fn corridor(out: &Path, config: Option<&Path>) -> Result<()> {
     let summary = job.run(&mut progress::reporter())?;
     print!("{summary}");
     println!("outputs       {}", super::shown(out));
-    Ok(())
+    super::fail_without_map(&summary, out)
 }
 
 /// `fusemap demo`: the production line, lidar-only, camera-only and fused.

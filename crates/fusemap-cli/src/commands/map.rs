@@ -2,7 +2,7 @@
 //! planned and run by the library ([`fusemap_pipeline::job`]); this prints its summary.
 
 use crate::progress;
-use anyhow::{bail, Result};
+use anyhow::Result;
 use fusemap_pipeline::job::MapJob;
 use fusemap_pipeline::outputs::Crop;
 use std::path::Path;
@@ -20,15 +20,5 @@ pub fn map(
     let summary = job.run(&mut progress::reporter())?;
     print!("{summary}");
     println!("outputs       {}", super::shown(out));
-    // A run that observed no cell wrote only its summary: that is a failure a script must
-    // see, with the reason.
-    if summary.entropy.is_none() {
-        bail!(
-            "no map was written: no cell was observed in {} scans ({} valid returns); {} says what was skipped and why",
-            summary.scans,
-            summary.returns.valid,
-            out.join("summary.json").display()
-        );
-    }
-    Ok(())
+    super::fail_without_map(&summary, out)
 }

@@ -19,3 +19,17 @@ pub fn plan_of(config: Option<&std::path::Path>) -> anyhow::Result<fusemap_core:
 pub fn shown(path: &std::path::Path) -> String {
     fusemap_io::text::printable(&path.display().to_string()).into_owned()
 }
+
+/// A run that observed no cell wrote only its summary: that is a failure a script must
+/// see, with the reason (for `map` and `demo --corridor` alike).
+pub fn fail_without_map(summary: &fusemap_pipeline::outputs::Summary, out: &std::path::Path) -> anyhow::Result<()> {
+    if summary.entropy.is_none() {
+        anyhow::bail!(
+            "no map was written: no cell was observed in {} scans ({} valid returns); {} says what was skipped and why",
+            summary.scans,
+            summary.returns.valid,
+            out.join("summary.json").display()
+        );
+    }
+    Ok(())
+}

@@ -11,7 +11,7 @@ use crate::sensor::camera::optical_mount;
 use crate::sensor::{CameraError, CameraModel, CameraParams, ClassSpec, ClassTable, Pinhole};
 use serde::{Deserialize, Serialize};
 
-use super::{err, finite, FieldError, SensorConfig};
+use super::{check_mount, err, finite, FieldError, SensorConfig};
 
 /// Default largest stamp difference between a label image and its depth image, seconds:
 /// aligned streams of one RGB-D driver carry the same stamp; 5 ms allows for rounding.
@@ -102,9 +102,7 @@ pub(super) fn plan_camera(i: usize, s: &SensorConfig, name: String, prior: f64) 
         None => Ok(default.to_string()),
     };
     if let Some(m) = &s.base_from_sensor {
-        for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", m.yaw)] {
-            finite(&f(&format!("base_from_sensor.{k}")), v)?;
-        }
+        check_mount(f, m)?;
     }
     Ok(PlannedCamera {
         name,

@@ -230,6 +230,23 @@ fn finite(field: &str, v: f64) -> Result<f64, FieldError> {
     }
 }
 
+/// How far from the base a sensor's mount may be, metres: a sensor kilometres away is a
+/// typo (or a hostile config), not a robot.
+pub const MAX_MOUNT_OFFSET_M: f64 = 1000.0;
+
+/// Checks a configured mount `m` of the table whose keys `f` names: every value finite,
+/// the translation within [`MAX_MOUNT_OFFSET_M`].
+fn check_mount(f: impl Fn(&str) -> String, m: &crate::geometry::Mount3) -> Result<(), FieldError> {
+    for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", m.yaw)] {
+        let field = f(&format!("base_from_sensor.{k}"));
+        finite(&field, v)?;
+        if k.len() == 1 && v.abs() > MAX_MOUNT_OFFSET_M {
+            return Err(err(field, format!("must be within ±{MAX_MOUNT_OFFSET_M} m of the base, got {v}")));
+        }
+    }
+    Ok(())
+}
+
 fn probability(field: &str, v: f64) -> Result<f64, FieldError> {
     finite(field, v)?;
     if v > 0.0 && v < 1.0 {
@@ -513,6 +530,14 @@ mod tests {
             field_of(c)
         };
         assert_eq!(lidar(|s| s.p_free = Some(0.5)), "sensor[0].p_free");
+        let far = Mount3 { x: 1e300, ..Default::default() };
+        assert_eq!(
+            lidar(|s| s.base_from_sensor = Some(Mount3 { x: 1e300, ..Default::default() })),
+            "sensor[0].base_from_sensor.x"
+        );
+        let mut c = Config::default();
+        c.sensor.push(SensorConfig { base_from_sensor: Some(far), ..SensorConfig::new(SensorKind::Imu) });
+        assert_eq!(field_of(c), "sensor[0].base_from_sensor.x");
         assert_eq!(lidar(|s| s.max_range = Some(0.05)), "sensor[0].max_range");
         assert_eq!(lidar(|s| s.min_range = Some(f64::NAN)), "sensor[0].min_range");
         assert_eq!(

@@ -16,7 +16,7 @@ use crate::sensor::{LidarModel, LidarParams, MaxRangePolicy, ScanFilters};
 use serde::{Deserialize, Serialize};
 
 use super::camera::{plan_camera, PlannedCamera};
-use super::{err, finite, probability, FieldError};
+use super::{check_mount, err, finite, probability, FieldError};
 
 /// What a sensor is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -499,9 +499,7 @@ pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<Planne
         let pose_noise =
             (pos("position_noise_m", s.position_noise_m)?, pos("yaw_noise_deg", s.yaw_noise_deg)?.map(f64::to_radians));
         if let Some(m) = &s.base_from_sensor {
-            for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", m.yaw)] {
-                finite(&f(&format!("base_from_sensor.{k}")), v)?;
-            }
+            check_mount(f, m)?;
         }
         others.push(PlannedSensor {
             kind: s.kind,
@@ -547,6 +545,7 @@ fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<Pl
         return Err(err(f("max_tilt_deg"), format!("must be within [0, 90] degrees, got {tilt}")));
     }
     let mount3 = s.base_from_sensor.unwrap_or_default();
+    check_mount(f, &mount3)?;
     let mount: PlanarMount =
         mount3.to_planar(tilt.to_radians()).map_err(|e| err(f("base_from_sensor"), e.to_string()))?;
     let params = LidarParams {
