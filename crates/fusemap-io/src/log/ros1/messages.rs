@@ -134,34 +134,17 @@ impl<'a> FieldReader<'a> for Fields<'a> {
         self.c.string(field).map_err(|e| self.at(e))
     }
 
-    fn field<T>(
-        &mut self,
-        name: &'static str,
-        read: impl FnOnce(&mut Self) -> Result<T, Malformed>,
-    ) -> Result<T, Malformed> {
-        self.path.push_field(name);
-        let value = read(self)?;
-        self.path.pop();
-        Ok(value)
+    fn path(&mut self) -> &mut FieldPath {
+        &mut self.path
     }
 
-    fn seq<T>(
-        &mut self,
-        field: &'static str,
-        min_element_size: usize,
-        mut read: impl FnMut(&mut Self) -> Result<T, Malformed>,
-    ) -> Result<Vec<T>, Malformed> {
-        let n = self.c.array_len(min_element_size, field).map_err(|e| self.at(e))?;
-        let mut out = crate::bounded::vec_with_capacity(n)
-            .map_err(|e| self.at(Malformed(format!("{field}: no memory for its {n} elements ({e})"))))?;
-        self.path.push_field(field);
-        for i in 0..n {
-            self.path.push_index(i);
-            out.push(read(self)?);
-            self.path.pop();
-        }
-        self.path.pop();
-        Ok(out)
+    fn count(&mut self, field: &'static str, min_element_size: usize) -> Result<usize, Malformed> {
+        self.c.array_len(min_element_size, field).map_err(|e| self.at(e))
+    }
+
+    fn room_for<T>(&self, field: &'static str, n: usize) -> Result<Vec<T>, Malformed> {
+        crate::bounded::vec_with_capacity(n)
+            .map_err(|e| self.at(Malformed(format!("{field}: no memory for its {n} elements ({e})"))))
     }
 
     fn position(&self) -> usize {

@@ -189,13 +189,6 @@ impl<'a> CdrReader<'a> {
             })
         }
     }
-
-    /// An empty `Vec` for the `n` elements of `field` (a count already checked against the
-    /// bytes left), reserved fallibly: an allocator that refuses is an error, not an abort.
-    fn room_for<T>(&self, field: &str, n: usize) -> Result<Vec<T>, CdrError> {
-        crate::bounded::vec_with_capacity(n)
-            .map_err(|e| self.invalid(field, format!("no memory for its {n} elements ({e})")))
-    }
 }
 
 impl<'a> FieldReader<'a> for CdrReader<'a> {
@@ -304,33 +297,17 @@ impl<'a> FieldReader<'a> for CdrReader<'a> {
         }
     }
 
-    fn field<T>(
-        &mut self,
-        name: &'static str,
-        read: impl FnOnce(&mut Self) -> Result<T, CdrError>,
-    ) -> Result<T, CdrError> {
-        self.path.push_field(name);
-        let value = read(self)?;
-        self.path.pop();
-        Ok(value)
+    fn path(&mut self) -> &mut FieldPath {
+        &mut self.path
     }
 
-    fn seq<T>(
-        &mut self,
-        field: &'static str,
-        min_element_size: usize,
-        mut read: impl FnMut(&mut Self) -> Result<T, CdrError>,
-    ) -> Result<Vec<T>, CdrError> {
-        let n = self.sequence_len(field, min_element_size)?;
-        let mut out = self.room_for(field, n)?;
-        self.path.push_field(field);
-        for i in 0..n {
-            self.path.push_index(i);
-            out.push(read(self)?);
-            self.path.pop();
-        }
-        self.path.pop();
-        Ok(out)
+    fn count(&mut self, field: &'static str, min_element_size: usize) -> Result<usize, CdrError> {
+        self.sequence_len(field, min_element_size)
+    }
+
+    fn room_for<T>(&self, field: &'static str, n: usize) -> Result<Vec<T>, CdrError> {
+        crate::bounded::vec_with_capacity(n)
+            .map_err(|e| self.invalid(field, format!("no memory for its {n} elements ({e})")))
     }
 
     fn position(&self) -> usize {

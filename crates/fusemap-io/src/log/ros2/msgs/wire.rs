@@ -53,20 +53,47 @@ pub trait FieldReader<'a>: Sized {
     fn u8_seq(&mut self, field: &'static str) -> Result<&'a [u8], Self::Error>;
     /// A `string`.
     fn string(&mut self, field: &'static str) -> Result<String, Self::Error>;
+    /// The path of nested fields being read, for errors.
+    fn path(&mut self) -> &mut FieldPath;
+    /// The element count of a variable-length array `field`, bounded by the bytes left
+    /// for elements of at least `min_element_size` bytes.
+    fn count(&mut self, field: &'static str, min_element_size: usize) -> Result<usize, Self::Error>;
+    /// An empty `Vec` with room for the `n` elements of `field`, reserved fallibly (an
+    /// allocator that refuses is an error, not an abort).
+    fn room_for<T>(&self, field: &'static str, n: usize) -> Result<Vec<T>, Self::Error>;
+
     /// A nested struct field: errors inside name it as `name.inner`.
     fn field<T>(
         &mut self,
         name: &'static str,
         read: impl FnOnce(&mut Self) -> Result<T, Self::Error>,
-    ) -> Result<T, Self::Error>;
+    ) -> Result<T, Self::Error> {
+        self.path().push_field(name);
+        let value = read(self)?;
+        self.path().pop();
+        Ok(value)
+    }
+
     /// A variable-length array of structs, whose errors name `field[i]`; the count is
     /// bounded by the bytes left for elements of at least `min_element_size` bytes.
     fn seq<T>(
         &mut self,
         field: &'static str,
         min_element_size: usize,
-        read: impl FnMut(&mut Self) -> Result<T, Self::Error>,
-    ) -> Result<Vec<T>, Self::Error>;
+        mut read: impl FnMut(&mut Self) -> Result<T, Self::Error>,
+    ) -> Result<Vec<T>, Self::Error> {
+        let n = self.count(field, min_element_size)?;
+        let mut out = self.room_for(field, n)?;
+        self.path().push_field(field);
+        for i in 0..n {
+            self.path().push_index(i);
+            out.push(read(self)?);
+            self.path().pop();
+        }
+        self.path().pop();
+        Ok(out)
+    }
+
     /// Bytes consumed so far.
     fn position(&self) -> usize;
     /// The error for `field`, which started at `position`, holding a value its type
@@ -87,33 +114,34 @@ enum PathPart {
 }
 
 /// The path of nested fields a reader is inside, so an error names
-/// `transforms[1].header.frame_id` rather than just `frame_id`.
+/// `transforms[1].header.frame_id` rather than just `frame_id`. Readers keep one; the
+/// message structs never see it.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct FieldPath(Vec<PathPart>);
+pub struct FieldPath(Vec<PathPart>);
 
 impl FieldPath {
     /// Enters the struct field `name`.
-    pub(crate) fn push_field(&mut self, name: &'static str) {
+    pub fn push_field(&mut self, name: &'static str) {
         self.0.push(PathPart::Field(name));
     }
 
     /// Enters element `i` of the array just entered.
-    pub(crate) fn push_index(&mut self, i: usize) {
+    pub fn push_index(&mut self, i: usize) {
         self.0.push(PathPart::Index(i));
     }
 
     /// Leaves the innermost field or element.
-    pub(crate) fn pop(&mut self) {
+    pub fn pop(&mut self) {
         self.0.pop();
     }
 
     /// True at the message's top level.
-    pub(crate) fn is_empty(&self) -> bool {
+    pub fn is_empty(&self) -> bool {
         self.0.is_empty()
     }
 
     /// The dotted path to `leaf` (which may be empty) from the top of the message.
-    pub(crate) fn to(&self, leaf: &str) -> String {
+    pub fn to(&self, leaf: &str) -> String {
         let mut s = String::new();
         for part in &self.0 {
             match part {
