@@ -302,6 +302,9 @@ def world_cases() -> None:
              names=["{case}/big.toml", "larger than 4 MiB"], max_seconds=1.0)
     with open(d / "big.toml", "wb") as f:
         f.truncate(2 << 30)  # sparse: no disk used
+    d = case("simulate/truth-resolution-1e-9", ["simulate", "{case}/short.toml", "--resolution", "1e-9", "--out",
+                                                "{case}/out"], "error", names=["truth.yaml", "no true map at resolution", "coarser"])
+    (d / "short.toml").write_text("[robot]\nduration_s = 1.0\n[camera]\nenabled = false\n")
     d = case("simulate/scenario-sparse-2gib", ["simulate", "{case}/big.toml", "--out", "{case}/out"],
              "error", names=["{case}/big.toml", "larger than 4 MiB"], max_seconds=1.0)
     with open(d / "big.toml", "wb") as f:

@@ -7,7 +7,7 @@
 //! Scenario files are TOML mapping one to one onto
 //! [`crate::Scenario`]; unknown keys are errors naming their line.
 
-use crate::{Scenario, SimMessage, SimRecording, TruthSemantic, CLASS_COLORS, CLASS_NAMES};
+use crate::{Scenario, SimMessage, SimRecording, TruthRasterError, TruthSemantic, CLASS_COLORS, CLASS_NAMES};
 use fusemap_core::grid::logodds::logit;
 use fusemap_core::grid::{GridGeometry, OccupancyParams, Raster};
 use fusemap_io::config_file::{field_error, read_text, toml_error};
@@ -62,12 +62,12 @@ pub fn write_bag(rec: &SimRecording, dir: &Path, overwrite: bool) -> Result<Writ
 
 /// The true occupancy as a map raster: occupied where an object covers the cell, free
 /// elsewhere inside the hall.
-pub fn truth_raster(rec: &SimRecording, geometry: GridGeometry) -> Option<Raster> {
-    let t = rec.truth_occupancy(geometry).ok()?;
+pub fn truth_raster(rec: &SimRecording, geometry: GridGeometry) -> Result<Raster, TruthRasterError> {
+    let t = rec.truth_occupancy(geometry)?;
     let params = OccupancyParams::default();
     let (occ, free) = (logit(params.clamp_max) as f32, logit(params.clamp_min) as f32);
     let origin = geometry.cell_corner(t.first_cell);
-    Some(Raster {
+    Ok(Raster {
         width: t.width,
         height: t.height,
         resolution: geometry.resolution(),
@@ -130,27 +130,33 @@ pub struct SimulationFiles {
     /// The rosbag2 directory.
     pub bag: WrittenBag,
     /// `truth.yaml` (map_server; `truth.pgm` beside it).
-    pub truth_map: Option<PathBuf>,
+    pub truth_map: PathBuf,
     /// `truth_semantic.yaml` (`truth_semantic.png` beside it).
-    pub truth_semantic: Option<PathBuf>,
+    pub truth_semantic: PathBuf,
     /// `truth.tum`.
     pub truth_trajectory: PathBuf,
 }
 
 /// Writes the bag (`out/bag`), the true map (`out/truth.yaml` + `.pgm`, at `resolution`),
 /// the true classes (`out/truth_semantic.yaml` + `.png`) and the true trajectory
-/// (`out/truth.tum`).
+/// (`out/truth.tum`). The truth is rastered first: a resolution the world cannot be
+/// rastered at (too many cells, or not a resolution) is an error before anything is
+/// written, never a run without its truth.
 pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwrite: bool) -> Result<SimulationFiles> {
+    let no_truth = |why: String| {
+        fusemap_io::Error::format(
+            &out.join("truth.yaml"),
+            fusemap_io::Location::File,
+            format!("no true map at resolution {resolution} m: {why}; give a coarser --resolution"),
+        )
+    };
+    let geometry = GridGeometry::centered(resolution).map_err(|e| no_truth(e.to_string()))?;
+    let raster = truth_raster(rec, geometry).map_err(|e| no_truth(e.to_string()))?;
+    let semantic = rec.truth_semantic(geometry).map_err(|e| no_truth(e.to_string()))?;
     std::fs::create_dir_all(out).map_err(|e| fusemap_io::Error::io(out, e))?;
     let bag = write_bag(rec, &out.join("bag"), overwrite)?;
-    let truth_map = match GridGeometry::centered(resolution).ok().and_then(|g| truth_raster(rec, g)) {
-        Some(r) => Some(fusemap_io::map_server::write_map_server(&out.join("truth.yaml"), &r)?),
-        None => None,
-    };
-    let truth_semantic = match GridGeometry::centered(resolution).ok().and_then(|g| rec.truth_semantic(g).ok()) {
-        Some(t) => Some(write_truth_semantic(&out.join("truth_semantic.yaml"), &t)?),
-        None => None,
-    };
+    let truth_map = fusemap_io::map_server::write_map_server(&out.join("truth.yaml"), &raster)?;
+    let truth_semantic = write_truth_semantic(&out.join("truth_semantic.yaml"), &semantic)?;
     let truth_trajectory = out.join("truth.tum");
     fusemap_io::trajectory::write_tum(&truth_trajectory, &rec.truth_trajectory)?;
     Ok(SimulationFiles { bag, truth_map, truth_semantic, truth_trajectory })
@@ -200,7 +206,7 @@ mod tests {
         let rec = crate::simulate(&s).unwrap();
         let dir = fusemap_io::testdata::temp_dir("sim-semantic");
         let files = write_simulation(&rec, &dir, 0.1, false).unwrap();
-        let yaml = std::fs::read_to_string(files.truth_semantic.unwrap()).unwrap();
+        let yaml = std::fs::read_to_string(files.truth_semantic).unwrap();
         assert!(yaml.contains("image: truth_semantic.png\nresolution: 0.1\n"), "{yaml}");
         assert!(yaml.contains("{id: 3, name: glass, color: [80, 200, 230]}"), "{yaml}");
         let t = rec.truth_semantic(GridGeometry::centered(0.1).unwrap()).unwrap();
@@ -216,6 +222,22 @@ mod tests {
         let top = &buf[..t.width];
         assert_eq!(top, &t.class_ids[(t.height - 1) * t.width..]);
         assert!(buf.contains(&3) && buf.contains(&4) && buf.contains(&5) && buf.contains(&2));
+    }
+
+    /// A resolution the world cannot be rastered at is an error before anything is
+    /// written (it was a run without its truth map, exit 0).
+    #[test]
+    fn a_truth_too_fine_to_raster_is_an_error_before_anything_is_written() {
+        let mut s = Scenario::default();
+        s.robot.duration_s = 0.5;
+        s.camera.enabled = false;
+        let rec = crate::simulate(&s).unwrap();
+        let dir = fusemap_io::testdata::temp_dir("sim-too-fine");
+        for resolution in [1e-9, 0.0, f64::NAN] {
+            let e = write_simulation(&rec, &dir.join("out"), resolution, false).err().expect("refused").to_string();
+            assert!(e.contains("truth.yaml") && e.contains("no true map at resolution"), "{e}");
+            assert!(!dir.join("out").exists(), "nothing written for {resolution}");
+        }
     }
 
     /// The camera's topics read back by a reader that is not ours: the python `rosbags`

@@ -22,12 +22,8 @@ pub fn run(scenario: Option<&Path>, out: &Path, resolution: f64, overwrite: bool
     for t in &files.bag.topics {
         println!("  {:<12}  {:<28} {}", t.name, t.type_name, t.message_count);
     }
-    if let Some(m) = &files.truth_map {
-        println!("true map      {}", super::shown(m));
-    }
-    if let Some(m) = &files.truth_semantic {
-        println!("true classes  {}", super::shown(m));
-    }
+    println!("true map      {}", super::shown(&files.truth_map));
+    println!("true classes  {}", super::shown(&files.truth_semantic));
     println!("true track    {}", super::shown(&files.truth_trajectory));
     println!(
         "injected      gyro bias {:.4} rad/s, odometry scale {:.3}, {} GNSS outliers, {} GNSS dropouts",
