@@ -208,6 +208,11 @@ def config_cases() -> None:
     # The map outgrows the budget while the world is mapped: the error names the world.
     config_case("config/limits-tiny-map-cells", "[limits]\nmap_cells = 4096\n", names=[WORLD, "limits.map_cells"],
                 names_config=False)
+    config_case("config/limits-zero-memory", "[limits]\nmemory_mib = 0\n", names=["memory_mib"])
+    # The corridor at 1 mm needs 66 MB of tiles: past a 64 MiB budget, refused naming it.
+    config_case("config/limits-1mm-past-memory", "[map]\nresolution = 0.001\n[limits]\nmemory_mib = 64\n",
+                names=[WORLD, "limits.memory_mib = 64 MiB"], names_config=False)
+    config_case("config/resolution-1mm", "[map]\nresolution = 0.001\n", "map")
     config_case("config/limits-tiny-export",
                 "[limits]\nexport_cells = 1\n", "map", notes=["sparse"])
     config_case("config/max-speed-zero", "[log]\nmax_speed_m_s = 0.0\n", names=["max_speed_m_s"])

@@ -121,7 +121,7 @@ pub fn map_with_track(
         Some(m) => Engine::with_maps(m),
         None => Engine::new(FusionGrid::new(plan.geometry, plan.occupancy)),
     };
-    engine.set_map_cells_limit(&plan.limits);
+    engine.set_limits(&plan.limits);
     let (tree, tree_notes) = frame_tree(cfg, &inv.tf_static, &inv.tf_dynamic);
     notes.extend(tree_notes);
     let input = Inputs { plan, inv, bound, track: &chosen.track, tree: &tree };

@@ -33,7 +33,7 @@ pub fn map_world(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<WorldRun, PipelineError> {
     let mut engine = Engine::new(FusionGrid::new(plan.geometry, plan.occupancy));
-    engine.set_map_cells_limit(&plan.limits);
+    engine.set_limits(&plan.limits);
     let ids: Vec<SensorId> = plan.lidars.iter().map(|l| engine.add_lidar(l.name.clone(), l.model)).collect();
     let stamp = |i: usize| Stamp::from_secs_f64(i as f64 / scanner.rate_hz).unwrap_or_default();
     let timed: Vec<_> = poses.iter().enumerate().map(|(i, p)| (stamp(i), *p)).collect();

@@ -10,9 +10,16 @@
 //! * `ray_cells` is checked when the configuration is validated: every lidar's
 //!   `max_range`, every camera's `max_depth_m` and SLAM's `max_range_m` over its cell size
 //!   (a ray's length in cells bounds both its walk and the tiles it can allocate).
-//! * `map_cells` is enforced by the map itself: its tile store refuses to allocate past the
-//!   budget and the engine turns that into an error after the observation that met it
-//!   (see [`TileMap::set_tile_budget`](crate::grid::TileMap::set_tile_budget)).
+//! * `memory_mib` bounds the bytes of every grid a run holds at once. The maps count each
+//!   tile with every layer it can carry (occupancy, semantic counts, the dynamic layer,
+//!   the correlation scratch); their tile stores refuse to allocate past it and the engine
+//!   turns that into an error after the observation that met it (see
+//!   [`TileMap::set_tile_budget`](crate::grid::TileMap::set_tile_budget)). SLAM counts its
+//!   submaps' grids, and its branch-and-bound grids are held to their own cache
+//!   (`slam.loop_closure_grid_cache_mib`); SLAM's pass ends before the mapping pass
+//!   begins, so each holds to the whole budget.
+//! * `map_cells` is the older cap in cells (whole 64 × 64 tiles), kept for configurations
+//!   that set it: whichever of the two is tighter holds.
 //! * `export_cells` is applied by the exporters: past it, a run writes the map's tiles
 //!   sparsely instead of one dense raster of the bounding box of everything it touched.
 //! * `decompressed_mib` is passed to the log readers (`fusemap-io`'s `ReadOptions`): a
@@ -30,9 +37,13 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LimitsConfig {
-    /// Cells the map may hold, counted in whole 64 × 64 tiles. A cell costs a little over
-    /// 4 bytes of occupancy (plus 4 per class where a camera wrote semantics): 2³⁰ cells
-    /// is 2.7 km² at 5 cm, about 4.1 GiB.
+    /// MiB the grids of a run may hold: the maps (every layer of every tile counted) and
+    /// SLAM's submaps. 1 GiB is 0.67 km² of lidar-only map at 5 cm (a cell costs a little
+    /// over 4 bytes, plus 4 a class where a camera writes semantics and 12 with a dynamic
+    /// layer), and leaves a 4 GiB machine room for the rest of the run.
+    pub memory_mib: u64,
+    /// Cells a map may hold, counted in whole 64 × 64 tiles: an older cap than
+    /// `memory_mib`, which is the one to raise (2³⁰ cells need over 4 GiB).
     pub map_cells: u64,
     /// Cells one ray may cross: the longest range of any lidar, camera or SLAM over its
     /// cell size. 50,000 is 2.5 km at 5 cm, or 500 m at 1 cm.
@@ -59,6 +70,7 @@ pub struct LimitsConfig {
 impl Default for LimitsConfig {
     fn default() -> Self {
         Self {
+            memory_mib: 1024,
             map_cells: 1 << 30,
             ray_cells: 50_000,
             export_cells: 100_000_000,
@@ -76,6 +88,11 @@ impl LimitsConfig {
         usize::try_from(self.map_cells.div_ceil(TILE_CELLS as u64)).unwrap_or(usize::MAX).max(1)
     }
 
+    /// `memory_mib` in bytes.
+    pub fn memory_bytes(&self) -> u64 {
+        self.memory_mib.saturating_mul(1 << 20)
+    }
+
     /// `decompressed_mib` in bytes.
     pub fn decompressed_bytes(&self) -> u64 {
         self.decompressed_mib.saturating_mul(1 << 20)
@@ -84,6 +101,7 @@ impl LimitsConfig {
     /// Checks the values themselves (every limit at least 1).
     pub(super) fn validate(&self) -> Result<(), FieldError> {
         for (key, v) in [
+            ("memory_mib", self.memory_mib),
             ("map_cells", self.map_cells),
             ("ray_cells", self.ray_cells),
             ("export_cells", self.export_cells),

@@ -48,6 +48,11 @@ impl Correlator {
         Self { cfg, open, next: 1, merged: 0 }
     }
 
+    /// True when no sensors are declared correlated.
+    pub(super) fn is_empty(&self) -> bool {
+        self.cfg.groups.is_empty()
+    }
+
     /// The group an observation of `sensor` at `stamp` belongs to, `None` for a sensor in
     /// no configured group.
     pub(super) fn assign(&mut self, sensor: SensorId, stamp: Stamp) -> Option<Group> {

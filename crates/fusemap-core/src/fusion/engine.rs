@@ -26,10 +26,11 @@
 //! lidar hits on cells that hold a dynamic object now go there instead of the static
 //! occupancy (when routing is on), and rays through it clear it.
 
+use super::budget::{BudgetKey, MapBudget, TileLayers};
 use super::camera::FrameCells;
 use super::correlation::Correlator;
 use super::sensors::SensorSlot;
-use super::{Correlation, InsertContext, MapSet, SensorModel, SensorSelection, SensorStats};
+use super::{Correlation, InsertContext, MapEntry, MapSet, SensorModel, SensorSelection, SensorStats};
 use crate::geometry::Pose2;
 use crate::grid::{DynamicParams, DynamicUpdate, FusionGrid, Group, InsertStats};
 use crate::measurement::{Evidence, ObservationId, RangeData, SensorId, SensorKind};
@@ -71,21 +72,41 @@ pub enum EngineError {
         /// Its registered kind.
         kind: SensorKind,
     },
-    /// The observation needed more map than `[limits] map_cells` allows. The map missed
-    /// part of it: the run must stop.
+    /// The observation needed more map than `[limits]` allows (`memory_mib`, or the cap in
+    /// cells `map_cells`). The maps missed part of it: the run must stop.
     #[error(
-        "the map reached limits.map_cells = {cells} cells ({tiles} tile(s) of 64 x 64) at the measurement stamped {:.6} s; \
-         raise limits.map_cells, coarsen map.resolution, or look for poses far from the rest",
-        .stamp.as_secs_f64()
+        "the maps reached {} at the measurement stamped {:.6} s: {maps} map(s) of at most {tiles} tile(s) of 64 x 64, \
+         {tile_bytes} bytes a tile with their layers; raise {}, coarsen map.resolution, or look for poses far from the rest",
+        budget_limit(*.key, *.limit), .stamp.as_secs_f64(), budget_key(*.key)
     )]
-    MapCells {
-        /// The limit, cells.
-        cells: u64,
-        /// The limit, whole tiles.
+    MapBudget {
+        /// The limit that was met.
+        key: BudgetKey,
+        /// Its value (MiB or cells).
+        limit: u64,
+        /// Tiles each map may hold.
         tiles: usize,
+        /// Bytes a tile of every map together can hold.
+        tile_bytes: usize,
+        /// Maps written.
+        maps: usize,
         /// The stamp of the observation that met it.
         stamp: Stamp,
     },
+}
+
+fn budget_key(key: BudgetKey) -> &'static str {
+    match key {
+        BudgetKey::MemoryMib => "limits.memory_mib",
+        BudgetKey::MapCells => "limits.map_cells",
+    }
+}
+
+fn budget_limit(key: BudgetKey, limit: u64) -> String {
+    match key {
+        BudgetKey::MemoryMib => format!("limits.memory_mib = {limit} MiB"),
+        BudgetKey::MapCells => format!("limits.map_cells = {limit} cells"),
+    }
 }
 
 /// Counters of a whole run.
@@ -121,8 +142,8 @@ pub struct Engine {
     correlator: Correlator,
     dynamic: Option<(DynamicParams, bool)>,
     stats: EngineStats,
-    /// `[limits] map_cells`, for the error (the grids hold the budget in tiles).
-    map_cells: u64,
+    /// `[limits]` as tiles per map, once set (the grids hold it).
+    budget: Option<MapBudget>,
 }
 
 impl Engine {
@@ -145,37 +166,74 @@ impl Engine {
             correlator: Correlator::default(),
             dynamic: None,
             stats: EngineStats::default(),
-            map_cells: u64::MAX,
+            budget: None,
         }
     }
 
-    /// Holds every map to `[limits] map_cells` (see [`LimitsConfig`](crate::config::LimitsConfig)):
-    /// the observation that would need more tiles is refused with
-    /// [`EngineError::MapCells`], after which the maps are incomplete.
-    pub fn set_map_cells_limit(&mut self, limits: &crate::config::LimitsConfig) {
-        self.map_cells = limits.map_cells;
+    /// Holds the maps to `[limits] memory_mib` and `map_cells` (see
+    /// [`LimitsConfig`](crate::config::LimitsConfig) and `budget.rs`): the observation that
+    /// would need more tiles is refused with [`EngineError::MapBudget`], after which the
+    /// maps are incomplete. Sensors, correlation and the dynamic layer set afterwards are
+    /// counted too.
+    pub fn set_limits(&mut self, limits: &crate::config::LimitsConfig) {
+        self.budget = Some(MapBudget::new(*limits, &[]));
+        self.apply_budget();
+    }
+
+    /// Recomputes the tiles each map may hold from the layers its tiles may carry.
+    fn apply_budget(&mut self) {
+        let Some(b) = self.budget else { return };
+        let layers: Vec<TileLayers> = self.maps.iter().map(|m| self.tile_layers(m)).collect();
+        let budget = MapBudget::new(b.limits, &layers);
+        self.budget = Some(budget);
         for m in self.maps.entries_mut() {
-            m.grid_mut().set_tile_budget(limits.map_tiles());
+            m.grid_mut().set_tile_budget(budget.tiles);
         }
+    }
+
+    /// The layers `map`'s tiles may come to carry.
+    fn tile_layers(&self, map: &MapEntry) -> TileLayers {
+        let semantic_classes = (self.sensors.iter().enumerate())
+            .filter_map(|(i, s)| match &s.model {
+                SensorModel::Camera(m) if map.sensors().includes(SensorId(i as u16), SensorKind::Camera) => {
+                    Some(m.classes().len())
+                }
+                _ => None,
+            })
+            .max()
+            .unwrap_or(0);
+        TileLayers { semantic_classes, dynamic: self.dynamic.is_some(), correlated: !self.correlator.is_empty() }
     }
 
     /// The error for a map past its budget after the observation at `stamp`, if any.
     fn check_budget(&self, stamp: Stamp) -> Result<(), EngineError> {
-        match self.maps.iter().find(|m| m.grid().over_budget()) {
-            Some(m) => Err(EngineError::MapCells { cells: self.map_cells, tiles: m.grid().tile_count(), stamp }),
-            None => Ok(()),
+        match (self.budget, self.maps.iter().any(|m| m.grid().over_budget())) {
+            (Some(b), true) => Err(EngineError::MapBudget {
+                key: b.key,
+                limit: match b.key {
+                    BudgetKey::MemoryMib => b.limits.memory_mib,
+                    BudgetKey::MapCells => b.limits.map_cells,
+                },
+                tiles: b.tiles,
+                tile_bytes: b.bytes_per_tile,
+                maps: self.maps.iter().count(),
+                stamp,
+            }),
+            _ => Ok(()),
         }
     }
 
     /// Declares correlated sensors (see the module docs). Call before inserting.
     pub fn set_correlation(&mut self, correlation: Correlation) {
         self.correlator = Correlator::new(correlation);
+        self.apply_budget();
     }
 
     /// Gives the maps a dynamic-object layer with `params`; `route_hits`: lidar hits on
     /// cells holding a dynamic object go there instead of the static layer.
     pub fn set_dynamic(&mut self, params: DynamicParams, route_hits: bool) {
         self.dynamic = Some((params, route_hits));
+        self.apply_budget();
     }
 
     /// The dynamic layer's parameters, if the maps carry one.
@@ -196,6 +254,7 @@ impl Engine {
     pub fn add_sensor(&mut self, name: impl Into<String>, model: SensorModel) -> SensorId {
         let id = SensorId(self.sensors.len() as u16);
         self.sensors.push(SensorSlot::new(name.into(), model));
+        self.apply_budget();
         id
     }
 
@@ -484,6 +543,7 @@ fn apply(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::LimitsConfig;
     use crate::geometry::PlanarMount;
     use crate::grid::{GridGeometry, OccupancyParams};
     use crate::sensor::LidarParams;
@@ -520,18 +580,44 @@ mod tests {
 
     #[test]
     fn an_observation_past_the_map_budget_is_an_error_naming_the_limit() {
-        let (mut e, a, _) = engine();
         // 0.1 m cells: one 64 x 64 tile is 6.4 m; a 1 m beam from the origin touches the
         // four tiles around it, a 30 m one (max range 10 m: cleared to 10 m) reaches more.
-        e.set_map_cells_limit(&crate::config::LimitsConfig { map_cells: 4 * 4096, ..Default::default() });
-        let short = LaserScan { stamp: Stamp(1), angle_min: 0.0, angle_increment: 0.5, ranges: vec![1.0; 13] };
-        e.insert_scan(a, &short, Pose2::IDENTITY).unwrap();
-        let far = Pose2::new(100.0, 0.0, 0.0);
-        let err = e.insert_scan(a, &scan(2), far).unwrap_err();
-        assert!(matches!(err, EngineError::MapCells { cells: 16384, .. }), "{err:?}");
-        let text = err.to_string();
-        assert!(text.contains("limits.map_cells = 16384") && text.contains("raise limits.map_cells"), "{text}");
-        assert!(e.grid().tile_count() <= 4);
+        for (limits, key, text) in [
+            (
+                LimitsConfig { map_cells: 4 * 4096, ..Default::default() },
+                BudgetKey::MapCells,
+                "limits.map_cells = 16384 cells",
+            ),
+            (LimitsConfig { memory_mib: 1, ..Default::default() }, BudgetKey::MemoryMib, "limits.memory_mib = 1 MiB"),
+        ] {
+            let (mut e, a, _) = engine();
+            e.set_limits(&limits);
+            let short = LaserScan { stamp: Stamp(1), angle_min: 0.0, angle_increment: 0.5, ranges: vec![1.0; 13] };
+            e.insert_scan(a, &short, Pose2::IDENTITY).unwrap();
+            let far = Pose2::new(100.0, 0.0, 0.0);
+            let mut err = e.insert_scan(a, &scan(2), far).err();
+            // 1 MiB holds about 60 tiles: walk on until the budget is met.
+            for k in 3..200 {
+                err = err.or_else(|| e.insert_scan(a, &scan(k), Pose2::new(100.0 * k as f64, 0.0, 0.0)).err());
+            }
+            let err = err.expect("the budget is met");
+            assert!(matches!(err, EngineError::MapBudget { key: k, .. } if k == key), "{err:?}");
+            let msg = err.to_string();
+            assert!(msg.contains(text) && msg.contains(&format!("raise {}", budget_key(key))), "{msg}");
+            let budget = e.budget.expect("set");
+            assert!(e.grid().tile_count() <= budget.tiles);
+            assert!(e.grid().tile_count() * budget.bytes_per_tile <= limits.memory_bytes() as usize);
+        }
+    }
+
+    #[test]
+    fn a_camera_with_many_classes_and_the_dynamic_layer_shrink_the_tiles_a_map_may_hold() {
+        let (mut e, _, _) = engine();
+        e.set_limits(&LimitsConfig::default());
+        let lidar_only = e.budget.expect("set").tiles;
+        e.set_dynamic(crate::grid::DynamicParams::default(), false);
+        let dynamic = e.budget.expect("set").tiles;
+        assert!(dynamic < lidar_only / 3, "{dynamic} vs {lidar_only}");
     }
 }
 

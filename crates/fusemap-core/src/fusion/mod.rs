@@ -1,6 +1,7 @@
 //! The fusion engine: time-ordered observations from any number of sensors into one or
 //! several maps of layers.
 
+mod budget;
 pub mod camera;
 #[cfg(test)]
 mod camera_tests;
@@ -12,6 +13,7 @@ mod merge_tests;
 pub mod rasters;
 mod sensors;
 
+pub use budget::BudgetKey;
 pub use correlation::Correlation;
 pub use engine::{Engine, EngineError, EngineStats};
 pub use mapset::{InsertContext, MapEntry, MapSet, SensorSelection};
