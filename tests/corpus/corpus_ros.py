@@ -225,6 +225,27 @@ def ros1_message_cases(tmp: Path, messages, static: int) -> None:
     write_ros1(p, messages, static, None, odom_jump)
     log_case("ros1/odometry-jumps-1e8m", "room.bag", p.read_bytes(), "map", notes=["glitch"])
 
+    # An odometry reset that stays (a wheel driver restarted with garbage), and odometry
+    # alternating by ±10¹⁷ m: SLAM must neither follow the jump nor grow a submap across it
+    # (it allocated until the process aborted), and the mapping pass holds the memory budget.
+    def odom_reset(jump: float, every_other: bool):
+        def mutate(t: str, i: int, d: dict) -> list[dict]:
+            if t in ("/odom", "/tf") and (i % 2 == 1 if every_other else i >= 20):
+                d = copy.deepcopy(d)
+                pose = d["pose"]["pose"]["position"] if t == "/odom" else d["transforms"][0]["transform"]["translation"]
+                pose["x"] += jump if i % 4 < 2 or not every_other else -jump
+            return [d]
+        return mutate
+
+    for what, jump, every_other, note in (
+        ("odometry-reset-1e17", 1e17, False, "more than 1e9 m from their frame's origin"),
+        ("odometry-alternating-1e17", 1e17, True, "rejected as glitches"),
+        ("odometry-reset-1000km", 1e6, False, "moved faster than log.max_speed_m_s"),
+    ):
+        p = tmp / f"{what}.bag"
+        write_ros1(p, messages, static, None, odom_reset(jump, every_other))
+        log_case(f"ros1/{what}", "room.bag", p.read_bytes(), "map", notes=[note])
+
     pose_sensor_cases(tmp, messages, static)
 
 

@@ -221,6 +221,9 @@ pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Ch
         glitches: odometry_glitches,
         ..Default::default()
     };
+    if let Some(o) = odom {
+        notes.extend(crate::track::unusable_note(&format!("odometry `{}`", o.topic), &counts));
+    }
     Ok(ChosenTrack {
         source: PoseSource::Estimator,
         track: Track::Timed(Box::new(e)),

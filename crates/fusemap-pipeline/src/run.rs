@@ -86,7 +86,7 @@ pub fn prepare_with(
     }
     let t0 = Instant::now();
     let mut run = crate::slam::run(plan, inv, &bound, &chosen, reason, progress)?;
-    let mut track = crate::slam::track(chosen, &mut run);
+    let mut track = crate::slam::track(chosen, &mut run, &plan.log);
     // Scans SLAM was given but left without an optimised pose: a few (a refused reading)
     // are normal; more means the run did not correct the log (equal stamps collapsing the
     // track did this once), and the note says so instead of "corrected".

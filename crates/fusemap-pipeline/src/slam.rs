@@ -120,13 +120,13 @@ pub fn run(
         }
         while let Some((_, _, scan)) = merge.pop_ready() {
             progress(Progress::Advance(1));
-            feed.feed(Stamp(scan.scan.stamp.0.saturating_add(offset)), scan);
+            feed.feed(Stamp(scan.scan.stamp.0.saturating_add(offset)), scan)?;
         }
         Ok(())
     })?;
     while let Some((_, _, scan)) = merge.pop_final() {
         progress(Progress::Advance(1));
-        feed.feed(Stamp(scan.scan.stamp.0.saturating_add(offset)), scan);
+        feed.feed(Stamp(scan.scan.stamp.0.saturating_add(offset)), scan)?;
     }
     progress(Progress::Done);
     let result = feed.slam.finish();
@@ -159,6 +159,8 @@ struct ScanFeed<'a> {
     /// With poses on the scan lines: each scan's stamp and line pose.
     lines: Vec<Option<(Stamp, Pose2)>>,
     without_pose: u64,
+    /// `limits.memory_mib` in bytes.
+    memory_bytes: u64,
 }
 
 impl<'a> ScanFeed<'a> {
@@ -199,6 +201,7 @@ impl<'a> ScanFeed<'a> {
             mount: *model.mount(),
             params: *model.params(),
             slam: Slam::new(plan.slam),
+            memory_bytes: plan.limits.memory_bytes(),
             repeats: Default::default(),
             hits: Vec::new(),
             lines: Vec::new(),
@@ -206,10 +209,12 @@ impl<'a> ScanFeed<'a> {
         })
     }
 
-    fn feed(&mut self, t: Stamp, scan: ScanMessage) {
+    /// Feeds one scan to SLAM; an error once SLAM's grids hold more than
+    /// `limits.memory_mib`.
+    fn feed(&mut self, t: Stamp, scan: ScanMessage) -> Result<(), PipelineError> {
         // A repeated message is one scan, as in the mapping pass.
         if self.repeats.is_repeat(&scan) {
-            return;
+            return Ok(());
         }
         // The track refuses to interpolate across its gaps (a map must not guess); a
         // prediction may: the match corrects it.
@@ -229,6 +234,17 @@ impl<'a> ScanFeed<'a> {
         if matches!(self.track, Track::ScanLine(_)) && outcome != ScanOutcome::Refused {
             self.lines.push(pose.map(|p| (scan.scan.stamp, p)));
         }
+        let bytes = self.slam.grid_bytes();
+        if bytes as u64 > self.memory_bytes {
+            return Err(PipelineError::Refused(format!(
+                "SLAM's grids reached limits.memory_mib = {} MiB ({} submaps, {bytes} bytes) at the scan stamped {:.6} s; \
+                 raise limits.memory_mib, coarsen slam.resolution_m, or shorten slam.max_range_m",
+                self.memory_bytes >> 20,
+                self.slam.report().submaps,
+                t.as_secs_f64()
+            )));
+        }
+        Ok(())
     }
 
     /// The scan's beams within range as points in the base frame at the scan's stamp.
@@ -395,12 +411,12 @@ fn summary(r: &SlamResult, reason: String, topic: String, without_pose: u64, lat
 /// relation error was 9.4 m against 0.02 m for the optimised poses. The graph already
 /// fuses the estimator's motion (with the fixes in it), the matches and the loop
 /// closures; the correction keeps its result exactly at every scan.
-pub fn track(chosen: ChosenTrack, run: &mut SlamRun) -> ChosenTrack {
+pub fn track(chosen: ChosenTrack, run: &mut SlamRun, cfg: &fusemap_core::config::LogConfig) -> ChosenTrack {
     match chosen.track {
         Track::Timed(base) => {
             run.summary.track = format!("{} corrected at every scan by the optimised pose graph", chosen.name);
             ChosenTrack {
-                track: Track::Timed(Box::new(CorrectedTrack::new(base, &run.summary.scan_poses))),
+                track: Track::Timed(Box::new(CorrectedTrack::new(base, &run.summary.scan_poses, cfg.motion_limits()))),
                 name: format!("SLAM (scan matching + loop closure) over {}", chosen.name),
                 ..chosen
             }

@@ -31,7 +31,8 @@ pub struct TrackCounts {
     pub duplicates: u64,
     /// Arrived after a sample with a later stamp: put back in stamp order and used.
     pub reordered: u64,
-    /// NaN or infinite poses (a zero quaternion among them).
+    /// NaN or infinite poses (a zero quaternion among them), and poses beyond 10⁹ m
+    /// (`MAX_POSITION_M`: an odometry reset to garbage).
     pub not_finite: u64,
     /// Pose glitches: samples implying a motion beyond `log.max_speed_m_s` or
     /// `log.max_turn_rate_deg_s` from their neighbours, rejected.
@@ -251,8 +252,21 @@ pub fn glitch_note(source: &str, glitches: u64, cfg: &LogConfig) -> String {
     )
 }
 
-fn glitch_notes(source: &str, counts: &TrackCounts, cfg: &LogConfig) -> Vec<String> {
-    (counts.glitches > 0).then(|| glitch_note(source, counts.glitches, cfg)).into_iter().collect()
+/// The notes on `source`'s samples left out: poses no robot can have, and glitches.
+fn sample_notes(source: &str, counts: &TrackCounts, cfg: &LogConfig) -> Vec<String> {
+    let glitches = (counts.glitches > 0).then(|| glitch_note(source, counts.glitches, cfg));
+    unusable_note(source, counts).into_iter().chain(glitches).collect()
+}
+
+/// The note on `source`'s samples that are no pose at all, if any.
+pub fn unusable_note(source: &str, counts: &TrackCounts) -> Option<String> {
+    (counts.not_finite > 0).then(|| {
+        format!(
+            "{source}: {} pose sample(s) left out as NaN, infinite, or more than {:e} m from their frame's origin (a reset to garbage): the track has a gap there",
+            counts.not_finite,
+            fusemap_core::geometry::MAX_POSITION_M
+        )
+    })
 }
 
 /// Whether the log carries a sensor the estimator fuses beyond odometry.
@@ -315,7 +329,7 @@ impl ChosenTrack {
         (stamps, receive): (Vec<Stamp>, Vec<Option<Stamp>>),
         cfg: &LogConfig,
     ) -> Self {
-        let notes = glitch_notes(&name, &counts, cfg);
+        let notes = sample_notes(&name, &counts, cfg);
         ChosenTrack { source, track, name, notes, counts, stamps, receive, estimator: None, slam: None }
     }
 }

@@ -393,7 +393,9 @@ impl Config {
         let classes = camera::class_table(&self.class)?;
         self.estimator.validate()?;
         let dynamic = self.fusion.validate(occ_t)?;
-        let slam = self.slam.validate()?;
+        let mut slam = self.slam.validate()?;
+        let motion = g.motion_limits();
+        (slam.max_track_speed_m_s, slam.max_track_turn_rate_rad_s) = (motion.max_speed_m_s, motion.max_turn_rate_rad_s);
         let limits = self.limits;
         limits.validate()?;
         for (i, l) in lidars.iter().enumerate() {

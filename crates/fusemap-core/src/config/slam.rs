@@ -318,6 +318,8 @@ impl SlamConfig {
             field_sigma_m: non_negative("field_sigma_m", self.field_sigma_m)?.min(1.0),
             max_range_m: positive("max_range_m", self.max_range_m)?,
             min_points: self.min_points,
+            max_track_speed_m_s: SlamParams::default().max_track_speed_m_s,
+            max_track_turn_rate_rad_s: SlamParams::default().max_track_turn_rate_rad_s,
             node_distance_m: non_negative("node_distance_m", self.node_distance_m)?,
             node_angle_rad: non_negative("node_angle_deg", self.node_angle_deg)?.to_radians(),
             node_time_s: positive("node_time_s", self.node_time_s)?,

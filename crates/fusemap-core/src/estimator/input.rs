@@ -203,7 +203,7 @@ pub(crate) fn sort_inputs(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> (
         match inputs[i] {
             EstimatorInput::Odometry { stamp, pose, covariance } => {
                 counts.odometry.received += 1;
-                if !pose.is_finite() {
+                if !pose.is_position() {
                     counts.odometry.not_finite += 1;
                     continue;
                 }

@@ -93,7 +93,8 @@ pub struct OdometryReport {
     pub received: usize,
     /// Messages forming the track.
     pub used: usize,
-    /// Messages with a NaN or infinite pose (or an absurd stamp), skipped.
+    /// Messages with a NaN or infinite pose, one beyond 10⁹ m (`MAX_POSITION_M`), or an
+    /// absurd stamp: skipped.
     pub not_finite: usize,
     /// Messages repeating the previous stamp, skipped.
     pub duplicate_stamps: usize,

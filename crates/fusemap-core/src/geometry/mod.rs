@@ -12,5 +12,5 @@ mod pose3;
 
 pub use geodetic::{ecef_to_geodetic, geodetic_to_ecef, Datum, GeodeticError};
 pub use mount::{quaternion_to_rpy, quaternion_yaw, Mount3, MountError, PlanarMount};
-pub use pose2::{normalize_angle, Point2, Pose2};
+pub use pose2::{normalize_angle, Point2, Pose2, MAX_POSITION_M};
 pub use pose3::Pose3;

@@ -29,6 +29,12 @@ impl Point2 {
     }
 }
 
+/// The largest coordinate a pose may have, metres: 10⁹ m is 25 times round the Earth, and
+/// still resolved to 10⁻⁷ m by an `f64`. An odometry reset to 10¹⁷ m (where one `f64` step
+/// is 16 m, so the readings after it carry no motion at all) is a broken reading, not a
+/// position.
+pub const MAX_POSITION_M: f64 = 1e9;
+
 /// Wraps an angle to (-π, π].
 ///
 /// Uses `rem_euclid`, so the result is exact for angles a few turns away and stays
@@ -80,6 +86,13 @@ impl Pose2 {
     /// True when all three components are finite.
     pub fn is_finite(self) -> bool {
         self.x.is_finite() && self.y.is_finite() && self.theta.is_finite()
+    }
+
+    /// True when the pose is finite and within [`MAX_POSITION_M`] of its frame's origin in
+    /// x and y: a pose a robot can have. A pose stream's frame origin is where it began, a
+    /// datum or a map origin, never farther than the Earth is round.
+    pub fn is_position(self) -> bool {
+        self.is_finite() && self.x.abs() <= MAX_POSITION_M && self.y.abs() <= MAX_POSITION_M
     }
 
     /// Composition: `(a_from_b.compose(b_from_c))` is `a_from_c`.

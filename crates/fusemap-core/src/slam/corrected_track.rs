@@ -5,28 +5,34 @@
 //! interpolated (linear in translation, shortest arc in rotation) and applied on the left
 //! of the track, so the track's own fine motion (odometry, gyro) still places every
 //! measurement between two scans — the de-skewed beams, a camera frame — at its stamp.
+//! Where the correction changes between two scans faster than a robot moves, the track
+//! jumped there (an odometry reset SLAM did not follow): between those two scans the
+//! optimised poses are interpolated instead, as across a gap of the track.
 //! This is the `map → odom` transform a ROS localiser publishes (REP 105), here estimated
 //! offline for every scan. At a scan stamp the track is exactly the optimised pose.
 
 use crate::geometry::Pose2;
-use crate::time::{NoPose, PoseTrack, Stamp, SyncMode};
+use crate::time::{MotionLimits, NoPose, PoseTrack, Stamp, SyncMode};
 
 /// `base` corrected by SLAM.
 pub struct CorrectedTrack {
     base: Box<dyn PoseTrack>,
-    corrections: Vec<(Stamp, Pose2)>,
+    /// At each scan where `base` has a pose: the correction and the optimised pose.
+    corrections: Vec<(Stamp, Pose2, Pose2)>,
     slam: Vec<(Stamp, Pose2)>,
+    limits: MotionLimits,
 }
 
 impl CorrectedTrack {
     /// `slam_poses`: the optimised `map_from_base` of scans (any order) whose stamps lie in
-    /// `base`'s span; scans where `base` has no pose are left out.
-    pub fn new(base: Box<dyn PoseTrack>, slam_poses: &[(Stamp, Pose2)]) -> Self {
-        let mut corrections: Vec<(Stamp, Pose2)> = slam_poses
+    /// `base`'s span; scans where `base` has no pose are left out. `limits`: the fastest
+    /// the correction may change and still be interpolated (`log.max_speed_m_s`, …).
+    pub fn new(base: Box<dyn PoseTrack>, slam_poses: &[(Stamp, Pose2)], limits: MotionLimits) -> Self {
+        let mut corrections: Vec<(Stamp, Pose2, Pose2)> = slam_poses
             .iter()
             .filter_map(|&(t, p)| {
                 let b = base.pose_at(t, SyncMode::Interpolate).ok()?;
-                Some((t, p.compose(b.inverse())))
+                Some((t, p.compose(b.inverse()), p))
             })
             .collect();
         corrections.sort_by_key(|c| c.0);
@@ -34,7 +40,7 @@ impl CorrectedTrack {
         let mut slam = slam_poses.to_vec();
         slam.sort_by_key(|c| c.0);
         slam.dedup_by_key(|c| c.0);
-        Self { base, corrections, slam }
+        Self { base, corrections, slam, limits }
     }
 
     /// The correction at `t`: interpolated between scans, the nearest one outside them.
@@ -45,17 +51,32 @@ impl CorrectedTrack {
             Err(0) => c.first().map_or(Pose2::IDENTITY, |x| x.1),
             Err(i) if i == c.len() => c[i - 1].1,
             Err(i) => {
-                let ((t0, a), (t1, b)) = (c[i - 1], c[i]);
+                let ((t0, a, _), (t1, b, _)) = (c[i - 1], c[i]);
                 a.interpolate(b, (t.0 - t0.0) as f64 / (t1.0 - t0.0) as f64)
             }
         }
     }
+
+    /// Between two scans whose corrections differ by more than a robot moves (the base
+    /// track jumped between them), the optimised poses interpolated: the base track holds
+    /// the jump, the scans were placed by the lidar.
+    fn across_jump(&self, t: Stamp) -> Option<Pose2> {
+        let c = &self.corrections;
+        let i = c.partition_point(|x| x.0 < t);
+        let ((t0, a, p0), (t1, b, p1)) = (*c.get(i.checked_sub(1)?)?, *c.get(i)?);
+        (t1 != t && !self.limits.plausible((t0, a), (t1, b)))
+            .then(|| p0.interpolate(p1, (t.0 - t0.0) as f64 / (t1.0 - t0.0) as f64))
+    }
 }
 
 impl PoseTrack for CorrectedTrack {
-    /// Inside a gap of the base track, between two scans SLAM matched, the optimised
-    /// poses themselves are interpolated: the scans were placed by the lidar.
+    /// Inside a gap of the base track, or across a jump of it, between two scans SLAM
+    /// matched, the optimised poses themselves are interpolated: the scans were placed by
+    /// the lidar.
     fn pose_at(&self, t: Stamp, mode: SyncMode) -> Result<Pose2, NoPose> {
+        if let Some(p) = self.across_jump(t) {
+            return Ok(p);
+        }
         match self.base.pose_at(t, mode) {
             Ok(p) => Ok(self.correction_at(t).compose(p)),
             Err(e) => {
@@ -73,8 +94,12 @@ impl PoseTrack for CorrectedTrack {
         self.base.span()
     }
 
+    /// The base track's samples, corrected; those across a jump are left out.
     fn samples(&self) -> Vec<(Stamp, Pose2)> {
-        self.base.samples().into_iter().map(|(t, p)| (t, self.correction_at(t).compose(p))).collect()
+        (self.base.samples().into_iter())
+            .filter(|(t, _)| self.across_jump(*t).is_none())
+            .map(|(t, p)| (t, self.correction_at(t).compose(p)))
+            .collect()
     }
 }
 
@@ -93,7 +118,7 @@ mod tests {
         let c = Pose2::new(1.0, 2.0, 0.1);
         let slam: Vec<(Stamp, Pose2)> =
             [0, 400, 1000].iter().map(|&t| (Stamp(t), c.compose(Pose2::new(t as f64 * 1e-3, 0.0, 0.0)))).collect();
-        let track = CorrectedTrack::new(Box::new(odo), &slam);
+        let track = CorrectedTrack::new(Box::new(odo), &slam, limits());
         for &(t, p) in &slam {
             let q = track.pose_at(t, SyncMode::Interpolate).unwrap();
             assert!((q.x - p.x).abs() < 1e-12 && (q.y - p.y).abs() < 1e-12 && (q.theta - p.theta).abs() < 1e-12);
@@ -102,5 +127,29 @@ mod tests {
         let want = c.compose(Pose2::new(0.25, 0.0, 0.0));
         assert!((mid.x - want.x).abs() < 1e-12 && (mid.y - want.y).abs() < 1e-12);
         assert!(track.pose_at(Stamp(2000), SyncMode::Interpolate).is_err());
+    }
+
+    fn limits() -> MotionLimits {
+        MotionLimits { max_speed_m_s: 20.0, max_turn_rate_rad_s: 10.0 }
+    }
+
+    #[test]
+    fn across_a_jump_of_the_track_the_optimised_poses_are_interpolated() {
+        // The odometry reset by 10⁶ m between 0.4 s and 0.5 s; SLAM kept the scans in place,
+        // so the correction jumps by −10⁶ m there.
+        let mut odo = PoseBuffer::new(10.0);
+        let reset = |k: i64| if k >= 5 { 1e6 } else { 0.0 };
+        for k in 0..=10 {
+            odo.push(Stamp(k * 100_000_000), Pose2::new(k as f64 * 0.1 + reset(k), 0.0, 0.0));
+        }
+        let slam: Vec<(Stamp, Pose2)> =
+            (0..=10).map(|k| (Stamp(k * 100_000_000), Pose2::new(k as f64 * 0.1, 0.0, 0.0))).collect();
+        let track = CorrectedTrack::new(Box::new(odo), &slam, limits());
+        // Between the two scans around the reset every pose stays near the scans, never
+        // half a million metres away.
+        for t in (400..=500).step_by(10) {
+            let p = track.pose_at(Stamp(t * 1_000_000), SyncMode::Interpolate).unwrap();
+            assert!((0.3..=0.6).contains(&p.x), "{t} ms: {p:?}");
+        }
     }
 }

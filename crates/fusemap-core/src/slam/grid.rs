@@ -200,6 +200,15 @@ impl ProbabilityGrid {
         self.limits.index(x, y).is_some_and(|i| self.cells[i] != 0)
     }
 
+    /// Bytes the grid holds: its cells, their `f32` mirror while active, and the marks'
+    /// scratch.
+    pub fn bytes(&self) -> usize {
+        let mirror = self.mirror.as_ref().map_or(0, |m| m.capacity() * std::mem::size_of::<f32>());
+        self.cells.capacity() * std::mem::size_of::<u16>()
+            + mirror
+            + self.marked.capacity() * std::mem::size_of::<u32>()
+    }
+
     /// Observed cells.
     pub fn known_cells(&self) -> usize {
         self.cells.iter().filter(|&&v| v != 0).count()

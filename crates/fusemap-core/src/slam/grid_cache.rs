@@ -34,6 +34,11 @@ impl GridCache {
         Self { grids: Vec::new(), recent: VecDeque::new(), bytes: 0, budget, depth, built: 0, peak_bytes: 0 }
     }
 
+    /// Bytes of the grids held now.
+    pub fn bytes(&self) -> usize {
+        self.bytes
+    }
+
     /// Makes room for one more submap (its grids are built on first use).
     pub fn add_submap(&mut self) {
         self.grids.push(None);

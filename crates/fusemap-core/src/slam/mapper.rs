@@ -97,6 +97,10 @@ pub struct Slam {
     scans: Vec<ScanRecord>,
     /// The last scan's local pose, and its track pose if it had one.
     pub(super) last: Option<(Pose2, Option<Pose2>)>,
+    /// The stamp of that scan.
+    last_stamp: Stamp,
+    /// The most bytes the submaps' grids have held at once.
+    submap_peak_bytes: usize,
     /// The last two scans' stamps and local poses (the constant-velocity prediction).
     pub(super) recent: [Option<(Stamp, Pose2)>; 2],
     pub(super) global_from_local: Pose2,
@@ -179,6 +183,8 @@ impl Slam {
             nodes: Vec::new(),
             scans: Vec::new(),
             last: None,
+            last_stamp: Stamp(0),
+            submap_peak_bytes: 0,
             recent: [None, None],
             global_from_local: Pose2::IDENTITY,
             typical_score: None,
@@ -217,6 +223,11 @@ impl Slam {
         self.fixes.attach(upto, before, after, in_track_frame, &mut self.graph, &self.p, &mut self.report);
     }
 
+    /// Bytes held by the submaps' grids and the loop search's branch-and-bound grids.
+    pub fn grid_bytes(&self) -> usize {
+        self.submaps.bytes() + self.grids.bytes()
+    }
+
     /// Adds the next scan (stamps non-decreasing).
     pub fn add_scan(&mut self, scan: ScanInput) -> ScanOutcome {
         self.report.scans += 1;
@@ -242,18 +253,23 @@ impl Slam {
         if held {
             self.report.held_readings += 1;
         }
-        // The track's own motion since the last scan, when it has one.
-        let track_motion = match (self.last, scan.track) {
-            (Some((_, Some(before))), Some(now)) if !held => Some(before.inverse().compose(now)),
+        // The track's own motion since the last scan, when it has one and it is a motion a
+        // robot can make: a jump (an odometry reset, a GNSS teleport the estimator took) is
+        // a gap of the track, counted, and the track is followed again from its new place.
+        let last_track = self.last.and_then(|(_, t)| t).map(|t| (t, self.last_stamp));
+        let jumped = !held
+            && matches!((last_track, scan.track), (Some((before, t)), Some(now)) if self.jumps(t, before, scan.stamp, now));
+        self.report.track_jumps += u64::from(jumped);
+        let track_motion = match (last_track, scan.track) {
+            (Some((before, _)), Some(now)) if !held && !jumped => Some(before.inverse().compose(now)),
             _ => None,
         };
-        let predicted = match (self.last, scan.track) {
+        let predicted = match (self.last, track_motion) {
             _ if held => self.recent[1].map_or(Pose2::IDENTITY, |r| r.1),
-            (Some((local, Some(before))), Some(now)) => local.compose(before.inverse().compose(now)),
+            (Some((local, _)), Some(d)) => local.compose(d),
             // In or just out of a gap of the track: no motion known, the search finds it.
-            (Some((local, _)), _) => local,
-            (None, Some(now)) => now,
-            (None, None) => Pose2::IDENTITY,
+            (Some((local, _)), None) => local,
+            (None, _) => scan.track.unwrap_or(Pose2::IDENTITY),
         };
         if scan.track.is_none() {
             self.report.without_track += 1;
@@ -288,6 +304,7 @@ impl Slam {
         }
         if !held {
             self.last = Some((local, scan.track));
+            self.last_stamp = scan.stamp;
         }
         let anchor = self.nodes.last().map(|_| self.nodes.len() - 1);
         self.scans.push(ScanRecord { stamp: scan.stamp, local, anchor });
@@ -306,6 +323,18 @@ impl Slam {
             self.scans.last_mut().expect("pushed above").anchor = Some(self.nodes.len() - 1);
         }
         outcome
+    }
+
+    /// Whether the track moving from `before` (at `t0`) to `now` (at `t1`) is faster than
+    /// `max_track_speed_m_s` or `max_track_turn_rate_rad_s` allow (with the glitch filter's
+    /// stamp jitter). Equal stamps say nothing of speed and are never a jump (the `%g`
+    /// stamps of some CARMEN logs).
+    fn jumps(&self, t0: Stamp, before: Pose2, t1: Stamp, now: Pose2) -> bool {
+        let limits = crate::time::MotionLimits {
+            max_speed_m_s: self.p.max_track_speed_m_s,
+            max_turn_rate_rad_s: self.p.max_track_turn_rate_rad_s,
+        };
+        t1 != t0 && !limits.plausible((t0, before), (t1, now))
     }
 
     fn match_local(
@@ -429,6 +458,7 @@ impl Slam {
         let local_misses: Vec<Point2> = misses.iter().map(to_local).collect();
         let before = self.submaps.all().len();
         let (into, finished) = self.submaps.insert(local, local.transform_point(origin), &local_hits, &local_misses);
+        self.submap_peak_bytes = self.submap_peak_bytes.max(self.submaps.bytes());
         for s in before..self.submaps.all().len() {
             let g = self.graph.add_node(self.global_from_local.compose(self.submaps.all()[s].local_pose));
             self.submap_graph.push(g);
@@ -510,7 +540,7 @@ impl Slam {
         self.report.submaps = self.submaps.all().len();
         self.take_optimisation_if_due();
         if self.p.loop_closure {
-            self.loop_closure_after_node(finished);
+            self.loop_closure_after_node(&finished);
         }
         self.optimise_if_due();
     }
@@ -526,6 +556,7 @@ impl Slam {
         self.report.travel_m = self.nodes.last().map_or(0.0, |n| n.path_m);
         self.report.grids_built = self.grids.built;
         self.report.grids_peak_bytes = self.grids.peak_bytes;
+        self.report.submap_peak_bytes = self.submap_peak_bytes;
         self.report.odometry_scale = self.odometry.scales();
         // Without a node (no scan), every fix is left unplaced, and counted.
         self.report.fixes_unplaced += self.fixes.pending() as u64;

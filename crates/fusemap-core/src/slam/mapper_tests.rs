@@ -195,6 +195,39 @@ fn odometry_that_jumps_is_left_out_and_the_scans_stay_on_the_truth() {
     assert!(mean < 0.05 && max < 0.15, "mean {mean}, max {max}");
 }
 
+/// Odometry of `truth` that jumps by `offset` (world frame) from scan `from` on, or on
+/// every odd scan when `alternate`.
+fn jumping_track(truth: &[Pose2], offset: f64, from: usize, alternate: bool) -> Vec<Option<Pose2>> {
+    let odo = odometry(truth, 3);
+    let shifted = |i: usize| if alternate { i % 2 == 1 } else { i >= from };
+    odo.iter()
+        .enumerate()
+        .map(|(i, p)| Some(if shifted(i) { Pose2::new(p.x + offset, p.y - offset, p.theta) } else { *p }))
+        .collect()
+}
+
+#[test]
+fn a_track_that_teleports_is_not_followed_and_the_submaps_stay_small() {
+    // An odometry reset of 10¹⁷ m, a GNSS jump of 1,000 km that stays, and a track
+    // alternating by ±10¹⁷ m: no scan can have moved that far, so the jump is taken as a
+    // gap of the track (matched from the previous pose), counted, and never drawn into a
+    // submap (a grid spanning it would need 10³⁶ cells).
+    // At 10¹⁷ m the odometry's own increments are lost to rounding (its values are 16 m
+    // apart), so every step that rounds to one is another jump.
+    let truth = ring_poses(1);
+    let all = truth.len() as u64 - 1;
+    for (offset, alternate, jumps) in [(1e6, false, 1..=1), (1e17, false, 1..=all), (1e17, true, all..=all)] {
+        let r = run(&truth, &jumping_track(&truth, offset, 150, alternate), 360);
+        let (mean, max) = errors(&r);
+        let rep = &r.result.report;
+        let case = format!("offset {offset}, alternate {alternate}");
+        assert!(jumps.contains(&rep.track_jumps), "{case}: {} jumps", rep.track_jumps);
+        assert!(mean < 0.05 && max < 0.2, "{case}: mean {mean}, max {max}");
+        let mib = rep.submap_peak_bytes as f64 / (1 << 20) as f64;
+        assert!(mib < 16.0, "{case}: the submaps held {mib:.1} MiB");
+    }
+}
+
 #[test]
 fn a_non_finite_track_pose_is_refused_and_counted() {
     let truth = ring_poses(1)[..50].to_vec();

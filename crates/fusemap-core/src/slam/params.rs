@@ -25,6 +25,13 @@ pub struct SlamParams {
     pub max_range_m: f64,
     /// A scan with fewer usable returns is not matched (its pose is predicted).
     pub min_points: usize,
+    /// The pose track moving faster than this between two scans is a jump, not a motion
+    /// (an odometry reset, a teleported pose): the scan is matched as in a gap of the
+    /// track. Metres per second; the plan sets it from `log.max_speed_m_s`, the limit the
+    /// glitch filter holds every pose stream to.
+    pub max_track_speed_m_s: f64,
+    /// … or turning faster than this, radians per second (`log.max_turn_rate_deg_s`).
+    pub max_track_turn_rate_rad_s: f64,
     /// A scan becomes a node (and goes into the submaps) once the robot has moved this far
     /// since the last node, metres …
     pub node_distance_m: f64,
@@ -158,6 +165,8 @@ impl Default for SlamParams {
             miss_probability: 0.49,
             field_sigma_m: 0.05,
             max_range_m: 30.0,
+            max_track_speed_m_s: 20.0,
+            max_track_turn_rate_rad_s: 720f64.to_radians(),
             min_points: 20,
             node_distance_m: 0.1,
             node_angle_rad: 2f64.to_radians(),

@@ -18,6 +18,10 @@ pub struct SlamReport {
     pub without_track: u64,
     /// Scans refused (non-finite track pose or sensor origin).
     pub refused: u64,
+    /// Scans whose track moved faster than a robot can since the previous scan (an
+    /// odometry reset, a teleported pose): matched from the previous scan's pose instead,
+    /// as in a gap of the track.
+    pub track_jumps: u64,
     /// Scans also matched from the constant-velocity prediction, because it lay outside
     /// half the search window of the track's prediction.
     pub moving_prediction_searched: u64,
@@ -86,6 +90,8 @@ pub struct SlamReport {
     pub grids_built: u64,
     /// The most bytes of branch-and-bound grids held at once.
     pub grids_peak_bytes: usize,
+    /// The most bytes the submaps' grids held at once.
+    pub submap_peak_bytes: usize,
     /// Pose-graph optimisations run.
     pub optimisations: u64,
     /// … of which taken some nodes after they started (run beside the matching when the
@@ -150,6 +156,12 @@ impl SlamReport {
         if self.refused > 0 {
             out.push(format!("{} scans refused: a non-finite track pose or sensor origin", self.refused));
         }
+        if self.track_jumps > 0 {
+            out.push(format!(
+                "{} times the pose track moved faster than log.max_speed_m_s or log.max_turn_rate_deg_s allow between two scans (an odometry reset, a teleported pose): those scans were matched from the previous scan's pose, not moved with the track",
+                self.track_jumps
+            ));
+        }
         if self.loop_over_budget > 0 {
             out.push(format!(
                 "{} loop-closure searches left out by the per-batch work budget ([slam] loop_closure_work_per_batch)",
@@ -199,7 +211,9 @@ mod tests {
         assert!(f(&unmatched)[0].contains("10 scans were not matched"), "{:?}", f(&unmatched));
         let failed = SlamReport { optimisation_failures: vec!["singular".into()], ..clean.clone() };
         assert!(f(&failed)[0].contains("1 pose-graph optimisations failed"), "{:?}", f(&failed));
-        let budget = SlamReport { loop_over_budget: 3, refused: 1, ..clean };
+        let budget = SlamReport { loop_over_budget: 3, refused: 1, ..clean.clone() };
         assert_eq!(f(&budget).len(), 2, "{:?}", f(&budget));
+        let jumps = SlamReport { track_jumps: 2, ..clean };
+        assert!(f(&jumps)[0].starts_with("2 times the pose track moved faster"), "{:?}", f(&jumps));
     }
 }

@@ -65,7 +65,17 @@ pub struct Submaps {
     all: Vec<Submap>,
     /// Indices of the active submaps (oldest first).
     active: Vec<usize>,
+    /// Farthest a scan may be from an active submap's start, metres (see
+    /// [`insert`](Self::insert)).
+    reach_m: f64,
+    /// Bytes held by the finished submaps' grids.
+    finished_bytes: usize,
 }
+
+/// Beyond twice a submap's length, how much farther a scan may lie from the submap's start
+/// before the active submaps are closed rather than grown to reach it, metres: more than
+/// any one step between scans of a real log (one scan a metre on the slowest CARMEN logs).
+const REACH_MARGIN_M: f64 = 10.0;
 
 impl Submaps {
     /// No submap yet; fields of σ `field_sigma_m`.
@@ -87,7 +97,16 @@ impl Submaps {
             crossings: [Vec::new(), Vec::new()],
             all: Vec::new(),
             active: Vec::new(),
+            reach_m: 2.0 * bounds.distance_m + REACH_MARGIN_M,
+            finished_bytes: 0,
         }
+    }
+
+    /// Bytes held by every submap's grids: the finished ones' fields and the active ones'
+    /// grids with their mirrors and scratch.
+    pub fn bytes(&self) -> usize {
+        let active: usize = self.active.iter().map(|&i| self.all[i].grid.bytes() + self.all[i].occupancy.bytes()).sum();
+        self.finished_bytes + active
     }
 
     /// Every submap, in creation order.
@@ -101,15 +120,28 @@ impl Submaps {
     }
 
     /// Inserts a scan (points in the local frame) into the active submaps, starting a new
-    /// submap when needed. Returns the indices of the submaps it went into, and the index
-    /// of a submap finished by this insertion.
+    /// submap when needed. Returns the indices of the submaps it went into, and those of
+    /// the submaps finished by this insertion.
+    ///
+    /// A scan farther from an active submap's start than a submap's travel allows (after a
+    /// long pause in the log, or a pose that came from nowhere) closes the active submaps
+    /// and starts a new one: a grid grown to span the gap would need the square of its
+    /// length in cells (10¹⁷ m apart, 10³⁷), and would hold nothing between.
     pub fn insert(
         &mut self,
         pose: Pose2,
         origin: Point2,
         hits: &[Point2],
         misses: &[Point2],
-    ) -> (Vec<usize>, Option<usize>) {
+    ) -> (Vec<usize>, Vec<usize>) {
+        let mut finished = Vec::new();
+        let far = |s: &Submap| s.local_pose.translation().distance(pose.translation()) > self.reach_m;
+        if self.active.iter().any(|&i| far(&self.all[i])) {
+            for i in std::mem::take(&mut self.active) {
+                self.finish(i);
+                finished.push(i);
+            }
+        }
         if let Some(last) = self.travel.2 {
             let d = last.inverse().compose(pose);
             self.travel.0 += d.x.hypot(d.y);
@@ -155,15 +187,21 @@ impl Submaps {
         let (b, (d, r, _)) = (self.bounds, self.travel);
         let newest = &self.all[*self.active.last().expect("one active at least")];
         self.newest_full = newest.scans >= b.max_scans || d >= b.distance_m || r >= b.rotation_rad;
-        let mut finished = None;
         if self.newest_full && self.active.len() == 2 {
             let i = self.active.remove(0);
-            self.all[i].finished = true;
-            self.all[i].grid.freeze();
-            self.all[i].occupancy = ProbabilityGrid::new(self.resolution);
-            finished = Some(i);
+            self.finish(i);
+            finished.push(i);
         }
         (into, finished)
+    }
+
+    /// Submap `i` takes no more scans: its field is frozen and its occupancy dropped.
+    fn finish(&mut self, i: usize) {
+        let s = &mut self.all[i];
+        s.finished = true;
+        s.grid.freeze();
+        s.occupancy = ProbabilityGrid::new(self.resolution);
+        self.finished_bytes += s.grid.bytes() + s.occupancy.bytes();
     }
 
     /// A copy of finished submap `i`, appended (tests of the loop search's cost over very
@@ -224,5 +262,24 @@ mod tests {
             s.insert(Pose2::new(0.0, 0.0, 0.1 * k as f64), Point2::new(0.0, 0.0), &hit, &[]);
         }
         assert_eq!(s.all().len(), 4);
+    }
+
+    #[test]
+    fn a_scan_far_beyond_the_active_submaps_closes_them_and_starts_anew() {
+        let bounds = SubmapBounds { distance_m: 2.0, rotation_rad: 1.0, max_scans: 1000 };
+        let hit = [Point2::new(0.5, 0.3)];
+        let mut s = Submaps::new(0.05, bounds, 0.55, 0.49, 0.05);
+        for k in 0..30 {
+            s.insert(Pose2::new(0.1 * k as f64, 0.0, 0.0), Point2::new(0.1 * k as f64, 0.0), &hit, &[]);
+        }
+        let (before, bytes) = (s.all().len(), s.bytes());
+        assert_eq!(before, 2);
+        // 10¹⁷ m away: both active submaps are finished, the scan goes into a new one only.
+        let far = Pose2::new(1e17, -1e17, 0.0);
+        let (into, finished) = s.insert(far, far.translation(), &[Point2::new(1e17 + 0.5, -1e17)], &[]);
+        assert_eq!((into, finished), (vec![2], vec![0, 1]));
+        assert!(s.all()[..2].iter().all(|m| m.finished));
+        // The grids hold what they held (finished: cropped), and the new one a scan's worth.
+        assert!(s.bytes() < 2 * bytes, "{} bytes, {bytes} before", s.bytes());
     }
 }

@@ -65,7 +65,8 @@ pub enum PushOutcome {
     Duplicate,
     /// Older than the last sample: dropped.
     OutOfOrder,
-    /// A non-finite pose: dropped.
+    /// A non-finite pose, or one beyond [`MAX_POSITION_M`](crate::geometry::MAX_POSITION_M):
+    /// dropped.
     NotFinite,
 }
 
@@ -124,7 +125,7 @@ impl PoseBuffer {
     /// Appends a sample; samples must come in increasing time order. Duplicates, older
     /// samples and non-finite poses are dropped and reported.
     pub fn push(&mut self, stamp: Stamp, pose: Pose2) -> PushOutcome {
-        if !pose.is_finite() {
+        if !pose.is_position() {
             return PushOutcome::NotFinite;
         }
         if let Some(&last) = self.stamps.last() {

@@ -236,12 +236,12 @@ impl Slam {
 
     /// Queues the searches a new node brings (and a submap it finished), and runs the
     /// batch when due.
-    pub(super) fn loop_closure_after_node(&mut self, finished: Option<usize>) {
+    pub(super) fn loop_closure_after_node(&mut self, finished: &[usize]) {
         let n = self.nodes.len() - 1;
         let p = self.node_position(n);
         self.loops.node_index.insert(n, p);
         let far = self.max_reach();
-        if let Some(f) = finished {
+        for &f in finished {
             self.finished[f] = true;
             let c = self.submap_centre(f);
             self.loops.submap_index.insert(f, c);
