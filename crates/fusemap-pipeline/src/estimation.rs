@@ -206,6 +206,12 @@ fn estimate_without_unusable_fixes(
 pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<ChosenTrack, PipelineError> {
     let Inputs { inputs, gnss, config, mut notes, odometry_glitches } = inputs(plan, inv, bound)?;
     let (e, inputs) = estimate_without_unusable_fixes(inputs, &config, &mut notes)?;
+    if e.report.gate_resets_refused > 0 {
+        notes.push(format!(
+            "GNSS: {} fixes rejected by the filter's gate; {} times a run of them agreed with each other but lay farther from the track than the odometry could have drifted since the last fix taken (estimator.gate_reset_max_drift = {} of the distance driven): a jump of the receiver, not followed",
+            e.report.fixes.rejected_gate, e.report.gate_resets_refused, config.gate_reset_max_drift
+        ));
+    }
     let odom = bound.first(SensorKind::WheelOdometry);
     let names: Vec<String> =
         bound.sensors.iter().map(|s| format!("{} `{}`", s.sensor.kind.as_str().replace('_', " "), s.topic)).collect();

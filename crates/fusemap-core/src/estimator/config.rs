@@ -103,6 +103,11 @@ pub struct EstimatorConfig {
     /// Gate-rejected position fixes in a row that agree with each other (the filter, not
     /// the fixes, is off) before the filter's position uncertainty is reopened; 0 disables.
     pub gate_reset_consistent_fixes: usize,
+    /// … and only when the odometry could have drifted that far: the common offset of the
+    /// rejected fixes is at most this share of the distance driven since the last fix the
+    /// filter took (plus ten times the fixes' σ). A GNSS jump of 100 m seconds after a good
+    /// fix is the receiver's, not the filter's, however well the fixes after it agree.
+    pub gate_reset_max_drift: f64,
     /// `pose_at` refuses to interpolate across samples further apart than this, seconds.
     pub max_sample_gap_s: f64,
     /// Correlation time of the position error of non-RTK fixes (multipath, atmosphere),
@@ -163,6 +168,7 @@ impl Default for EstimatorConfig {
             stationary_max_rate: 0.005,
             stationary_min_s: 0.5,
             gate_reset_consistent_fixes: 3,
+            gate_reset_max_drift: 0.2,
             max_sample_gap_s: 1.0,
             fix_correlation_time_s: 10.0,
             rtk_fix_correlation_time_s: 0.0,
@@ -209,6 +215,7 @@ impl EstimatorConfig {
         }
         let non_negative = [
             ("odometry_translation_noise", self.odometry_translation_noise),
+            ("gate_reset_max_drift", self.gate_reset_max_drift),
             ("odometry_translation_noise_per_sqrt_s", self.odometry_translation_noise_per_sqrt_s),
             ("odometry_rotation_noise_per_rad", self.odometry_rotation_noise_per_rad),
             ("odometry_rotation_noise_per_m", self.odometry_rotation_noise_per_m),

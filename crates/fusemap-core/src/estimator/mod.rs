@@ -137,6 +137,7 @@ pub(crate) fn estimate_once(inputs: &[EstimatorInput], cfg: &EstimatorConfig) ->
         by_quality,
         rejected_fixes: counts.rejected_fixes,
         gate_resets: 0,
+        gate_resets_refused: 0,
         stationary_s: 0.0,
         steps_without_gyro: 0,
     };
@@ -169,6 +170,7 @@ pub(crate) fn estimate_once(inputs: &[EstimatorInput], cfg: &EstimatorConfig) ->
         slip_stretches,
         heading_init: init.info,
         gate_resets: rc.gate_resets,
+        gate_resets_refused: rc.gate_resets_refused,
         stationary_s: rc.stationary_s,
         steps: out.records.len(),
     };

@@ -236,6 +236,10 @@ pub struct EstimatorReport {
     pub heading_init: HeadingInit,
     /// Times the position uncertainty was reopened after consistent gate rejections.
     pub gate_resets: usize,
+    /// Times the rejected fixes agreed with each other but were farther off than the
+    /// odometry could have drifted since the last fix taken (`gate_reset_max_drift`): a
+    /// jump of the receiver, left rejected.
+    pub gate_resets_refused: usize,
     /// Time spent standing still (zero-rate updates), seconds.
     pub stationary_s: f64,
     /// Filter steps (samples of the track).

@@ -23,6 +23,7 @@ pub(crate) struct RunCounts {
     pub by_quality: Vec<FixQualityCount>,
     pub rejected_fixes: Vec<RejectedFix>,
     pub gate_resets: usize,
+    pub gate_resets_refused: usize,
     pub stationary_s: f64,
     pub steps_without_gyro: usize,
 }
@@ -54,6 +55,8 @@ struct Filter<'a> {
     counts: &'a mut RunCounts,
     rejected_run: RejectedRun,
     last_fix: Option<Stamp>,
+    /// Odometry distance since the filter last took a fix (infinite before the first).
+    driven_since_fix_m: f64,
 }
 
 impl Filter<'_> {
@@ -79,6 +82,7 @@ impl Filter<'_> {
                 if accepted {
                     q.used += 1;
                     self.rejected_run.clear();
+                    self.driven_since_fix_m = 0.0;
                 } else {
                     q.rejected_gate += 1;
                     self.counts.rejected_fixes.push(RejectedFix { stamp, reason: FixRejection::Gate, nis: g.nis });
@@ -137,6 +141,12 @@ impl Filter<'_> {
         if !consistent {
             return false;
         }
+        // The odometry must be able to explain the offset (see `gate_reset_max_drift`).
+        let sigma = r[0][0].max(r[1][1]).sqrt();
+        if offset > self.cfg.gate_reset_max_drift * self.driven_since_fix_m + 10.0 * sigma {
+            self.counts.gate_resets_refused += 1;
+            return false;
+        }
         let n2 = mean[0] * mean[0] + mean[1] * mean[1];
         self.p[0][0] += mean[0] * mean[0] + n2;
         self.p[0][1] += mean[0] * mean[1];
@@ -186,7 +196,16 @@ pub(crate) fn run(
     let (t0, t_last) = odo.span();
     let mut records = Vec::with_capacity(odo.stamps.len() + corrections.len());
     let mut slips = vec![false; odo.intervals.len()];
-    let mut f = Filter { x: init.x, p: init.p, cfg, gates, counts, rejected_run: Vec::new(), last_fix: None };
+    let mut f = Filter {
+        x: init.x,
+        p: init.p,
+        cfg,
+        gates,
+        counts,
+        rejected_run: Vec::new(),
+        last_fix: None,
+        driven_since_fix_m: f64::INFINITY,
+    };
     let mut j = 0;
     let outside = |(stamp, c): &(Stamp, Correction), counts: &mut RunCounts| match c {
         Correction::Position { .. } => {
@@ -261,6 +280,7 @@ pub(crate) fn run(
                 bias_noise: cfg.gyro_bias_random_walk.powi(2) * dt,
                 scale_noise: cfg.odometry_scale_random_walk.powi(2) * inc.x.hypot(inc.y),
             };
+            f.driven_since_fix_m += inc.x.hypot(inc.y);
             let (x_pred, p_pred, jac) = predict(&f.x, &f.p, &motion);
             f.x = x_pred;
             f.p = p_pred;

@@ -161,6 +161,30 @@ fn a_lone_first_fix_far_away_is_neither_the_datum_nor_the_start() {
 }
 
 #[test]
+fn fixes_that_jump_111_m_and_stay_are_not_followed() {
+    // From 20 s on every fix is 0.001° (111 m) north: the fixes agree with each other, so
+    // the gate's reset would take them, but no odometry drifts 111 m in 20 s.
+    let clean = short_run();
+    let mut bad = clean.clone();
+    let start = clean.messages.iter().map(|m| m.stamp()).min().expect("the run has messages");
+    for m in &mut bad.messages {
+        let late = m.stamp().secs_since(start) > 20.0;
+        if let (SimMessage::Fix(f), true) = (m, late) {
+            f.latitude += 0.001;
+        }
+    }
+    let cfg = estimator_only(Some(&clean));
+    let a = map(&clean, "jump-clean", &cfg);
+    let b = map(&bad, "jump-111m", &cfg);
+    let e = &serde_json::to_value(&b.report).unwrap()["estimator"]["estimator"];
+    assert!(e["gate_resets_refused"].as_u64().unwrap() >= 1, "{e}");
+    assert!(b.notes.iter().any(|n| n.contains("a jump of the receiver, not followed")), "{:?}", b.notes);
+    let (ate_a, ate_b) = (ate(&a.trajectory, &clean.truth_trajectory), ate(&b.trajectory, &clean.truth_trajectory));
+    println!("ATE clean {ate_a:.4} m, fixes 111 m off from 20 s {ate_b:.4} m");
+    assert!(ate_b < ate_a + 0.1, "clean {ate_a:.4} m, with the jump {ate_b:.4} m");
+}
+
+#[test]
 fn fixes_too_imprecise_to_give_the_heading_are_dropped_with_a_note() {
     let mut rec = short_run();
     for m in &mut rec.messages {
