@@ -172,6 +172,17 @@ def ros1_message_cases(tmp: Path, messages, static: int) -> None:
         "scan-range-max-below-min": (at("/scan", None, setting(range_min=5.0, range_max=1.0)), "no_map", {}),
         "scan-dropped-odometry": (at("/odom", None, lambda d: []), "map", {}),
     }
+    # The lidar driver stalls at scan 10 and republishes that reading while the robot
+    # drives on: the 26 frozen scans read after it has moved 10 cm are noted and not mapped.
+    held = {}
+
+    def frozen(t: str, i: int, d: dict) -> list[dict]:
+        if t != "/scan" or i < 10:
+            return [d]
+        held.setdefault("ranges", list(d["ranges"]))
+        return [{**d, "ranges": held["ranges"]}]
+
+    cases["scan-frozen-while-moving"] = (frozen, "map", {lidar + "frozen": 26, "scans": 14})
     for what, (mutate, expect, summary) in cases.items():
         p = tmp / f"{what}.bag"
         write_ros1(p, messages, static, None, mutate)

@@ -142,6 +142,14 @@ impl Inserter<'_> {
         self.next_id += 1;
         match self.track {
             Track::ScanLine(corrected) => {
+                // Judged by the line's own pose (as SLAM judged it, leaving the same lines
+                // out), before SLAM's pose is looked up.
+                let own =
+                    msg.pose.filter(|p| p.is_finite() && !l.line_glitches.contains(&line_key(msg.scan.stamp, *p)));
+                if own.is_some_and(|p| l.repeats.is_frozen(p)) {
+                    l.report.scans_skipped.frozen += 1;
+                    return Ok(());
+                }
                 let Some(pose) = line_pose(corrected.as_ref(), &mut self.lines_seen, l, msg) else {
                     return Ok(());
                 };
@@ -160,6 +168,10 @@ impl Inserter<'_> {
                         return Ok(());
                     }
                 };
+                if l.repeats.is_frozen(pose) {
+                    l.report.scans_skipped.frozen += 1;
+                    return Ok(());
+                }
                 scan.stamp = t;
                 let n = scan.ranges.len();
                 let ti = msg.time_increment as f64;

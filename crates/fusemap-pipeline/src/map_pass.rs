@@ -418,6 +418,12 @@ fn lidar_notes(lidars: &[Mapped], cfg: &LogConfig, notes: &mut Vec<String>) -> S
                 r.scans_skipped.repeated, r.topic
             ));
         }
+        if r.scans_skipped.frozen > 0 {
+            notes.push(format!(
+                "{} scans of `{}` are frozen: the ranges of the scan before, bit for bit, while the pose track moved (a driver republishing its last reading); they were not mapped",
+                r.scans_skipped.frozen, r.topic
+            ));
+        }
         if r.scans_skipped.late > 0 {
             notes.push(format!(
                 "{} scans of `{}` arrived more than log.reorder_window_s = {} s behind the others and were dropped",
@@ -426,7 +432,7 @@ fn lidar_notes(lidars: &[Mapped], cfg: &LogConfig, notes: &mut Vec<String>) -> S
         }
     }
     let read: u64 = lidars.iter().map(|l| l.report.scans_read).sum();
-    let without_pose = skipped.total() - skipped.bad_angles - skipped.repeated;
+    let without_pose = skipped.total() - skipped.bad_angles - skipped.repeated - skipped.frozen;
     if without_pose > 0 {
         notes.push(format!("{without_pose} of {read} scans skipped without a pose"));
     }

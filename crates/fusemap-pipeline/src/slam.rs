@@ -224,6 +224,10 @@ impl<'a> ScanFeed<'a> {
             }
             Track::Timed(track) => track.pose_at(t, self.mode).ok().or_else(|| across_gap(&self.samples, t)),
         };
+        // A frozen scan is left out, as the mapping pass leaves it out (`repeats.rs`).
+        if pose.is_some_and(|p| self.repeats.is_frozen(p)) {
+            return Ok(());
+        }
         if pose.is_none() {
             self.without_pose += 1;
         }

@@ -61,6 +61,9 @@ pub struct Skipped {
     pub bad_angles: u64,
     /// The same scan again (same stamp and ranges as the one before it): inserted once.
     pub repeated: u64,
+    /// Frozen: the ranges of the scan before, bit for bit, at a new stamp, while the pose
+    /// track moved (a driver republishing its last reading; `repeats.rs`).
+    pub frozen: u64,
 }
 
 impl Skipped {
@@ -85,6 +88,7 @@ impl Skipped {
             + self.late
             + self.bad_angles
             + self.repeated
+            + self.frozen
     }
 
     /// Adds another lidar's counts.
@@ -98,5 +102,6 @@ impl Skipped {
         self.late += o.late;
         self.bad_angles += o.bad_angles;
         self.repeated += o.repeated;
+        self.frozen += o.frozen;
     }
 }
