@@ -28,6 +28,7 @@ use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SensorKind};
 use fusemap_core::estimator::{
     base_yaw_rate, estimate, odometry_increment_covariance, Estimate, EstimatorConfig, EstimatorError, EstimatorInput,
+    StaleOrientation,
 };
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{quaternion_yaw, Pose2, Pose3};
@@ -151,14 +152,21 @@ fn imu_inputs(
     let m3 = sensor_mount(s, cfg, tree, &frame, msgs.first().map(|m| m.stamp), &mut all.notes)?;
     let r = m3.rotation();
     let q_mount = m3.quaternion();
+    let (mut stale, mut stale_count) = (StaleOrientation::default(), 0u64);
     for m in msgs {
         let stamp = s.stamp(m.stamp);
         // `angular_velocity_covariance[0] = -1`: no rate in this message.
+        let mut rate = f64::NAN;
         if m.rate_covariance[0] != -1.0 {
             let (yaw_rate, variance) = base_yaw_rate(&r, m.angular_velocity, &m.rate_covariance);
             all.inputs.push(EstimatorInput::Gyro { stamp, yaw_rate, variance });
+            rate = yaw_rate;
         }
         if let Some((orientation, var)) = m.orientation.filter(|_| s.sensor.use_orientation) {
+            if stale.is_stale(stamp, orientation, rate) {
+                stale_count += 1;
+                continue;
+            }
             // world_from_base = world_from_imu · (base_from_imu)⁻¹.
             let world_from_imu = Pose3::new([0.0; 3], orientation);
             let q = world_from_imu.compose(&Pose3::new([0.0; 3], q_mount).inverse()).rotation;
@@ -167,6 +175,13 @@ fn imu_inputs(
                 all.inputs.push(EstimatorInput::Heading { stamp, yaw, variance: var });
             }
         }
+    }
+    if stale_count > 0 {
+        all.notes.push(format!(
+            "IMU `{}`: {stale_count} orientation readings left out as stale: the orientation repeated, bit for bit, while the gyro turned more than {:.0}° (a frozen attitude filter)",
+            s.topic,
+            fusemap_core::estimator::STALE_TURN_RAD.to_degrees()
+        ));
     }
     Ok(())
 }

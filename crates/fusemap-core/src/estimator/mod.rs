@@ -66,6 +66,7 @@ mod second_pass;
 mod sensor_models;
 mod slip_fixes;
 mod smoother;
+mod stale_orientation;
 mod streams;
 
 #[cfg(test)]
@@ -86,6 +87,7 @@ pub use sensor_models::{
     base_yaw_rate, check_fix, odometry_increment_covariance, FixProblem, GnssCovariance, GnssCovarianceKind, GnssNoise,
     DEFAULT_ALTITUDE_RANGE_M,
 };
+pub use stale_orientation::{StaleOrientation, STALE_TURN_RAD};
 
 use crate::geometry::Pose2;
 use filter::{StepRecord, N};

@@ -184,6 +184,43 @@ fn fixes_that_jump_111_m_and_stay_are_not_followed() {
     assert!(ate_b < ate_a + 0.1, "clean {ate_a:.4} m, with the jump {ate_b:.4} m");
 }
 
+/// The IMU's messages given an orientation: the true heading with an attitude filter's
+/// jitter (±0.1 mrad; 1 mrad σ claimed) until `frozen_after_s`, then the heading of that
+/// moment, repeated.
+fn with_orientation(rec: &SimRecording, frozen_after_s: f64) -> SimRecording {
+    let mut out = rec.clone();
+    let truth = &rec.truth_trajectory;
+    let start = truth[0].0;
+    let yaw_at = |t: Stamp| truth[truth.partition_point(|(s, _)| *s < t).min(truth.len() - 1)].1.theta;
+    let frozen = yaw_at(Stamp(start.0 + (frozen_after_s * 1e9) as i64));
+    for (k, m) in out.messages.iter_mut().enumerate() {
+        if let SimMessage::Imu(i) = m {
+            let t = i.header.stamp;
+            let jitter = 1e-4 * ((k * 7919) % 200) as f64 / 100.0 - 1e-4;
+            let yaw = if t.secs_since(start) < frozen_after_s { yaw_at(t) + jitter } else { frozen };
+            i.orientation = fusemap_sim::rpy_to_quaternion(0.0, 0.0, yaw).into();
+            i.orientation_covariance = [1e-6, 0.0, 0.0, 0.0, 1e-6, 0.0, 0.0, 0.0, 1e-6];
+        }
+    }
+    out
+}
+
+#[test]
+fn an_imu_orientation_frozen_while_the_gyro_turns_is_left_out() {
+    let clean = short_run();
+    let mut cfg = estimator_only(Some(&clean));
+    cfg.sensor.push(SensorConfig { use_orientation: Some(true), ..SensorConfig::new(SensorKind::Imu) });
+    let good = map(&with_orientation(&clean, 1e9), "orientation-good", &cfg);
+    let frozen = map(&with_orientation(&clean, 10.0), "orientation-frozen", &cfg);
+    let truth = &clean.truth_trajectory;
+    let (a, b) = (ate(&good.trajectory, truth), ate(&frozen.trajectory, truth));
+    let note = frozen.notes.iter().find(|n| n.contains("orientation readings left out as stale"));
+    println!("ATE with the true orientation {a:.4} m, frozen from 10 s {b:.4} m; {note:?}");
+    assert!(!good.notes.iter().any(|n| n.contains("stale")), "{:?}", good.notes);
+    assert!(note.is_some(), "{:?}", frozen.notes);
+    assert!(b < a + 0.02, "true orientation {a:.4} m, frozen {b:.4} m");
+}
+
 #[test]
 fn fixes_too_imprecise_to_give_the_heading_are_dropped_with_a_note() {
     let mut rec = short_run();
