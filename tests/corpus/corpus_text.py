@@ -216,6 +216,9 @@ def config_cases() -> None:
     config_case("config/limits-tiny-export",
                 "[limits]\nexport_cells = 1\n", "map", notes=["sparse"])
     config_case("config/max-speed-zero", "[log]\nmax_speed_m_s = 0.0\n", names=["max_speed_m_s"])
+    config_case("config/slam-window-costly",
+                "[slam]\nresolution_m = 0.005\nsearch_linear_window_m = 5.0\nsearch_angular_window_deg = 180.0\n",
+                names=["search_linear_window_m", "candidate poses a scan"], max_seconds=1.0)
     config_case("config/slam-window-negative", "[slam]\nsearch_linear_window_m = -1.0\n",
                 names=["search_linear_window_m"])
     config_case("config/integer-overflow", "[slam]\nscans_per_submap = 99999999999999999999\n", names=[":2:"])

@@ -270,6 +270,34 @@ fn unit_ratio(field: &str, v: f64) -> Result<f64, FieldError> {
     }
 }
 
+/// The most candidate poses one correlative search may score for a scan: 500 times the
+/// local search's default (2,107) and 40 times the rescue search's (23,829). Each is scored
+/// against every return, so 10⁶ candidates of a 360-beam scan are 3.6 × 10⁸ lookups.
+pub const MAX_SEARCH_CANDIDATES: f64 = 1e6;
+
+/// Checks what the correlative searches cost a scan, not only each key's sign: a window
+/// of 5 m and 180° at 5 mm passes every key's range and would score 10¹¹ poses a scan.
+fn check_search_cost(p: &SlamParams) -> Result<(), FieldError> {
+    let windows = [
+        ("search", p.local.linear_window_m, p.local.angular_window_rad),
+        ("rescue", p.rescue_linear_window_m, p.rescue_angular_window_rad),
+    ];
+    for (name, linear, angular) in windows {
+        let n = crate::slam::search_candidates(linear, angular, p.resolution);
+        if n > MAX_SEARCH_CANDIDATES {
+            return Err(err(
+                format!("slam.{name}_linear_window_m"),
+                format!(
+                    "slam.{name}_linear_window_m = {linear} m and slam.{name}_angular_window_deg = {:.1}° at slam.resolution_m = {} m are {n:.3e} candidate poses a scan, over the limit of {MAX_SEARCH_CANDIDATES:.0e} (each is scored against every return); narrow the windows or coarsen slam.resolution_m",
+                    angular.to_degrees(),
+                    p.resolution
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl SlamConfig {
     /// Checks every key and builds the parameters.
     pub fn validate(&self) -> Result<SlamParams, FieldError> {
@@ -306,7 +334,7 @@ impl SlamConfig {
         if angular > 180.0 || lc_angular > 180.0 || rescue_angular > 180.0 {
             return Err(err("slam", "angular search windows must be at most 180°"));
         }
-        Ok(SlamParams {
+        let params = SlamParams {
             resolution: res,
             submap: SubmapBounds {
                 distance_m: positive("submap_distance_m", self.submap_distance_m)?,
@@ -417,7 +445,9 @@ impl SlamConfig {
             fixes: self.fixes,
             fix_max_offset_s: non_negative("fix_max_offset_s", self.fix_max_offset_s)?.min(60.0),
             fix_huber: positive("fix_huber", self.fix_huber)?,
-        })
+        };
+        check_search_cost(&params)?;
+        Ok(params)
     }
 }
 
@@ -448,5 +478,33 @@ mod tests {
         assert!(c.validate().unwrap_err().to_string().contains("slam.loop_closure_degeneracy_ratio"));
         let c = SlamConfig { submap_max_scans: 0, ..Default::default() };
         assert!(c.validate().unwrap_err().to_string().contains("slam.submap_max_scans"));
+    }
+
+    #[test]
+    fn a_search_window_is_judged_by_what_it_costs_a_scan() {
+        let p = SlamConfig::default().validate().unwrap();
+        let cost = |lin: f64, ang: f64| crate::slam::search_candidates(lin, ang, p.resolution);
+        assert_eq!(cost(p.local.linear_window_m, p.local.angular_window_rad), 2107.0);
+        assert_eq!(cost(p.rescue_linear_window_m, p.rescue_angular_window_rad), 23829.0);
+        // A wide window a user may want for poor odometry passes …
+        let wide = SlamConfig { search_linear_window_m: 1.0, search_angular_window_deg: 30.0, ..Default::default() };
+        assert!(wide.validate().is_ok());
+        // … every key of this one is in range, and it would score 10¹¹ poses a scan.
+        for (name, c) in [
+            (
+                "slam.search_linear_window_m",
+                SlamConfig {
+                    resolution_m: 0.005,
+                    search_linear_window_m: 5.0,
+                    search_angular_window_deg: 180.0,
+                    ..Default::default()
+                },
+            ),
+            ("slam.rescue_linear_window_m", SlamConfig { rescue_linear_window_m: 3.0, ..Default::default() }),
+        ] {
+            let e = c.validate().unwrap_err();
+            assert_eq!(e.field, name, "{e}");
+            assert!(e.message.contains("candidate poses a scan, over the limit of 1e6"), "{e}");
+        }
     }
 }

@@ -93,6 +93,26 @@ pub fn mean_probability(grid: &ProbabilityGrid, points: &[Point2], pose: Pose2) 
     sum / points.len() as f32
 }
 
+/// Olson's step moves the farthest point by one cell; far returns of a long corridor
+/// would make it tiny. The refinement converges from a cell or two away, so the step is
+/// taken for points up to this range (metres) and farther ones may move a few cells.
+const STEP_RANGE_M: f64 = 10.0;
+
+/// The most candidate poses the correlative search scores for one scan with a window of
+/// `linear_window_m` and `angular_window_rad` on cells of `resolution` (each candidate is
+/// scored against every return of the scan): what its time grows with.
+pub fn search_candidates(linear_window_m: f64, angular_window_rad: f64, resolution: f64) -> f64 {
+    let step = angular_step(resolution, STEP_RANGE_M);
+    let n_lin = (linear_window_m / resolution).ceil();
+    let n_ang = (angular_window_rad / step).ceil();
+    (2.0 * n_lin + 1.0).powi(2) * (2.0 * n_ang + 1.0)
+}
+
+/// The heading step at which a point `range` metres away moves by one cell of `r`.
+fn angular_step(r: f64, range: f64) -> f64 {
+    (1.0 - r * r / (2.0 * range * range)).clamp(-1.0, 1.0).acos().max(1e-4)
+}
+
 /// The correlative search: the best pose of the window around `predicted`.
 pub fn correlative_search(
     grid: &ProbabilityGrid,
@@ -101,12 +121,8 @@ pub fn correlative_search(
     p: &LocalMatchParams,
 ) -> (Pose2, f32) {
     let r = grid.resolution();
-    // Olson's step moves the farthest point by one cell; far returns of a long corridor
-    // would make it tiny. The refinement converges from a cell or two away, so the step is
-    // taken for points up to `STEP_RANGE_M` and farther ones may move a few cells.
-    const STEP_RANGE_M: f64 = 10.0;
     let max_range = points.iter().map(|q| q.x.hypot(q.y)).fold(r, f64::max).min(STEP_RANGE_M);
-    let step = (1.0 - r * r / (2.0 * max_range * max_range)).clamp(-1.0, 1.0).acos().max(1e-4);
+    let step = angular_step(r, max_range);
     let n_ang = (p.angular_window_rad / step).ceil() as i64;
     let n_lin = (p.linear_window_m / r).ceil() as i64;
     // The headings in two halves on two threads; the first half wins a tie, as the first

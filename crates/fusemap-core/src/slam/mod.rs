@@ -39,7 +39,7 @@ mod test_world;
 
 pub use corrected_track::CorrectedTrack;
 pub use fixes::PositionFix;
-pub use local_match::LocalMatchParams;
+pub use local_match::{search_candidates, LocalMatchParams};
 pub use loop_closure::{OpenReason, OpenSearch};
 pub use mapper::{ScanInput, ScanOutcome, Slam, SlamResult};
 pub use parallel::adopt_calling_thread;
