@@ -313,6 +313,10 @@ def world_cases() -> None:
     d = case("simulate/truth-resolution-1e-9", ["simulate", "{case}/short.toml", "--resolution", "1e-9", "--out",
                                                 "{case}/out"], "error", names=["truth.yaml", "no true map at resolution", "coarser"])
     (d / "short.toml").write_text("[robot]\nduration_s = 1.0\n[camera]\nenabled = false\n")
+    d = case("simulate/waypoints-1e7-m-apart", ["simulate", "{case}/far.toml", "--out", "{case}/out"], "error",
+             names=["{case}/far.toml", "robot.waypoints", "more than the 1e5 m"], max_seconds=2.0)
+    (d / "far.toml").write_text("[robot]\nduration_s = 1.0\nwaypoints = [[0.0, 0.0], [1e7, 0.0], [1e7, 1e7]]\n"
+                                "[camera]\nenabled = false\n")
     d = case("simulate/scenario-sparse-2gib", ["simulate", "{case}/big.toml", "--out", "{case}/out"],
              "error", names=["{case}/big.toml", "larger than 4 MiB"], max_seconds=1.0)
     with open(d / "big.toml", "wb") as f:

@@ -142,6 +142,10 @@ impl Default for FramesConfig {
 /// Most lidar beams a run may simulate (8 bytes each in memory).
 pub const MAX_BEAMS: f64 = 5e7;
 
+/// The longest loop of waypoints a scenario may have, metres: 100 km, more than an hour
+/// (the longest run) at 20 m/s.
+pub const MAX_LOOP_M: f64 = 1e5;
+
 impl Scenario {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), FieldError> {
@@ -182,11 +186,21 @@ impl Scenario {
         if r.waypoints.len() < 3 || r.waypoints.iter().flatten().any(|v| !v.is_finite()) {
             return Err(FieldError::new("robot.waypoints", "needs at least 3 finite points (a closed loop)"));
         }
+        let mut length = 0.0;
         for i in 0..r.waypoints.len() {
             let (a, b) = (r.waypoints[i], r.waypoints[(i + 1) % r.waypoints.len()]);
             if (a[0] - b[0]).hypot(a[1] - b[1]) < 1e-6 {
                 return Err(FieldError::new(format!("robot.waypoints[{i}]"), "repeats the next waypoint"));
             }
+            length += (a[0] - b[0]).hypot(a[1] - b[1]);
+        }
+        // The loop is sampled every 5 cm before the robot drives it: bounded, so that
+        // waypoints 10⁷ m apart are an error, not 6 GB of path.
+        if length > MAX_LOOP_M {
+            return Err(FieldError::new(
+                "robot.waypoints",
+                format!("make a loop {length:.3e} m long, more than the {MAX_LOOP_M:.0e} m a simulated run may drive"),
+            ));
         }
         self.lidar.validate()?;
         let beams = self.lidar.beams as f64 * self.lidar.rate_hz * r.duration_s;
@@ -244,6 +258,9 @@ mod tests {
         let mut s = Scenario::default();
         s.robot.waypoints.truncate(2);
         assert!(s.validate().unwrap_err().to_string().starts_with("robot.waypoints"));
+        let mut s = Scenario::default();
+        s.robot.waypoints[1] = [1e7, 3.0];
+        assert!(s.validate().unwrap_err().to_string().contains("more than the 1e5 m"), "{:?}", s.validate());
         let mut s = Scenario::default();
         s.frames.gps.clear();
         assert!(s.validate().unwrap_err().to_string().starts_with("frames.gps"));
