@@ -5,9 +5,10 @@
 //! interpolated (linear in translation, shortest arc in rotation) and applied on the left
 //! of the track, so the track's own fine motion (odometry, gyro) still places every
 //! measurement between two scans — the de-skewed beams, a camera frame — at its stamp.
-//! Where the correction changes between two scans faster than a robot moves, the track
-//! jumped there (an odometry reset SLAM did not follow): between those two scans the
-//! optimised poses are interpolated instead, as across a gap of the track.
+//! Where the base track moves between two scans faster than a robot can (the same test
+//! SLAM makes: an odometry reset it did not follow), the base track jumped there: between
+//! those two scans the optimised poses are interpolated instead, as across a gap of the
+//! track.
 //! This is the `map → odom` transform a ROS localiser publishes (REP 105), here estimated
 //! offline for every scan. At a scan stamp the track is exactly the optimised pose.
 
@@ -17,8 +18,9 @@ use crate::time::{MotionLimits, NoPose, PoseTrack, Stamp, SyncMode};
 /// `base` corrected by SLAM.
 pub struct CorrectedTrack {
     base: Box<dyn PoseTrack>,
-    /// At each scan where `base` has a pose: the correction and the optimised pose.
-    corrections: Vec<(Stamp, Pose2, Pose2)>,
+    /// At each scan where `base` has a pose: the correction, the optimised pose and the
+    /// base pose.
+    corrections: Vec<(Stamp, Pose2, Pose2, Pose2)>,
     slam: Vec<(Stamp, Pose2)>,
     limits: MotionLimits,
 }
@@ -26,13 +28,14 @@ pub struct CorrectedTrack {
 impl CorrectedTrack {
     /// `slam_poses`: the optimised `map_from_base` of scans (any order) whose stamps lie in
     /// `base`'s span; scans where `base` has no pose are left out. `limits`: the fastest
-    /// the correction may change and still be interpolated (`log.max_speed_m_s`, …).
+    /// the base track may move between two scans and still be followed
+    /// (`log.max_speed_m_s`, …).
     pub fn new(base: Box<dyn PoseTrack>, slam_poses: &[(Stamp, Pose2)], limits: MotionLimits) -> Self {
-        let mut corrections: Vec<(Stamp, Pose2, Pose2)> = slam_poses
+        let mut corrections: Vec<(Stamp, Pose2, Pose2, Pose2)> = slam_poses
             .iter()
             .filter_map(|&(t, p)| {
                 let b = base.pose_at(t, SyncMode::Interpolate).ok()?;
-                Some((t, p.compose(b.inverse()), p))
+                Some((t, p.compose(b.inverse()), p, b))
             })
             .collect();
         corrections.sort_by_key(|c| c.0);
@@ -51,20 +54,20 @@ impl CorrectedTrack {
             Err(0) => c.first().map_or(Pose2::IDENTITY, |x| x.1),
             Err(i) if i == c.len() => c[i - 1].1,
             Err(i) => {
-                let ((t0, a, _), (t1, b, _)) = (c[i - 1], c[i]);
+                let ((t0, a, _, _), (t1, b, _, _)) = (c[i - 1], c[i]);
                 a.interpolate(b, (t.0 - t0.0) as f64 / (t1.0 - t0.0) as f64)
             }
         }
     }
 
-    /// Between two scans whose corrections differ by more than a robot moves (the base
-    /// track jumped between them), the optimised poses interpolated: the base track holds
-    /// the jump, the scans were placed by the lidar.
+    /// Between two scans across which the base track moves faster than a robot can (it
+    /// jumped between them), the optimised poses interpolated: the base track holds the
+    /// jump, the scans were placed by the lidar. Equal stamps say nothing of speed.
     fn across_jump(&self, t: Stamp) -> Option<Pose2> {
         let c = &self.corrections;
         let i = c.partition_point(|x| x.0 < t);
-        let ((t0, a, p0), (t1, b, p1)) = (*c.get(i.checked_sub(1)?)?, *c.get(i)?);
-        (t1 != t && !self.limits.plausible((t0, a), (t1, b)))
+        let ((t0, _, p0, b0), (t1, _, p1, b1)) = (*c.get(i.checked_sub(1)?)?, *c.get(i)?);
+        (t1 != t && t1 != t0 && !self.limits.plausible((t0, b0), (t1, b1)))
             .then(|| p0.interpolate(p1, (t.0 - t0.0) as f64 / (t1.0 - t0.0) as f64))
     }
 }
@@ -94,11 +97,11 @@ impl PoseTrack for CorrectedTrack {
         self.base.span()
     }
 
-    /// The base track's samples, corrected; those across a jump are left out.
+    /// The base track's samples, corrected (across a jump: the optimised poses
+    /// interpolated, as [`pose_at`](Self::pose_at) gives them).
     fn samples(&self) -> Vec<(Stamp, Pose2)> {
         (self.base.samples().into_iter())
-            .filter(|(t, _)| self.across_jump(*t).is_none())
-            .map(|(t, p)| (t, self.correction_at(t).compose(p)))
+            .map(|(t, p)| (t, self.across_jump(t).unwrap_or_else(|| self.correction_at(t).compose(p))))
             .collect()
     }
 }
