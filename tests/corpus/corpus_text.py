@@ -195,6 +195,8 @@ def config_cases() -> None:
     config_case("config/resolution-1e-5", "[map]\nresolution = 1e-5\n", names=["ray_cells"], max_seconds=1.0)
     config_case("config/resolution-1e-9", "[map]\nresolution = 1e-9\n", names=["ray_cells"])
     config_case("config/resolution-inf", "[map]\nresolution = inf\n", names=["resolution"])
+    config_case("config/origin-1e15", "[map]\norigin = [1e15, 0.0]\n", names=["map.origin", "within"])
+    config_case("config/origin-1e9", "[map]\norigin = [1e9, 1e9]\n", "map")
     config_case("config/prior-one", "[map]\nprior = 1.0\n", names=["prior"])
     config_case("config/clamps-crossed", "[map]\nclamp_min = 0.9\nclamp_max = 0.1\n", names=["clamp"])
     config_case("config/max-range-1e12",

@@ -305,6 +305,13 @@ impl Config {
             Some([x, y]) => {
                 finite("map.origin", x)?;
                 finite("map.origin", y)?;
+                // Beyond 10⁹ m an f64 no longer resolves a position to 10⁻⁷ m, and the cell
+                // of a point near the origin is rounded (at 10¹⁵ a quarter of the updates
+                // went to the wrong cell); no pose a robot has is that far out either.
+                let max = crate::geometry::MAX_POSITION_M;
+                if x.abs() > max || y.abs() > max {
+                    return Err(err("map.origin", format!("must be within ±{max:e} m, got [{x}, {y}]")));
+                }
                 GridGeometry::new(res, Point2::new(x, y))
             }
             None => GridGeometry::centered(res),
