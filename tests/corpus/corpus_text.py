@@ -211,10 +211,10 @@ def config_cases() -> None:
     config_case("config/limits-tiny-map-cells", "[limits]\nmap_cells = 4096\n", names=[WORLD, "limits.map_cells"],
                 names_config=False)
     config_case("config/limits-zero-memory", "[limits]\nmemory_mib = 0\n", names=["memory_mib"])
-    # The corridor at 1 mm needs 66 MB of tiles: past a 64 MiB budget, refused naming it.
+    # The corridor at 1 mm needs 66 MB of tiles (it maps in 215 MB): past a 64 MiB budget,
+    # refused naming it.
     config_case("config/limits-1mm-past-memory", "[map]\nresolution = 0.001\n[limits]\nmemory_mib = 64\n",
                 names=[WORLD, "limits.memory_mib = 64 MiB"], names_config=False)
-    config_case("config/resolution-1mm", "[map]\nresolution = 0.001\n", "map")
     config_case("config/limits-tiny-export",
                 "[limits]\nexport_cells = 1\n", "map", notes=["sparse"])
     config_case("config/max-speed-zero", "[log]\nmax_speed_m_s = 0.0\n", names=["max_speed_m_s"])
@@ -302,6 +302,15 @@ def world_cases() -> None:
                  "error", names=["{case}/world.toml", f"limits.{key}"])
         (d / "limits.toml").write_text(f"[limits]\n{key} = {value}\n")
         (d / "world.toml").write_text(corridor)
+    # Within world_poses and beams_per_scan, yet minutes or hours of ray casting: refused.
+    d = case("world/ten-million-poses", ["map", "--world", "{case}/world.toml", "--out", "{case}/out"], "error",
+             names=["{case}/world.toml", "trajectory.count", "more than the 2e7"], max_seconds=2.0)
+    (d / "world.toml").write_text(corridor.replace("count = 40", "count = 10000000"))
+    walls = "".join(f"[[wall]]\nfrom = [{0.1 * (k % 300):.1f}, {0.1 * (k // 300):.1f}]\nto = [{0.1 * (k % 300) + 0.05:.2f}, "
+                    f"{0.1 * (k // 300):.1f}]\n" for k in range(80000))
+    d = case("world/eighty-thousand-walls", ["map", "--world", "{case}/world.toml", "--out", "{case}/out"], "error",
+             names=["{case}/world.toml", "80003 walls", "beam-wall tests"], max_seconds=5.0)
+    (d / "world.toml").write_text(corridor.replace("count = 40", "count = 1000") + walls)
     d = case("world/fifo", ["map", "--world", "{case}/pipe", "--out", "{case}/out"], "error",
              names=["{case}/pipe", "FIFO"])
     os.mkfifo(d / "pipe")
