@@ -49,6 +49,11 @@ impl RepeatFilter {
             let first = ranges.iter().find(|r| r.is_finite());
             let varied = first.is_some_and(|f| ranges.iter().any(|r| r.is_finite() && r != f));
             self.same_ranges = same && varied;
+            // A new reading: the next pose it is seen at anchors it (if this scan gets no
+            // pose, the scan after it that repeats the reading does).
+            if !self.same_ranges {
+                self.anchor = None;
+            }
         }
         let bits = match self.last.take() {
             Some((_, mut v)) => {
@@ -66,11 +71,11 @@ impl RepeatFilter {
     /// true when it is frozen (see the module docs).
     pub fn is_frozen(&mut self, pose: Pose2) -> bool {
         match self.anchor {
-            Some(a) if self.same_ranges => {
+            Some(a) => {
                 let d = a.inverse().compose(pose);
                 d.x.hypot(d.y) > FROZEN_MOTION_M || normalize_angle(d.theta).abs() > FROZEN_TURN_RAD
             }
-            _ => {
+            None => {
                 self.anchor = Some(pose);
                 false
             }
@@ -102,15 +107,18 @@ mod tests {
     #[test]
     fn the_same_ranges_from_a_moving_robot_are_frozen_and_at_rest_are_not() {
         let mut f = RepeatFilter::default();
-        let at = |x: f64| Pose2::new(x, 0.0, 0.0);
-        let mut see = |t: i64, ranges: &[f32], pose: Pose2| !f.is_repeat(&scan(t, ranges)) && f.is_frozen(pose);
+        let at = |x: f64| Some(Pose2::new(x, 0.0, 0.0));
+        // A scan seen at `pose` (`None`: no pose, as in a gap of the track): frozen?
+        let mut see = |t: i64, ranges: &[f32], pose: Option<Pose2>| {
+            !f.is_repeat(&scan(t, ranges)) && pose.is_some_and(|p| f.is_frozen(p))
+        };
         assert!(!see(1, &[1.0, 2.0], at(0.0)));
         // At rest, and creeping within 10 cm of where the reading was first seen: kept.
         assert!(!see(2, &[1.0, 2.0], at(0.0)));
         assert!(!see(3, &[1.0, 2.0], at(0.05)));
         // The track has moved 30 cm (or turned 5°) and the lidar says the same: frozen.
         assert!(see(4, &[1.0, 2.0], at(0.3)));
-        assert!(see(5, &[1.0, 2.0], Pose2::new(0.0, 0.0, 0.09)));
+        assert!(see(5, &[1.0, 2.0], Some(Pose2::new(0.0, 0.0, 0.09))));
         // A new reading is fresh wherever the robot is, and anchors the next comparison.
         assert!(!see(6, &[1.0, 2.1], at(5.0)));
         assert!(!see(7, &[1.0, 2.1], at(5.05)));
@@ -119,5 +127,10 @@ mod tests {
         assert!(!see(9, &[f32::INFINITY, f32::INFINITY], at(9.0)));
         assert!(!see(10, &[2.0, 2.0, f32::NAN], at(10.0)));
         assert!(!see(11, &[2.0, 2.0, f32::NAN], at(12.0)));
+        // A new reading whose scan got no pose is anchored where it is next seen, not at
+        // the pose of the reading before it.
+        assert!(!see(12, &[3.0, 4.0], None));
+        assert!(!see(13, &[3.0, 4.0], at(20.0)));
+        assert!(see(14, &[3.0, 4.0], at(21.0)));
     }
 }
