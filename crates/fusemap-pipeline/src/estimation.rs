@@ -223,7 +223,7 @@ pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Ch
     let (e, inputs) = estimate_without_unusable_fixes(inputs, &config, &mut notes)?;
     if e.report.gate_resets_refused > 0 {
         notes.push(format!(
-            "GNSS: {} fixes rejected by the filter's gate; {} times a run of them agreed with each other but lay farther from the track than the odometry could have drifted since the last fix taken (estimator.gate_reset_max_drift = {} of the distance driven): a jump of the receiver, not followed",
+            "GNSS: {} fixes rejected by the filter's gate; {} times a run of them (and the fixes after it) agreed with each other but lay farther from the track than the odometry could have drifted since the last fix taken (estimator.gate_reset_max_drift = {} of the distance driven): a jump of the receiver, not followed",
             e.report.fixes.rejected_gate, e.report.gate_resets_refused, config.gate_reset_max_drift
         ));
     }

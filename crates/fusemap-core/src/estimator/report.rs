@@ -236,9 +236,9 @@ pub struct EstimatorReport {
     pub heading_init: HeadingInit,
     /// Times the position uncertainty was reopened after consistent gate rejections.
     pub gate_resets: usize,
-    /// Times the rejected fixes agreed with each other but were farther off than the
+    /// Runs of rejected fixes that agreed with each other but were farther off than the
     /// odometry could have drifted since the last fix taken (`gate_reset_max_drift`): a
-    /// jump of the receiver, left rejected.
+    /// jump of the receiver, left rejected (counted once until the filter takes a fix).
     pub gate_resets_refused: usize,
     /// Time spent standing still (zero-rate updates), seconds.
     pub stationary_s: f64,

@@ -57,6 +57,8 @@ struct Filter<'a> {
     last_fix: Option<Stamp>,
     /// Odometry distance since the filter last took a fix (infinite before the first).
     driven_since_fix_m: f64,
+    /// A reset was refused since the filter last took a fix.
+    reset_refused: bool,
 }
 
 impl Filter<'_> {
@@ -83,6 +85,7 @@ impl Filter<'_> {
                     q.used += 1;
                     self.rejected_run.clear();
                     self.driven_since_fix_m = 0.0;
+                    self.reset_refused = false;
                 } else {
                     q.rejected_gate += 1;
                     self.counts.rejected_fixes.push(RejectedFix { stamp, reason: FixRejection::Gate, nis: g.nis });
@@ -118,6 +121,11 @@ impl Filter<'_> {
         }
         let pxy = [[self.p[0][0] + r[0][0], self.p[0][1] + r[0][1]], [self.p[1][0] + r[1][0], self.p[1][1] + r[1][1]]];
         self.rejected_run.push((nu, pxy));
+        // Only the last `m` are judged: the run is kept to them (a receiver that jumped
+        // for the rest of the log would otherwise grow it by a fix a fix).
+        if self.rejected_run.len() > m {
+            self.rejected_run.drain(..self.rejected_run.len() - m);
+        }
         let run = &self.rejected_run;
         if run.len() < m {
             return false;
@@ -144,7 +152,11 @@ impl Filter<'_> {
         // The odometry must be able to explain the offset (see `gate_reset_max_drift`).
         let sigma = r[0][0].max(r[1][1]).sqrt();
         if offset > self.cfg.gate_reset_max_drift * self.driven_since_fix_m + 10.0 * sigma {
-            self.counts.gate_resets_refused += 1;
+            // Counted once per jump, not once per fix after it.
+            if !self.reset_refused {
+                self.counts.gate_resets_refused += 1;
+                self.reset_refused = true;
+            }
             return false;
         }
         let n2 = mean[0] * mean[0] + mean[1] * mean[1];
@@ -205,6 +217,7 @@ pub(crate) fn run(
         rejected_run: Vec::new(),
         last_fix: None,
         driven_since_fix_m: f64::INFINITY,
+        reset_refused: false,
     };
     let mut j = 0;
     let outside = |(stamp, c): &(Stamp, Correction), counts: &mut RunCounts| match c {
