@@ -125,7 +125,7 @@ pub fn parse_world_str_with(text: &str, path: &Path, limits: &LimitsConfig) -> R
     let t = &raw.trajectory;
     let n = t.poses.as_ref().map_or(t.count.unwrap_or(0), |p| p.len() as u64);
     if n <= limits.world_poses {
-        check_work(n as usize, scanner.beams, segments.len()).map_err(|(f, m)| {
+        check_work(n as usize, scanner.beams, segments.len(), limits.world_beams).map_err(|(f, m)| {
             let f = match (f, &t.poses) {
                 ("trajectory", Some(_)) => "trajectory.poses",
                 ("trajectory", None) => "trajectory.count",
@@ -138,30 +138,32 @@ pub fn parse_world_str_with(text: &str, path: &Path, limits: &LimitsConfig) -> R
     Ok(WorldFile { world: World { segments }, scanner, poses })
 }
 
-/// Beams a world run may cast in all (each is mapped): 2 × 10⁷, about 110,000 scans of
-/// 181 beams, ten seconds of mapping.
-pub const MAX_WORLD_BEAMS: f64 = 2e7;
-
 /// Beam-wall intersection tests a world run may make (every beam is tested against every
 /// wall): 4 × 10⁹, about ten seconds.
 pub const MAX_WORLD_RAY_TESTS: f64 = 4e9;
 
 /// Checks what simulating the scans costs: a world of `poses` poses, `beams` beams a
-/// scan and `walls` walls. Errors are (field, message). `world_poses` and
+/// scan and `walls` walls, within `max_beams` in all (`limits.world_beams`). Errors are
+/// (field, message). `world_poses` and
 /// `beams_per_scan` alone do not bound it: 10⁵ poses of 181 beams took 7.5 s, so the 10⁷
 /// `world_poses` allows would take 12 minutes, and hours among 80,000 walls.
-fn check_work(poses: usize, beams: usize, walls: usize) -> std::result::Result<(), (&'static str, String)> {
+fn check_work(
+    poses: usize,
+    beams: usize,
+    walls: usize,
+    max_beams: u64,
+) -> std::result::Result<(), (&'static str, String)> {
     let total = poses as f64 * beams as f64;
-    if total > MAX_WORLD_BEAMS {
+    if total > max_beams as f64 {
         let why = format!(
-            "{poses} poses of {beams} beams are {total:.3e} beams, more than the {MAX_WORLD_BEAMS:.0e} a world run may cast"
+            "{poses} poses of {beams} beams are {total:.3e} beams, more than the {max_beams:.0e} a world run may cast (limits.world_beams raises it)"
         );
         return Err(("trajectory", why));
     }
     let tests = total * walls as f64;
     if tests > MAX_WORLD_RAY_TESTS {
         let why = format!(
-            "{walls} walls met by {total:.3e} beams are {tests:.3e} beam-wall tests, more than the {MAX_WORLD_RAY_TESTS:.0e} a world run may make"
+            "{walls} walls met by {total:.3e} beams are {tests:.3e} beam-wall tests, more than the {MAX_WORLD_RAY_TESTS:.0e} a world run may make: fewer walls or fewer poses"
         );
         return Err(("wall", why));
     }
@@ -298,12 +300,14 @@ poses = [[0.0, 0.0, 0.0], [0.5, 0.0, 0.1]]
 
     #[test]
     fn a_world_whose_scans_would_take_hours_is_refused_naming_what_to_shrink() {
-        assert!(check_work(40, 181, 3).is_ok());
-        assert!(check_work(100_000, 181, 3).is_ok());
-        let (f, m) = check_work(10_000_000, 181, 3).unwrap_err();
+        let max = LimitsConfig::default().world_beams;
+        assert!(check_work(40, 181, 3, max).is_ok());
+        assert!(check_work(100_000, 181, 3, max).is_ok());
+        let (f, m) = check_work(10_000_000, 181, 3, max).unwrap_err();
         assert_eq!(f, "trajectory");
-        assert!(m.contains("1.810e9 beams, more than the 2e7"), "{m}");
-        let (f, m) = check_work(1000, 181, 80_000).unwrap_err();
+        assert!(m.contains("1.810e9 beams, more than the 2e7") && m.contains("limits.world_beams"), "{m}");
+        assert!(check_work(10_000_000, 181, 2, 2_000_000_000).is_ok(), "raised, it holds");
+        let (f, m) = check_work(1000, 181, 80_000, max).unwrap_err();
         assert_eq!(f, "wall");
         assert!(m.contains("80000 walls") && m.contains("more than the 4e9"), "{m}");
     }

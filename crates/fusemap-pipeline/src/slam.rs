@@ -241,8 +241,8 @@ impl<'a> ScanFeed<'a> {
         let bytes = self.slam.grid_bytes();
         if bytes as u64 > self.memory_bytes {
             return Err(PipelineError::Refused(format!(
-                "SLAM's grids reached limits.memory_mib = {} MiB ({} submaps, {bytes} bytes) at the scan stamped {:.6} s; \
-                 raise limits.memory_mib, coarsen slam.resolution_m, or shorten slam.max_range_m",
+                "SLAM's grids reached limits.memory_mib = {} MiB ({} submaps and the loop search's grids, {bytes} bytes) at the scan stamped {:.6} s; \
+                 raise limits.memory_mib, lower slam.loop_closure_grid_cache_mib, coarsen slam.resolution_m, or shorten slam.max_range_m",
                 self.memory_bytes >> 20,
                 self.slam.report().submaps,
                 t.as_secs_f64()

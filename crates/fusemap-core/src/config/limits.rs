@@ -15,9 +15,10 @@
 //!   the correlation scratch); their tile stores refuse to allocate past it and the engine
 //!   turns that into an error after the observation that met it (see
 //!   [`TileMap::set_tile_budget`](crate::grid::TileMap::set_tile_budget)). SLAM counts its
-//!   submaps' grids, and its branch-and-bound grids are held to their own cache
-//!   (`slam.loop_closure_grid_cache_mib`); SLAM's pass ends before the mapping pass
-//!   begins, so each holds to the whole budget.
+//!   submaps' grids and its loop search's branch-and-bound grids (whose cache,
+//!   `slam.loop_closure_grid_cache_mib`, is a part of this budget, not beside it) after
+//!   every scan; SLAM's pass ends before the mapping pass begins, so each holds to the
+//!   whole budget.
 //! * `map_cells` is the older cap in cells (whole 64 × 64 tiles), kept for configurations
 //!   that set it: whichever of the two is tighter holds.
 //! * `export_cells` is applied by the exporters: past it, a run writes the map's tiles
@@ -27,7 +28,8 @@
 //! * `beams_per_scan` and `image_pixels` are passed to the log readers too: a scan or an
 //!   image (whose pixels a pass decodes) past them ends the read with an error at that
 //!   message. The world-file loader holds its simulated scanner to `beams_per_scan`.
-//! * `world_poses` is checked by the world-file loader before it builds the trajectory.
+//! * `world_poses` and `world_beams` are checked by the world-file loader before it builds
+//!   the trajectory.
 
 use super::{err, FieldError};
 use crate::grid::TILE_CELLS;
@@ -65,6 +67,9 @@ pub struct LimitsConfig {
     /// Poses (scans) a simulated world file's trajectory may have: 10⁷ is more than ten
     /// days of driving at 10 Hz; a larger `count` is far more likely a typo than a plan.
     pub world_poses: u64,
+    /// Beams a world file's run may cast in all (poses × beams a scan; each is mapped):
+    /// 2 × 10⁷ is about 110,000 scans of 181 beams, ten seconds of mapping.
+    pub world_beams: u64,
 }
 
 impl Default for LimitsConfig {
@@ -78,6 +83,7 @@ impl Default for LimitsConfig {
             beams_per_scan: 1_000_000,
             image_pixels: 1 << 26,
             world_poses: 10_000_000,
+            world_beams: 20_000_000,
         }
     }
 }
@@ -109,6 +115,7 @@ impl LimitsConfig {
             ("beams_per_scan", self.beams_per_scan),
             ("image_pixels", self.image_pixels),
             ("world_poses", self.world_poses),
+            ("world_beams", self.world_beams),
         ] {
             if v == 0 {
                 return Err(err(format!("limits.{key}"), "must be at least 1"));
