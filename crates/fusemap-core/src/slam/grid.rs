@@ -100,6 +100,11 @@ impl CellLimits {
     }
 }
 
+/// The most cells one submap grid may hold: 2²⁶, a 8,192-cell square (410 m at 5 cm),
+/// 400 MB with its mirror. A submap holds a few metres of travel and the returns around
+/// them; a grid that would grow past this spans a pose that came from nowhere.
+pub const MAX_GRID_CELLS: i128 = 1 << 26;
+
 /// A submap's dense probability grid, in the local SLAM frame: cell `(i, j)` spans
 /// `[i·r, (i+1)·r) × [j·r, (j+1)·r)` metres.
 #[derive(Clone, Debug)]
@@ -221,24 +226,36 @@ impl ProbabilityGrid {
     }
 
     /// Grows the grid to hold the box `[lo, hi]` (cells), with a margin, keeping its data.
-    fn grow_to(&mut self, lo: (i64, i64), hi: (i64, i64)) {
+    /// A grid that would pass [`MAX_GRID_CELLS`] is not grown (false): the cells outside
+    /// it are left out of every update, which skips cells outside the grid.
+    fn grow_to(&mut self, lo: (i64, i64), hi: (i64, i64)) -> bool {
         let l = self.limits;
         let (max_x, max_y) = (l.min.x + l.width as i64 - 1, l.min.y + l.height as i64 - 1);
         if l.width > 0 && lo.0 >= l.min.x && lo.1 >= l.min.y && hi.0 <= max_x && hi.1 <= max_y {
-            return;
+            return true;
         }
-        const MARGIN: i64 = 64;
+        // In i128: a box from a pose 10¹⁷ m away overflows i64 arithmetic.
+        const MARGIN: i128 = 64;
+        let (lo, hi) = ((i128::from(lo.0), i128::from(lo.1)), (i128::from(hi.0), i128::from(hi.1)));
+        let (min_x, min_y, max_x, max_y) =
+            (i128::from(l.min.x), i128::from(l.min.y), i128::from(max_x), i128::from(max_y));
         let (nx0, ny0, nx1, ny1) = if l.width == 0 {
             (lo.0 - MARGIN, lo.1 - MARGIN, hi.0 + MARGIN, hi.1 + MARGIN)
         } else {
             (
-                if lo.0 < l.min.x { lo.0 - MARGIN } else { l.min.x },
-                if lo.1 < l.min.y { lo.1 - MARGIN } else { l.min.y },
+                if lo.0 < min_x { lo.0 - MARGIN } else { min_x },
+                if lo.1 < min_y { lo.1 - MARGIN } else { min_y },
                 if hi.0 > max_x { hi.0 + MARGIN } else { max_x },
                 if hi.1 > max_y { hi.1 + MARGIN } else { max_y },
             )
         };
-        let (w, h) = ((nx1 - nx0 + 1) as usize, (ny1 - ny0 + 1) as usize);
+        let (w, h) = (nx1 - nx0 + 1, ny1 - ny0 + 1);
+        let fits = |v: i128| i64::try_from(v).is_ok();
+        if w * h > MAX_GRID_CELLS || ![nx0, ny0, nx1, ny1].into_iter().all(fits) {
+            return false;
+        }
+        let (nx0, ny0) = (nx0 as i64, ny0 as i64);
+        let (w, h) = (w as usize, h as usize);
         let mut cells = vec![0u16; w * h];
         for row in 0..l.height {
             let src = &self.cells[row * l.width..(row + 1) * l.width];
@@ -257,11 +274,12 @@ impl ProbabilityGrid {
         }
         self.cells = cells;
         self.limits = CellLimits { min: CellIndex::new(nx0, ny0), width: w, height: h };
+        true
     }
 
     /// Grows the grid (with a margin) to hold every cell of the box `[lo, hi]`.
     pub(crate) fn ensure_cells(&mut self, lo: (i64, i64), hi: (i64, i64)) {
-        self.grow_to(lo, hi);
+        let _ = self.grow_to(lo, hi);
     }
 
     /// The stored value of cell `(x, y)`; `0` when unknown or outside.
@@ -347,7 +365,7 @@ impl ProbabilityGrid {
             lo = (lo.0.min(cx), lo.1.min(cy));
             hi = (hi.0.max(cx), hi.1.max(cy));
         }
-        self.grow_to(lo, hi);
+        let _ = self.grow_to(lo, hi);
         for p in hits {
             let c = self.to_cell_units(*p);
             self.apply(floor_i64(c.0), floor_i64(c.1), hit, &mut crossings);
@@ -493,5 +511,20 @@ mod tests {
         assert!(g.probability(-300, -200) > 0.5);
         assert!(g.is_known(201, 322));
         assert!(g.probability(201, 322) < 0.5);
+    }
+
+    #[test]
+    fn a_grid_never_grows_past_its_cap() {
+        let mut g = ProbabilityGrid::new(0.05);
+        let (hit, miss) = (UpdateTable::new(0.55), UpdateTable::new(0.49));
+        g.insert(Point2::new(0.0, 0.0), &[Point2::new(1.0, 0.0)], &[], &hit, &miss);
+        let (w, h) = (g.limits().width, g.limits().height);
+        // 10¹⁷ m away (2 · 10¹⁸ cells): not grown, nothing written, no overflow.
+        g.insert(Point2::new(1e17, 0.0), &[Point2::new(1e17 + 1.0, 0.0)], &[], &hit, &miss);
+        assert_eq!((g.limits().width, g.limits().height), (w, h));
+        // Near i64's end too.
+        g.insert(Point2::new(-4e17, 4e17), &[Point2::new(-4e17, 4e17 + 1.0)], &[], &hit, &miss);
+        assert_eq!((g.limits().width, g.limits().height), (w, h));
+        assert!(g.known_cells() > 0 && g.bytes() < 1 << 20);
     }
 }

@@ -60,7 +60,8 @@ pub enum ScanOutcome {
     Degenerate,
     /// Too few usable returns (or no submap yet): the predicted pose was kept.
     Predicted,
-    /// Refused: a non-finite track pose or sensor origin.
+    /// Refused: a non-finite track pose, or a sensor origin not finite or farther from the
+    /// base than `max_range_m`.
     Refused,
 }
 
@@ -231,7 +232,10 @@ impl Slam {
     /// Adds the next scan (stamps non-decreasing).
     pub fn add_scan(&mut self, scan: ScanInput) -> ScanOutcome {
         self.report.scans += 1;
-        if scan.track.is_some_and(|t| !t.is_finite()) || !scan.origin.is_finite() {
+        // A sensor farther from the base than its own range is no mount (and would put the
+        // scan's returns where no submap reaches).
+        let far_origin = scan.origin.x.hypot(scan.origin.y) > self.p.max_range_m;
+        if scan.track.is_some_and(|t| !t.is_finite()) || !scan.origin.is_finite() || far_origin {
             self.report.refused += 1;
             return ScanOutcome::Refused;
         }

@@ -16,7 +16,8 @@ pub struct SlamReport {
     pub predicted: u64,
     /// Scans inside a gap of the pose track (matched from the previous scan's pose).
     pub without_track: u64,
-    /// Scans refused (non-finite track pose or sensor origin).
+    /// Scans refused (a non-finite track pose; a sensor origin not finite or farther from
+    /// the base than `max_range_m`).
     pub refused: u64,
     /// Scans whose track moved faster than a robot can since the previous scan (an
     /// odometry reset, a teleported pose): matched from the previous scan's pose instead,
@@ -154,7 +155,7 @@ impl SlamReport {
             ));
         }
         if self.refused > 0 {
-            out.push(format!("{} scans refused: a non-finite track pose or sensor origin", self.refused));
+            out.push(format!("{} scans refused: a non-finite track pose, or a sensor origin not finite or farther from the base than slam.max_range_m", self.refused));
         }
         if self.track_jumps > 0 {
             out.push(format!(
