@@ -95,14 +95,16 @@ impl SpatialHash {
         // Few buckets when the span is large but the map small: walk the buckets instead.
         if ((2 * span + 1) * (2 * span + 1)) as usize > self.buckets.len() {
             for (key, v) in &self.buckets {
-                if (key.0 - k.0).abs() <= span && (key.1 - k.1).abs() <= span {
+                // `abs_diff`: keys of poses 10¹⁹ m out saturate at i64's ends.
+                if key.0.abs_diff(k.0) <= span as u64 && key.1.abs_diff(k.1) <= span as u64 {
                     out.extend(v);
                 }
             }
         } else {
             for dy in -span..=span {
                 for dx in -span..=span {
-                    if let Some(v) = self.buckets.get(&(k.0 + dx, k.1 + dy)) {
+                    let Some(key) = k.0.checked_add(dx).zip(k.1.checked_add(dy)) else { continue };
+                    if let Some(v) = self.buckets.get(&key) {
                         out.extend(v);
                     }
                 }
@@ -110,5 +112,27 @@ impl SpatialHash {
         }
         out.sort_unstable();
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_at_the_ends_of_the_key_range_are_found_without_overflow() {
+        let mut h = SpatialHash::new(10.0);
+        h.insert(0, Point2::new(0.0, 0.0));
+        h.insert(1, Point2::new(1e300, -1e300));
+        h.insert(2, Point2::new(-1e300, 1e300));
+        // Few buckets: the walk over the buckets.
+        assert_eq!(h.near(Point2::new(1e300, -1e300), 50.0), vec![1]);
+        assert_eq!(h.near(Point2::new(-1e300, 1e300), 50.0), vec![2]);
+        // Many buckets: the walk over the cells around the key.
+        for i in 3..200 {
+            h.insert(i, Point2::new(1000.0 * i as f64, 0.0));
+        }
+        assert_eq!(h.near(Point2::new(1e300, -1e300), 15.0), vec![1]);
+        assert_eq!(h.near(Point2::new(5.0, 5.0), 15.0), vec![0]);
     }
 }
