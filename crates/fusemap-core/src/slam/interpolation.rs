@@ -28,7 +28,8 @@ pub fn probability_and_gradient(grid: &ProbabilityGrid, u: f64, v: f64) -> (f64,
     let (i0, j0) = (floor_i64(fu), floor_i64(fv));
     let (wu, du) = keys(fu - i0 as f64);
     let (wv, dv) = keys(fv - j0 as f64);
-    let (i0, j0) = (i0 - 1, j0 - 1);
+    // Saturating: a point 10¹⁸ cells out reads cells outside the grid, never wraps.
+    let (i0, j0) = (i0.saturating_sub(1), j0.saturating_sub(1));
     // The 4 × 4 samples; inside the grid (nearly always) straight from its rows.
     let mut samples = [[0f64; 4]; 4];
     let width = grid.limits().width;
@@ -50,7 +51,7 @@ pub fn probability_and_gradient(grid: &ProbabilityGrid, u: f64, v: f64) -> (f64,
         (_, None) => {
             for (b, row) in samples.iter_mut().enumerate() {
                 for (a, s) in row.iter_mut().enumerate() {
-                    *s = grid.probability(i0 + a as i64, j0 + b as i64) as f64;
+                    *s = grid.probability(i0.saturating_add(a as i64), j0.saturating_add(b as i64)) as f64;
                 }
             }
         }

@@ -195,7 +195,9 @@ fn search_headings(
             }
             let (wx, wy) = (predicted.x + c * q.x - s * q.y, predicted.y + s * q.x + c * q.y);
             let (cx, cy) = (floor_i64(wx / r), floor_i64(wy / r));
-            let (x0, y0) = (cx - n_lin, cy - n_lin);
+            // Saturating: a prediction 10¹⁸ cells out (a pose from nowhere) reads cells
+            // outside every grid, never wraps into one.
+            let (x0, y0) = (cx.saturating_sub(n_lin), cy.saturating_sub(n_lin));
             match mirror.zip(grid.block_start(x0, y0, chunks * LANES, side)) {
                 Some((probabilities, start)) => {
                     for (row, acc) in sums.chunks_exact_mut(chunks).enumerate() {
@@ -210,7 +212,7 @@ fn search_headings(
                 None => {
                     for (row, acc) in sums.chunks_exact_mut(chunks).enumerate() {
                         for (col, sum) in acc.as_flattened_mut()[..side].iter_mut().enumerate() {
-                            *sum += grid.probability(x0 + col as i64, y0 + row as i64);
+                            *sum += grid.probability(x0.saturating_add(col as i64), y0.saturating_add(row as i64));
                         }
                     }
                 }
