@@ -493,7 +493,11 @@ impl Slam {
                 loss: Loss::Trivial,
                 kind: EdgeKind::Match,
             };
-            self.graph.add_edge(e).expect("valid match edge");
+            // A match far out (a pose from nowhere) can give a non-finite curvature or
+            // measurement: that edge is left out and counted, never a panic.
+            if self.graph.add_edge(e).is_err() {
+                self.report.edges_refused += 1;
+            }
         }
         if let Some((prev, before, now)) = self.nodes.last().and_then(|p| Some((p, p.track?, track?))) {
             let d = before.inverse().compose(now);
@@ -515,8 +519,8 @@ impl Slam {
                 loss: Loss::Trivial,
                 kind: EdgeKind::Odometry,
             };
-            if d.is_finite() && consistent {
-                self.graph.add_edge(e).expect("valid odometry edge");
+            if d.is_finite() && consistent && self.graph.add_edge(e).is_err() {
+                self.report.edges_refused += 1;
             }
         }
         // The global search's cost grows with the farthest point (its angular step), so

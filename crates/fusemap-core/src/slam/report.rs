@@ -19,6 +19,9 @@ pub struct SlamReport {
     /// Scans refused (a non-finite track pose; a sensor origin not finite or farther from
     /// the base than `max_range_m`).
     pub refused: u64,
+    /// Graph edges (match, odometry, loop closure) left out because their measurement or
+    /// information was not finite (a match far out, found by fuzzing).
+    pub edges_refused: u64,
     /// Scans whose track moved faster than a robot can since the previous scan (an
     /// odometry reset, a teleported pose): matched from the previous scan's pose instead,
     /// as in a gap of the track.
@@ -156,6 +159,12 @@ impl SlamReport {
         }
         if self.refused > 0 {
             out.push(format!("{} scans refused: a non-finite track pose, or a sensor origin not finite or farther from the base than slam.max_range_m", self.refused));
+        }
+        if self.edges_refused > 0 {
+            out.push(format!(
+                "{} pose-graph edges left out: their measurement or information was not finite",
+                self.edges_refused
+            ));
         }
         if self.track_jumps > 0 {
             out.push(format!(

@@ -231,7 +231,10 @@ impl Slam {
     }
 
     pub(super) fn accept(&mut self, edge: Edge, node: usize, submap: usize) {
-        self.graph.add_edge(edge).expect("valid loop-closure edge");
+        if self.graph.add_edge(edge).is_err() {
+            self.report.edges_refused += 1;
+            return;
+        }
         self.report.loop_accepted += 1;
         self.loops.since_optimisation += 1;
         let gap = self.drift(node, submap);
