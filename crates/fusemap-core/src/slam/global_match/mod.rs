@@ -134,7 +134,10 @@ impl Problem {
         let coarse = 1i64 << (levels - 1);
         // A point cell c is useful when some offset in [−window, window] puts a block of
         // 2^(levels−1) cells starting at c + offset over [0, size).
-        let useful = |c: i64, size: i32| c + window as i64 + coarse > 0 && c - (window as i64) < size as i64;
+        // Saturating: a point 10¹⁸ cells out (a pose from nowhere) is useless, never wraps.
+        let useful = |c: i64, size: i32| {
+            c.saturating_add(window as i64 + coarse) > 0 && c.saturating_sub(window as i64) < size as i64
+        };
         let scans = (-n_angles..=n_angles)
             .map(|k| {
                 let theta = initial.theta + k as f64 * step;
@@ -143,8 +146,8 @@ impl Problem {
                     .iter()
                     .filter_map(|p| {
                         let q = to(*p);
-                        let cx = floor_i64(q.x / r) - min.x;
-                        let cy = floor_i64(q.y / r) - min.y;
+                        let cx = floor_i64(q.x / r).saturating_sub(min.x);
+                        let cy = floor_i64(q.y / r).saturating_sub(min.y);
                         (useful(cx, w) && useful(cy, h)).then_some([cx as i32, cy as i32])
                     })
                     .collect();
