@@ -11,25 +11,24 @@ use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::time::{PoseTrack, Stamp, SyncMode};
 use libfuzzer_sys::fuzz_target;
 
-/// Reads little-endian values off the front of the fuzzer's bytes (zeros once they end).
-struct Bytes<'a>(&'a [u8]);
+#[path = "bytes.rs"]
+mod bytes;
+use bytes::Bytes;
 
-impl Bytes<'_> {
-    fn u8(&mut self) -> u8 {
-        let (v, rest) = self.0.split_first().map_or((0, &[][..]), |(v, r)| (*v, r));
-        self.0 = rest;
-        v
-    }
-    fn u16(&mut self) -> u16 {
-        u16::from(self.u8()) | u16::from(self.u8()) << 8
-    }
+/// The target's own values, on the shared reader.
+trait Values {
+    fn f64(&mut self) -> f64;
+    fn var(&mut self) -> f64;
+}
+
+impl Values for Bytes<'_> {
     /// A value: mostly small and plausible (so that the filter runs far), sometimes any
     /// f64 bit pattern.
     fn f64(&mut self) -> f64 {
         match self.u8() % 8 {
-            0 => f64::from_bits((0..8).fold(0u64, |a, i| a | u64::from(self.u8()) << (8 * i))),
+            0 => self.any_f64(),
             1 => 0.0,
-            _ => (f64::from(self.u16()) - 32768.0) / 1000.0,
+            _ => self.small(1000.0),
         }
     }
     fn var(&mut self) -> f64 {

@@ -10,23 +10,22 @@ use fusemap_core::slam::{PositionFix, ScanInput, Slam, SlamParams};
 use fusemap_core::time::Stamp;
 use libfuzzer_sys::fuzz_target;
 
-struct Bytes<'a>(&'a [u8]);
+#[path = "bytes.rs"]
+mod bytes;
+use bytes::Bytes;
 
-impl Bytes<'_> {
-    fn u8(&mut self) -> u8 {
-        let (v, rest) = self.0.split_first().map_or((0, &[][..]), |(v, r)| (*v, r));
-        self.0 = rest;
-        v
-    }
-    fn u16(&mut self) -> u16 {
-        u16::from(self.u8()) | u16::from(self.u8()) << 8
-    }
+/// The target's own values, on the shared reader.
+trait Values {
+    fn f64(&mut self) -> f64;
+}
+
+impl Values for Bytes<'_> {
     fn f64(&mut self) -> f64 {
         match self.u8() % 16 {
-            0 => f64::from_bits((0..8).fold(0u64, |a, i| a | u64::from(self.u8()) << (8 * i))),
+            0 => self.any_f64(),
             1 => 1e17,
             2 => -1e17,
-            _ => (f64::from(self.u16()) - 32768.0) / 2000.0,
+            _ => self.small(2000.0),
         }
     }
 }
