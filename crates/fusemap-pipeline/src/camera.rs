@@ -91,8 +91,19 @@ pub(crate) struct MappedCamera {
     pub(crate) report: CameraReport,
 }
 
+/// A camera as the log lets it be built.
+pub(crate) enum BuiltCamera {
+    /// Its model and the report to fill.
+    Ready(Box<(CameraModel, CameraReport)>),
+    /// Its streams are in the log but unusable (every image malformed, intrinsics no
+    /// pinhole camera has): the run maps with the other sensors, and this says why.
+    Unusable(String),
+}
+
 /// Builds a camera's model from the inventory: intrinsics from its `CameraInfo`, mount
-/// from TF or the config.
+/// from TF or the config. A topic the log lacks is an error (most often a typo in the
+/// config); streams that are there but unusable give [`BuiltCamera::Unusable`], so that
+/// one broken stream never sinks a run the lidar can map.
 pub(crate) fn build_camera(
     c: &PlannedCamera,
     classes: &ClassTable,
@@ -101,7 +112,8 @@ pub(crate) fn build_camera(
     tree: &FrameTree,
     cfg: &LogConfig,
     notes: &mut Vec<String>,
-) -> Result<(CameraModel, CameraReport), PipelineError> {
+) -> Result<BuiltCamera, PipelineError> {
+    let unusable = |m: String| Ok(BuiltCamera::Unusable(m));
     let refuse = |m: String| PipelineError::Refused(format!("camera `{}`: {m}", c.name));
     let info = inv.camera_info.get(&c.info_topic).ok_or_else(|| {
         refuse(format!(
@@ -112,7 +124,7 @@ pub(crate) fn build_camera(
     })?;
     for t in [&c.topic, &c.depth_topic] {
         if let (false, Some((n, first))) = (inv.images.contains_key(t), inv.stats.malformed_by_topic.get(t)) {
-            return Err(refuse(format!("the log's {n} messages on `{t}` are all malformed; the first: {first}")));
+            return unusable(format!("the log's {n} messages on `{t}` are all malformed; the first: {first}"));
         }
         if !inv.images.contains_key(t) {
             return Err(refuse(format!(
@@ -121,9 +133,12 @@ pub(crate) fn build_camera(
             )));
         }
     }
+    over_image_pixels(c, inv).map_or(Ok(()), |m| Err(refuse(m)))?;
     let i = &info.first;
-    let pinhole = Pinhole::from_camera_info(i.width, i.height, i.k, &i.distortion_model, &i.d)
-        .map_err(|e| refuse(format!("camera info on `{}`: {e}", c.info_topic)))?;
+    let pinhole = match Pinhole::from_camera_info(i.width, i.height, i.k, &i.distortion_model, &i.d) {
+        Ok(p) => p,
+        Err(e) => return unusable(format!("camera info on `{}`: {e}", c.info_topic)),
+    };
     if info.differing > 0 {
         notes.push(format!(
             "camera `{}`: {} of {} camera-info messages differ from the first; the first is used",
@@ -168,7 +183,22 @@ pub(crate) fn build_camera(
         extrinsics: ext,
         ..Default::default()
     };
-    Ok((model, report))
+    Ok(BuiltCamera::Ready(Box::new((model, report))))
+}
+
+/// The refusal the second pass would give at the camera's first image over
+/// `limits.image_pixels`, found from the first pass's image sizes: so that `doctor`,
+/// which reads no pixels, fails where `map` would, and `map` before it inserts a scan.
+fn over_image_pixels(c: &PlannedCamera, inv: &Inventory) -> Option<String> {
+    let max = inv.limits.max_image_pixels;
+    [&c.topic, &c.depth_topic].into_iter().find_map(|t| {
+        let sizes = &inv.images.get(t)?.sizes;
+        let (&(w, h), n) = sizes.iter().find(|(&(w, h), _)| u64::from(w) * u64::from(h) > max)?;
+        Some(format!(
+            "{n} images on `{t}` are {w} × {h}, {} pixels, over the limit of {max} (limits.image_pixels raises it)",
+            u64::from(w) * u64::from(h)
+        ))
+    })
 }
 
 fn list<'a>(it: impl Iterator<Item = &'a String>) -> String {

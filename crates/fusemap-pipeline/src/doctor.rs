@@ -332,10 +332,39 @@ fn how_posed(plan: &Plan, log: &Inventory) -> Posed {
                 }
             }
             notes.extend(chosen.notes.iter().cloned());
+            match crate::map_pass::check_streams(plan, log, &bound, &chosen.track) {
+                Ok(n) => notes.extend(n),
+                Err(e) => refusal = Some(e.to_string()),
+            }
+            refusal = refusal.or_else(|| unobservable(log, &bound));
         }
         Err(e) => refusal = Some(e.to_string()),
     }
     Posed { sync, notes, refusal }
+}
+
+/// Why `map` would write no map for want of readings, when it would: no lidar's topic
+/// holds a reading its model takes as evidence.
+fn unobservable(log: &Inventory, bound: &crate::sensors::Bound) -> Option<String> {
+    let blind = |b: &crate::sensors::BoundLidar| {
+        log.scans.get(&b.topic).is_none_or(|t| !t.readings.could_observe(&b.lidar.model))
+    };
+    if !bound.lidars.iter().all(blind) {
+        return None;
+    }
+    let b = &bound.lidars[0];
+    let (scans, r) = log.scans.get(&b.topic).map_or((0, Default::default()), |t| (t.stamps.len(), t.readings));
+    let p = b.lidar.model.params();
+    Some(format!(
+        "no cell would be observed: no reading of the {scans} scans on `{}` is a return within min_range = {} m and \
+         max_range = {} m ({} readings below the messages' range_max{}; the others NaN, infinite, zero, negative or \
+         no-returns)",
+        b.topic,
+        p.min_range,
+        p.max_range,
+        r.returns,
+        if r.returns > 0 { format!(", from {} to {} m", r.nearest, r.farthest) } else { String::new() },
+    ))
 }
 
 /// Findings per stream: stamps going backwards or repeated, header stamps far from the

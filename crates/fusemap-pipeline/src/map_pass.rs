@@ -4,7 +4,7 @@
 //! at its own stamp and inserted into the engine's maps; then the notes and the report of
 //! what happened to them.
 
-use crate::camera::{build_camera, MappedCamera};
+use crate::camera::{build_camera, BuiltCamera, MappedCamera};
 use crate::extrinsics::frame_tree;
 use crate::insert::{release, Inserter, Mapped};
 use crate::lidar_frames::{lidar_setup, other_frames};
@@ -149,6 +149,23 @@ pub fn map_with_track(
     Ok(MapRun { engine, format: inv.format, report, trajectory, notes })
 }
 
+/// Opens the pass's streams as [`map_with_track`] does (each lidar's model and mount, each
+/// camera's intrinsics and images) and inserts nothing: the refusal, or the notes. `fusemap
+/// doctor` runs this, so it fails wherever `map` would before the first scan, for the
+/// same reason.
+pub(crate) fn check_streams(
+    plan: &Plan,
+    inv: &Inventory,
+    bound: &Bound,
+    track: &Track,
+) -> Result<Vec<String>, PipelineError> {
+    let (tree, mut notes) = frame_tree(&plan.log, &inv.tf_static, &inv.tf_dynamic);
+    let mut engine = Engine::new(FusionGrid::new(plan.geometry, plan.occupancy));
+    let input = Inputs { plan, inv, bound, track, tree: &tree };
+    Streams::open(&input, &mut engine, &mut notes)?;
+    Ok(notes)
+}
+
 impl Streams {
     /// Registers every lidar (one engine sensor per frame id its topic carries) and every
     /// camera with the engine and the merge, and the correlation groups of the plan.
@@ -174,9 +191,14 @@ impl Streams {
                 notes,
             );
             let (model, report) = match built {
-                Ok(b) => b,
-                // A camera the config did not ask for never stops a run: the log is mapped
+                Ok(BuiltCamera::Ready(b)) => *b,
+                // Streams that are there but unusable never stop a run the lidar maps, nor
+                // does any fault of a camera the config did not ask for: the log is mapped
                 // without it, and the note says why.
+                Ok(BuiltCamera::Unusable(why)) => {
+                    notes.push(format!("camera `{}` is not mapped, the other sensors are: {why}", c.name));
+                    continue;
+                }
                 Err(e) if !c.explicit => {
                     notes.push(format!("the camera found on `{}` is not mapped: {e}", c.topic));
                     continue;

@@ -39,11 +39,67 @@ pub struct ScanTopic {
     /// The finite poses on the scan lines in file order, each with its stamp (24 + 8
     /// bytes a scan, for the pose-glitch check).
     pub line_poses: Vec<(Stamp, Pose2)>,
+    /// The span of the readings that can be returns.
+    pub readings: ReadingSpan,
+}
+
+/// What a scan topic's readings could observe: the readings that can be returns (finite,
+/// positive, at or above the message's `range_min` and below its `range_max` where it
+/// states them) with the nearest and the farthest, and the no-returns (finite, at or
+/// beyond `range_max`). Kept so that `doctor`, which maps nothing, can tell a topic that
+/// could observe no cell (every reading NaN, infinite, zero or a no-return) as `map`
+/// would find it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReadingSpan {
+    /// Readings that can be returns.
+    pub returns: u64,
+    /// The nearest of them, metres.
+    pub nearest: f32,
+    /// The farthest of them, metres.
+    pub farthest: f32,
+    /// Finite readings at or beyond the message's `range_max`.
+    pub no_returns: u64,
+}
+
+impl ReadingSpan {
+    /// Takes one scan's readings in.
+    fn add(&mut self, ranges: &[f32], range_min: f32, range_max: f32) {
+        let stated = |v: f32| v.is_finite() && v > 0.0;
+        let min = if stated(range_min) { range_min } else { 0.0 };
+        let max = if stated(range_max) { range_max } else { f32::INFINITY };
+        for &r in ranges {
+            if !r.is_finite() || r <= 0.0 {
+                continue;
+            }
+            if r >= max {
+                self.no_returns += 1;
+            } else if r >= min {
+                if self.returns == 0 {
+                    (self.nearest, self.farthest) = (r, r);
+                }
+                self.returns += 1;
+                self.nearest = self.nearest.min(r);
+                self.farthest = self.farthest.max(r);
+            }
+        }
+    }
+
+    /// False when `model` would take no reading as evidence: no return inside its
+    /// `[min_range, max_range)`, and no no-return its `clear` policy would use.
+    pub fn could_observe(&self, model: &fusemap_core::sensor::lidar::LidarModel) -> bool {
+        let p = model.params();
+        let clears = p.max_range_policy == fusemap_core::sensor::lidar::MaxRangePolicy::Clear;
+        if clears && self.returns + self.no_returns > 0 {
+            return true;
+        }
+        self.returns > 0 && f64::from(self.nearest) < p.max_range && f64::from(self.farthest) >= p.min_range
+    }
 }
 
 impl ScanTopic {
     /// Takes a scan's stamps, frame id and line pose into the inventory.
     fn add(&mut self, s: ScanMessage) {
+        self.readings.add(&s.scan.ranges, s.range_min, s.range_max);
         self.stamps.push(s.scan.stamp);
         self.receive.push(s.receive_stamp);
         *self.frames.entry(s.frame_id).or_default() += 1;
@@ -476,4 +532,35 @@ pub fn for_each_range_message(
         }
     }
     Ok(t0.elapsed().as_secs_f64())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ReadingSpan;
+    use fusemap_core::sensor::{LidarModel, LidarParams, MaxRangePolicy};
+
+    fn model(min_range: f64, max_range: f64, policy: MaxRangePolicy) -> LidarModel {
+        let p = LidarParams { min_range, max_range, max_range_policy: policy, ..Default::default() };
+        LidarModel::new(p, Default::default())
+    }
+
+    #[test]
+    fn a_span_tells_returns_from_readings_that_observe_nothing() {
+        let mut s = ReadingSpan::default();
+        s.add(&[f32::NAN, f32::INFINITY, 0.0, -1.0, 81.91, 81.91], 0.0, 81.91);
+        assert_eq!((s.returns, s.no_returns), (0, 2));
+        let skip = model(0.1, 10.0, MaxRangePolicy::Skip);
+        assert!(!s.could_observe(&skip));
+        // The no-returns clear free space under the `clear` policy.
+        assert!(s.could_observe(&model(0.1, 10.0, MaxRangePolicy::Clear)));
+        // Readings below the message's range_min are no returns of either kind.
+        s.add(&[0.05], 0.1, 81.91);
+        assert_eq!(s.returns, 0);
+        s.add(&[3.0, 12.0], 0.0, f32::NAN);
+        assert_eq!((s.returns, s.nearest, s.farthest), (2, 3.0, 12.0));
+        assert!(s.could_observe(&skip));
+        // Every return beyond the model's max_range, or below its min_range: nothing.
+        assert!(!s.could_observe(&model(0.1, 2.5, MaxRangePolicy::Skip)));
+        assert!(!s.could_observe(&model(20.0, 30.0, MaxRangePolicy::Skip)));
+    }
 }
