@@ -178,6 +178,13 @@ impl Default for EstimatorConfig {
     }
 }
 
+/// The largest standard deviation (or noise density) a key may give, in its own unit:
+/// the filter carries its square and multiplies that by elapsed times, distances and
+/// other variances, and 10¹² keeps every such product far inside an `f64`, where
+/// 10³⁰⁰ overflowed at the first prediction. A million metres, radians or a scale of
+/// a million is already no information at all.
+pub const MAX_SIGMA: f64 = 1e6;
+
 impl EstimatorConfig {
     /// Checks every field; the error names the first bad one in its TOML path
     /// (`estimator.gate_probability`).
@@ -237,6 +244,36 @@ impl EstimatorConfig {
                 ));
             }
         }
+        let sigmas = [
+            ("gyro_rate_sigma", self.gyro_rate_sigma),
+            ("initial_position_sigma_m", self.initial_position_sigma_m),
+            ("initial_gyro_bias_sigma", self.initial_gyro_bias_sigma),
+            ("initial_scale_sigma", self.initial_scale_sigma),
+            ("fallback_fix_sigma_m", self.fallback_fix_sigma_m),
+            ("fallback_heading_sigma_rad", self.fallback_heading_sigma_rad),
+            ("fallback_pose_sigma_m", self.fallback_pose_sigma_m),
+            ("fallback_pose_sigma_rad", self.fallback_pose_sigma_rad),
+            ("slip_sigma", self.slip_sigma),
+            ("odometry_translation_noise", self.odometry_translation_noise),
+            ("odometry_translation_noise_per_sqrt_s", self.odometry_translation_noise_per_sqrt_s),
+            ("odometry_rotation_noise_per_rad", self.odometry_rotation_noise_per_rad),
+            ("odometry_rotation_noise_per_m", self.odometry_rotation_noise_per_m),
+            ("gap_speed_sigma_mps", self.gap_speed_sigma_mps),
+            ("heading_noise_per_sqrt_s", self.heading_noise_per_sqrt_s),
+            ("gyro_bias_random_walk", self.gyro_bias_random_walk),
+            ("odometry_scale_random_walk", self.odometry_scale_random_walk),
+        ];
+        for (name, v) in sigmas {
+            if v > MAX_SIGMA {
+                return Err(FieldError::new(
+                    format!("estimator.{name}"),
+                    format!(
+                        "is a standard deviation of at most {MAX_SIGMA:e} (got {v}): the filter squares it, and \
+                         a larger one is no information at all, not a noise level"
+                    ),
+                ));
+            }
+        }
         if !(self.gate_probability > 0.0 && self.gate_probability < 1.0) {
             return Err(FieldError::new(
                 "estimator.gate_probability",
@@ -266,6 +303,10 @@ mod tests {
         assert_eq!(cfg.validate().unwrap_err().field, "estimator.gyro_rate_sigma");
         let cfg = EstimatorConfig { odometry_translation_noise: -1.0, ..Default::default() };
         assert_eq!(cfg.validate().unwrap_err().field, "estimator.odometry_translation_noise");
+        let cfg = EstimatorConfig { initial_scale_sigma: 1e300, ..Default::default() };
+        assert_eq!(cfg.validate().unwrap_err().field, "estimator.initial_scale_sigma");
+        let cfg = EstimatorConfig { gyro_bias_random_walk: MAX_SIGMA, ..Default::default() };
+        assert_eq!(cfg.validate(), Ok(()));
         let cfg = EstimatorConfig { slip_noise_inflation: 0.5, ..Default::default() };
         assert_eq!(cfg.validate().unwrap_err().field, "estimator.slip_noise_inflation");
     }
