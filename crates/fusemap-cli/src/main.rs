@@ -198,7 +198,8 @@ fn format_chain(e: &anyhow::Error) -> String {
             s.push_str(&c);
         }
     }
-    // One line, and nothing a log wrote into a name (escape sequences, NUL) reaches the
-    // terminal as itself.
-    fusemap_io::text::printable(&s.replace('\n', " ")).into_owned()
+    // One line, numbers a reader can take in, and nothing a log wrote into a name (escape
+    // sequences, NUL) reaches the terminal as itself.
+    let s = fusemap_io::text::compact_numbers(&s).replace('\n', " ");
+    fusemap_io::text::printable(&s).into_owned()
 }

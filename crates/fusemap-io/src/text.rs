@@ -30,6 +30,47 @@ pub fn printable(s: &str) -> Cow<'_, str> {
     Cow::Owned(out)
 }
 
+/// `s` with every number written out to more than 24 characters (Rust and the TOML
+/// parser print an `f64` in full: 1e300 as 301 digits, 1e-300 as 302) put in scientific
+/// notation, the shortest form that reads back as the same `f64`. Borrowed when there is
+/// none.
+pub fn compact_numbers(s: &str) -> Cow<'_, str> {
+    const LONG: usize = 24;
+    let b = s.as_bytes();
+    let mut out = String::new();
+    let (mut copied, mut i) = (0, 0);
+    while i < b.len() {
+        let starts = b[i].is_ascii_digit() && (i == 0 || !(b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'.'));
+        if !starts {
+            i += 1;
+            continue;
+        }
+        let mut end = i;
+        while end < b.len() && b[end].is_ascii_digit() {
+            end += 1;
+        }
+        if end + 1 < b.len() && b[end] == b'.' && b[end + 1].is_ascii_digit() {
+            end += 1;
+            while end < b.len() && b[end].is_ascii_digit() {
+                end += 1;
+            }
+        }
+        if end - i > LONG {
+            if let Ok(v) = s[i..end].parse::<f64>() {
+                out.push_str(&s[copied..i]);
+                let _ = write!(out, "{v:e}");
+                copied = end;
+            }
+        }
+        i = end;
+    }
+    if copied == 0 {
+        return Cow::Borrowed(s);
+    }
+    out.push_str(&s[copied..]);
+    Cow::Owned(out)
+}
+
 /// [`printable`], with `|` escaped too: for a cell of a Markdown table, where a `|` from
 /// the log would split the row.
 pub fn table_cell(s: &str) -> Cow<'_, str> {
@@ -41,6 +82,21 @@ pub fn table_cell(s: &str) -> Cow<'_, str> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn long_numbers_are_put_in_scientific_notation() {
+        use super::compact_numbers;
+        let huge = format!("got {}, over", 1e300);
+        assert_eq!(compact_numbers(&huge), "got 1e300, over");
+        let tiny = format!("got {} m", 1e-300);
+        assert_eq!(compact_numbers(&tiny), "got 1e-300 m");
+        let toml = format!("floating point `{:.1}`, expected usize", 1e300);
+        assert_eq!(compact_numbers(&toml), "floating point `1e300`, expected usize");
+        // Stamps in nanoseconds, line numbers, hashes and names stay as they are.
+        for s in ["at stamp 1000050000000 ns", "robot.toml:6: x", "id a1234567890123456789012345678", "v1.2.3"] {
+            assert!(matches!(compact_numbers(s), std::borrow::Cow::Borrowed(_)), "{s}");
+        }
+    }
+
     use super::*;
 
     #[test]
