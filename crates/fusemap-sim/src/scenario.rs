@@ -146,15 +146,20 @@ pub const MAX_BEAMS: f64 = 5e7;
 /// (the longest run) at 20 m/s.
 pub const MAX_LOOP_M: f64 = 1e5;
 
+/// The longest look-ahead of the robot's path follower, metres.
+pub const MAX_LOOKAHEAD_M: f64 = 20.0;
+
 impl Scenario {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), FieldError> {
         let w = &self.world;
         w.extent.check("world.extent")?;
-        if w.start_time_s.unsigned_abs() > 9_000_000_000 {
+        // The bag's log times are unsigned nanoseconds since 1970 (MCAP), and stamps must
+        // fit an i64 of nanoseconds.
+        if !(0..=9_000_000_000).contains(&w.start_time_s) {
             return Err(FieldError::new(
                 "world.start_time_s",
-                format!("must lie within ±9e9 s (year 2255), got {}", w.start_time_s),
+                format!("must lie within 0 (1970) and 9e9 s (year 2255), got {}", w.start_time_s),
             ));
         }
         for (i, o) in w.objects.iter().enumerate() {
@@ -183,6 +188,15 @@ impl Scenario {
         }
         non_negative("robot.corner_radius_m", r.corner_radius_m)?;
         positive("robot.lookahead_m", r.lookahead_m)?;
+        // A pure-pursuit look-ahead is a few metres: past 20 m the robot cuts every corner
+        // of a hall, and the controller's search for its place on the path, which spans
+        // twice the look-ahead at every step, grows with it (10^300 m never ended).
+        if r.lookahead_m > MAX_LOOKAHEAD_M {
+            return Err(FieldError::new(
+                "robot.lookahead_m",
+                format!("must be at most {MAX_LOOKAHEAD_M} m, got {}", r.lookahead_m),
+            ));
+        }
         if r.waypoints.len() < 3 || r.waypoints.iter().flatten().any(|v| !v.is_finite()) {
             return Err(FieldError::new("robot.waypoints", "needs at least 3 finite points (a closed loop)"));
         }
@@ -267,6 +281,13 @@ mod tests {
         let mut s = Scenario::default();
         s.world.start_time_s = i64::MAX;
         assert!(s.validate().unwrap_err().to_string().starts_with("world.start_time_s"));
+        s.world.start_time_s = -1;
+        assert!(s.validate().unwrap_err().to_string().starts_with("world.start_time_s"));
+        s.world.start_time_s = 0;
+        s.robot.lookahead_m = 1e300;
+        assert!(s.validate().unwrap_err().to_string().starts_with("robot.lookahead_m"));
+        s.robot.lookahead_m = MAX_LOOKAHEAD_M;
+        assert_eq!(s.validate(), Ok(()));
         let mut s = Scenario::default();
         s.robot.duration_s = 3_600.0;
         s.lidar.beams = 2_000;
