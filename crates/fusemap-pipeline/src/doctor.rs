@@ -354,6 +354,12 @@ fn unobservable(log: &Inventory, bound: &crate::sensors::Bound) -> Option<String
     }
     let b = &bound.lidars[0];
     let (scans, r) = log.scans.get(&b.topic).map_or((0, Default::default()), |t| (t.stamps.len(), t.readings));
+    if let Some((n, Some(why))) = log.scans.get(&b.topic).map(|t| &t.angle_faults).filter(|f| f.0 as usize == scans) {
+        return Some(format!(
+            "no cell would be observed: the angles of all {n} scans on `{}` are unusable; the first: {why}",
+            b.topic
+        ));
+    }
     let p = b.lidar.model.params();
     Some(format!(
         "no cell would be observed: no reading of the {scans} scans on `{}` is a return within min_range = {} m and \

@@ -39,8 +39,11 @@ pub struct ScanTopic {
     /// The finite poses on the scan lines in file order, each with its stamp (24 + 8
     /// bytes a scan, for the pose-glitch check).
     pub line_poses: Vec<(Stamp, Pose2)>,
-    /// The span of the readings that can be returns.
+    /// The span of the readings that can be returns (of the scans with usable angles).
     pub readings: ReadingSpan,
+    /// Scans whose angles cannot be used (`ScanMessage::angle_fault`), with the first
+    /// reason: the mapping pass skips them.
+    pub angle_faults: (u64, Option<String>),
 }
 
 /// What a scan topic's readings could observe: the readings that can be returns (finite,
@@ -99,7 +102,13 @@ impl ReadingSpan {
 impl ScanTopic {
     /// Takes a scan's stamps, frame id and line pose into the inventory.
     fn add(&mut self, s: ScanMessage) {
-        self.readings.add(&s.scan.ranges, s.range_min, s.range_max);
+        match s.angle_fault() {
+            Some(why) => {
+                self.angle_faults.0 += 1;
+                self.angle_faults.1.get_or_insert(why);
+            }
+            None => self.readings.add(&s.scan.ranges, s.range_min, s.range_max),
+        }
         self.stamps.push(s.scan.stamp);
         self.receive.push(s.receive_stamp);
         *self.frames.entry(s.frame_id).or_default() += 1;
