@@ -9,7 +9,8 @@ import random
 import struct
 import zlib
 
-from corpus_base import REPO, WORLD, case, carmen_lines, flaser, log_case, odom, text
+from corpus_base import (BAG_SECTIONS, REPO, WORLD, case, carmen_lines, example_numeric_keys, flaser, log_case, odom,
+                         text)
 
 
 # ---------------------------------------------------------------------------------------
@@ -153,37 +154,26 @@ def config_case(name: str, body: str, expect: str = "error", names=(), names_con
 
 
 def config_cases() -> None:
-    example = (REPO / "configs" / "example.toml").read_text()
-    lines = example.split("\n")
-    numeric = []
-    for i, line in enumerate(lines):
-        s = line.strip()
-        if s.startswith("#") or "=" not in s or s.startswith("["):
-            continue
-        key, value = (p.strip() for p in s.split("=", 1))
-        value = value.split("#")[0].strip()
-        try:
-            float(value)
-        except ValueError:
-            continue
-        numeric.append((i, key))
-    section = {}
-    current = ""
-    for i, line in enumerate(lines):
-        s = line.strip()
-        if s.startswith("["):
-            current = s.strip("[]")
-        section[i] = current
+    example, lines, numeric = example_numeric_keys()
     config_case("config/example-as-shipped", example, "map")
     seen = set()
-    for i, key in numeric:
-        name = f"config/nan-{section[i].replace('.', '-')}-{key}"
+    for i, key, section in numeric:
+        name = f"config/nan-{section.replace('.', '-')}-{key}"
         if name in seen:
             continue
         seen.add(name)
         mutated = list(lines)
         mutated[i] = f"{key} = nan"
         config_case(name, "\n".join(mutated), names=[f"{{case}}/robot.toml:{i + 1}:"])
+        # Values past any sensible range, each side: a map, or an error naming the file
+        # and the key, never a hang or an abort. (The sections a world does not exercise
+        # are swept over a bag: corpus_sensors.config_sweep.)
+        if section.split(".")[0] in BAG_SECTIONS:
+            continue
+        for label, value in (("minus-one", "-1"), ("1e300", "1e300")):
+            mutated[i] = f"{key} = {value}"
+            config_case(name.replace("/nan-", f"/{label}-"), "\n".join(mutated), "either",
+                        names=["{case}/robot.toml", key])
 
     config_case("config/toml-syntax", "[map\nresolution = 0.05\n", names=[":1:"])
     config_case("config/unknown-section", "[mapp]\nresolution = 0.05\n", names=[":1:", "mapp"])
@@ -332,6 +322,39 @@ def world_cases() -> None:
              "error", names=["{case}/big.toml", "larger than 4 MiB"], max_seconds=1.0)
     with open(d / "big.toml", "wb") as f:
         f.truncate(2 << 30)
+
+
+# Every numeric key of a scenario file: `simulate` writes its bag, or refuses with one
+# error naming the file and the key; never a hang, an abort or memory past the limit.
+SCENARIO_KEYS = {
+    "world": ["seed", "start_time_s"],
+    "robot": ["max_speed_mps", "max_turn_rate_radps", "duration_s", "corner_radius_m", "lookahead_m"],
+    "lidar": ["rate_hz", "beams", "fov_deg", "range_min_m", "range_max_m", "sweep_time_s", "range_noise_std_m",
+              "glass_pass_probability", "steel_flying_probability", "edge_mixed_probability", "edge_jump_m",
+              "dropout_probability", "time_offset_s"],
+    "odometry": ["rate_hz", "wheel_separation_m", "scale_error", "slip_factor_left", "slip_factor_right",
+                 "wheel_noise_std_mps", "time_offset_s"],
+    "imu": ["rate_hz", "gyro_bias_radps", "gyro_noise_std_radps", "time_offset_s"],
+    "gnss": ["rate_hz", "datum_lat_deg", "datum_lon_deg", "datum_alt_m", "good_sigma_m", "degraded_sigma_m",
+             "degraded_tau_s", "outlier_probability", "outlier_min_m", "outlier_max_m", "time_offset_s"],
+    "camera": ["rate_hz", "width", "height", "hfov_deg", "time_offset_s", "max_depth_m", "depth_sigma_k",
+               "label_noise_probability", "glass_depth_probability"],
+    "person": ["speed_mps", "radius_m", "height_m"],
+}
+
+
+def simulate_sweep() -> None:
+    for section, keys in SCENARIO_KEYS.items():
+        for key in keys:
+            for label, value in (("minus-one", "-1"), ("zero", "0"), ("1e300", "1e300")):
+                d = case(f"simulate/{label}-{section}-{key}", ["simulate", "{case}/s.toml", "--out", "{case}/out"],
+                         "either", names=["{case}/s.toml", key], max_seconds=10.0, writes="bag")
+                camera = "" if section == "camera" else "[camera]\nenabled = false\n"
+                head = "" if section == "robot" else "[robot]\nduration_s = 1.0\n"
+                body = f"{head}{camera}[{section}]\n{key} = {value}\n"
+                if section == "robot" and key != "duration_s":
+                    body = f"[robot]\nduration_s = 1.0\n{key} = {value}\n[camera]\nenabled = false\n"
+                (d / "s.toml").write_text(body)
 
 
 # ---------------------------------------------------------------------------------------

@@ -22,6 +22,7 @@ OUT_DIR (which must not exist yet, or be empty) receives one directory per case 
     notes    for "map": strings that one of the summary's notes must contain
     doctor   "fail" (doctor must exit 1: it reports what map refuses), "ok", "any",
              or absent (the case runs no doctor)
+    writes   optional: "bag" (`simulate`: success is a bag and its truth, not a map)
     setup    optional: "lock" (another process holds the output directory's lock),
              "fsize" (a file-size limit of 64 KiB stops the run as a full disk would),
              "good_run_first" (a good run fills `{case}/out` first; its files must
@@ -40,6 +41,7 @@ from pathlib import Path
 
 import corpus_base
 import corpus_ros
+import corpus_sensors
 import corpus_text
 
 
@@ -58,9 +60,11 @@ def main() -> int:
     corpus_text.carmen_cases()
     corpus_text.config_cases()
     corpus_text.world_cases()
+    corpus_text.simulate_sweep()
     corpus_ros.ros1_cases(tmp)
     corpus_ros.mcap_cases(tmp)
     corpus_ros.rosbag2_cases(tmp)
+    corpus_sensors.sensor_cases(tmp)
     corpus_text.output_cases()
     for c in corpus_base.CASES:
         c["dir"] = c["name"].replace("/", "__")

@@ -186,7 +186,13 @@ def check_case_in(fusemap: str, d: Path, c: dict) -> tuple[list[str], list[Run]]
     has_map = any(n.startswith("map.") for n in files)
     if expect == "either":
         expect = "map" if r.status == 0 else "error"
-    if expect == "map":
+    if expect == "map" and c.get("writes") == "bag":
+        # `simulate`: the bag and its truth.
+        if r.status != 0:
+            problems.append(f"expected a bag, got exit {r.status}: {r.stderr.strip()[-300:]}")
+        elif not (out / "bag" / "metadata.yaml").is_file() or "truth.yaml" not in files:
+            problems.append(f"exit 0 but the output holds {sorted(files)}")
+    elif expect == "map":
         if r.status != 0:
             problems.append(f"expected a map, got exit {r.status}: {r.stderr.strip()[-300:]}")
         elif not has_map or "summary.json" not in files:
@@ -221,7 +227,7 @@ def check_case_in(fusemap: str, d: Path, c: dict) -> tuple[list[str], list[Run]]
         if old_set and setup != "good_run_first":
             if files != old_set:
                 problems.append("a failed run changed the previous output set")
-        elif has_map:
+        elif has_map or "truth.yaml" in files:
             problems.append(f"a failed run left map files: {sorted(files)}")
     for rel in c.get("absent", []):
         if (d / rel).exists():
@@ -239,7 +245,7 @@ def check_case_in(fusemap: str, d: Path, c: dict) -> tuple[list[str], list[Run]]
             problems.append("doctor exits 0 on a log that map refuses")
         elif c["doctor"] == "ok" and dr.status != 0:
             problems.append(f"doctor fails on a log that map maps: {dr.stderr.strip()[-300:]}")
-        elif c["doctor"] == "any" and (dr.status == 0) != (r.status == 0) and c["expect"] != "no_map":
+        elif c["doctor"] == "any" and (dr.status == 0) != (r.status == 0):
             problems.append(f"doctor exits {dr.status} but map exits {r.status}")
     return problems, runs
 
