@@ -6,7 +6,9 @@
 //! is staged in one output set and moves into the output directory together.
 
 use crate::job::{plan_of_or, JobError};
-use crate::outputs::{finish, layers_of, prepare, ExportOptions, OutputFiles, RunRecord, Summary};
+use crate::outputs::{
+    finish, layers_of, prepare, view_of, ExportOptions, ExportRoom, MapView, OutputFiles, RunRecord, Summary,
+};
 use crate::scenario::{production_line_plan, score, three_maps, MapScore, Truth};
 use crate::Progress;
 use fusemap_core::config::Plan;
@@ -51,11 +53,15 @@ impl DemoJob {
         let started = Instant::now();
         let (plan, out) = (&self.plan, &self.out);
         let mut files = prepare(out, &self.inputs)?;
-        let rec = simulate(&Scenario::default())?;
+        let mut rec = simulate(&Scenario::default())?;
         files.own_dir("sim");
         let sim_dir = files.staged("sim");
-        let sim = fusemap_sim::bag::write_simulation(&rec, &sim_dir, plan.geometry.resolution(), true)
+        let memory = plan.limits.memory_bytes();
+        let sim = fusemap_sim::bag::write_simulation(&rec, &sim_dir, plan.geometry.resolution(), true, memory)
             .map_err(|source| JobError::Simulation { dir: sim_dir.clone(), source })?;
+        // The messages (most of them images) are in the bag now, which the run reads back;
+        // the truth needs only the world and the tracks.
+        rec.messages = Vec::new();
         let inv = crate::recording::Inventory::read_with(&sim.bag.dir, &plan.limits)?;
         let (bound, chosen, track_s) = crate::run::prepare(plan, &inv)?;
         let run = crate::map_with_track(plan, &inv, &bound, chosen, track_s, Some(three_maps(plan)), progress)?;
@@ -75,10 +81,12 @@ impl DemoJob {
         log["scenario_scores"] = serde_json::to_value(&scores)?;
         let bag_in_out = out.join(sim.bag.dir.strip_prefix(files.staged("")).unwrap_or(&sim.bag.dir));
         let source = format!("built-in production line, simulated to {}", bag_in_out.display());
+        let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
         let mut other_maps = Vec::new();
+        let mut notes = run.notes.clone();
         for m in run.engine.maps().iter().skip(1) {
             files.own_dir(m.name());
-            write_map_files(&files.staged(m.name()), &run.engine, m)?;
+            write_map_files(&files.staged(m.name()), &run.engine, m, &export, &mut notes)?;
             other_maps.push(m.name().to_string());
         }
         write_comparison(&files.staged("comparison.png"), &run.engine, &scores, &truth_occupancy, plan)?;
@@ -86,22 +94,38 @@ impl DemoJob {
             source_kind: "rosbag2 (simulated production line)",
             source: &source,
             started,
-            notes: run.notes.clone(),
+            notes,
             log: Some(log),
             trajectory: Some(&run.trajectory),
         };
-        let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
         let summary = finish(&run.engine, files, &export, record)?;
         Ok(DemoRun { summary, scores, other_maps })
     }
 }
 
 /// Writes a map of the set (not the primary) as map.npz, map.pgm + map.yaml, map.png, and
-/// its semantic and dynamic layers when it has them.
-fn write_map_files(dir: &Path, engine: &Engine, m: &MapEntry) -> Result<(), JobError> {
+/// its semantic and dynamic layers when it has them; sparsely (map.npz of its tiles and an
+/// overview map.png) where the primary's limits would write it so, with a note.
+fn write_map_files(
+    dir: &Path,
+    engine: &Engine,
+    m: &MapEntry,
+    export: &ExportOptions,
+    notes: &mut Vec<String>,
+) -> Result<(), JobError> {
     std::fs::create_dir_all(dir).map_err(|e| fusemap_io::Error::io(dir, e))?;
     let files = OutputFiles::in_dir(dir);
-    let Some(raster) = m.grid().known_raster() else { return Ok(()) };
+    let mut why = Vec::new();
+    let raster = match view_of(m.grid(), export, ExportRoom::of(engine.export_room(m)), &mut why)? {
+        MapView::Empty => return Ok(()),
+        MapView::Sparse { tiles, overview, .. } => {
+            notes.extend(why.into_iter().map(|n| format!("map `{}`: {n}", m.name())));
+            fusemap_io::npz::write_sparse_map_npz(&files.npz, &tiles)?;
+            fusemap_io::picture::write_map_png(&files.png, &overview)?;
+            return Ok(());
+        }
+        MapView::Dense(r) => r,
+    };
     let layers = layers_of(engine, m.grid(), &raster).filter(|l| l.semantic.best.iter().any(|&b| b >= 0));
     match &layers {
         Some(l) => {

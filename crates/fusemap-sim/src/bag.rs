@@ -7,6 +7,7 @@
 //! Scenario files are TOML mapping one to one onto
 //! [`crate::Scenario`]; unknown keys are errors naming their line.
 
+use crate::recording::TRUTH_BYTES_PER_CELL;
 use crate::{Scenario, SimMessage, SimRecording, TruthRasterError, TruthSemantic, CLASS_COLORS, CLASS_NAMES};
 use fusemap_core::grid::logodds::logit;
 use fusemap_core::grid::{GridGeometry, OccupancyParams, Raster};
@@ -140,9 +141,16 @@ pub struct SimulationFiles {
 /// Writes the bag (`out/bag`), the true map (`out/truth.yaml` + `.pgm`, at `resolution`),
 /// the true classes (`out/truth_semantic.yaml` + `.png`) and the true trajectory
 /// (`out/truth.tum`). The truth is rastered first: a resolution the world cannot be
-/// rastered at (too many cells, or not a resolution) is an error before anything is
-/// written, never a run without its truth.
-pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwrite: bool) -> Result<SimulationFiles> {
+/// rastered at (too many cells, not a resolution, or more bytes than `memory_bytes`
+/// leaves beside the recording, [`TRUTH_BYTES_PER_CELL`] a cell) is an error before
+/// anything is written, never a run without its truth.
+pub fn write_simulation(
+    rec: &SimRecording,
+    out: &Path,
+    resolution: f64,
+    overwrite: bool,
+    memory_bytes: u64,
+) -> Result<SimulationFiles> {
     let no_truth = |why: String| {
         fusemap_io::Error::format(
             &out.join("truth.yaml"),
@@ -151,6 +159,17 @@ pub fn write_simulation(rec: &SimRecording, out: &Path, resolution: f64, overwri
         )
     };
     let geometry = GridGeometry::centered(resolution).map_err(|e| no_truth(e.to_string()))?;
+    let cells = rec.truth_cells(geometry).map_err(|e| no_truth(e.to_string()))?;
+    let (truth, held) = (cells.saturating_mul(TRUTH_BYTES_PER_CELL as u128), rec.held_bytes());
+    if truth.saturating_add(held as u128) > memory_bytes as u128 {
+        return Err(no_truth(format!(
+            "its {cells} cells take {} MiB while written, and with the recording's {} MiB that is over the \
+             memory budget of {} MiB (limits.memory_mib)",
+            truth >> 20,
+            held >> 20,
+            memory_bytes >> 20
+        )));
+    }
     let raster = truth_raster(rec, geometry).map_err(|e| no_truth(e.to_string()))?;
     let semantic = rec.truth_semantic(geometry).map_err(|e| no_truth(e.to_string()))?;
     std::fs::create_dir_all(out).map_err(|e| fusemap_io::Error::io(out, e))?;
@@ -205,7 +224,7 @@ mod tests {
         s.camera.enabled = false;
         let rec = crate::simulate(&s).unwrap();
         let dir = fusemap_io::testdata::temp_dir("sim-semantic");
-        let files = write_simulation(&rec, &dir, 0.1, false).unwrap();
+        let files = write_simulation(&rec, &dir, 0.1, false, u64::MAX).unwrap();
         let yaml = std::fs::read_to_string(files.truth_semantic).unwrap();
         assert!(yaml.contains("image: truth_semantic.png\nresolution: 0.1\n"), "{yaml}");
         assert!(yaml.contains("{id: 3, name: glass, color: [80, 200, 230]}"), "{yaml}");
@@ -234,7 +253,10 @@ mod tests {
         let rec = crate::simulate(&s).unwrap();
         let dir = fusemap_io::testdata::temp_dir("sim-too-fine");
         for resolution in [1e-9, 0.0, f64::NAN] {
-            let e = write_simulation(&rec, &dir.join("out"), resolution, false).err().expect("refused").to_string();
+            let e = write_simulation(&rec, &dir.join("out"), resolution, false, u64::MAX)
+                .err()
+                .expect("refused")
+                .to_string();
             assert!(e.contains("truth.yaml") && e.contains("no true map at resolution"), "{e}");
             assert!(!dir.join("out").exists(), "nothing written for {resolution}");
         }

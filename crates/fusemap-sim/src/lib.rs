@@ -86,7 +86,9 @@ pub use messages::{
 };
 pub use path::{rounded_loop, Approach, Trajectory, TruthSample, TRUTH_RATE_HZ};
 pub use person::{ray_circle, PersonConfig};
-pub use recording::{segment_meets_box, SimRecording, TruthRaster, TruthRasterError, MAX_TRUTH_CELLS};
+pub use recording::{
+    segment_meets_box, SimRecording, TruthRaster, TruthRasterError, MAX_TRUTH_CELLS, TRUTH_BYTES_PER_CELL,
+};
 pub use scenario::{FramesConfig, RobotConfig, Scenario, WorldConfig};
 pub use semantic_truth::TruthSemantic;
 pub use sensors::{DropoutMode, GnssConfig, GnssZone, ImuConfig, LidarConfig, OdometryConfig, ZoneKind};

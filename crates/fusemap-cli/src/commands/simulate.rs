@@ -16,7 +16,9 @@ pub fn run(scenario: Option<&Path>, out: &Path, resolution: f64, overwrite: bool
         fusemap_io::atomic::ensure_not_input(&out.join("bag"), &[p.to_path_buf()])?;
     }
     let rec = simulate(&s).map_err(|e| anyhow::anyhow!("scenario: {e}"))?;
-    let files = fusemap_sim::bag::write_simulation(&rec, out, resolution, overwrite)
+    // The memory budget of a run with default limits: `simulate` reads no config.
+    let memory = fusemap_core::config::LimitsConfig::default().memory_bytes();
+    let files = fusemap_sim::bag::write_simulation(&rec, out, resolution, overwrite, memory)
         .with_context(|| format!("writing the simulation to {}", out.display()))?;
     println!("bag           {} ({} messages)", super::shown(&files.bag.dir), files.bag.message_count);
     for t in &files.bag.topics {

@@ -12,6 +12,13 @@
 //! budget whichever map grows first; the tile stores refuse to allocate past it (see
 //! [`TileMap`](crate::grid::TileMap)) and the engine stops the run after the observation
 //! that met it.
+//!
+//! The rasters a map is exported as count too: the maps are written one after another
+//! while all of them are held, so each tile also reserves what one map's export takes a
+//! tile (the largest among the maps, [`export_bytes_per_cell`]). The tiles of a map
+//! therefore always fit their export as stored; a dense raster of the observed box, which
+//! also covers the cells between the tiles, is written only where the room left
+//! ([`Engine::export_room`](super::Engine::export_room)) holds it.
 
 use crate::config::LimitsConfig;
 use crate::grid::{DynamicBlock, FusionLayers, GroupBlock, MapTile, TileKey, TILE_CELLS};
@@ -40,6 +47,21 @@ impl TileLayers {
         let group = if self.correlated { size_of::<GroupBlock>() } else { 0 };
         size_of::<MapTile<FusionLayers>>() + store + semantic + dynamic + group
     }
+
+    /// Bytes one tile of such a map takes exported.
+    pub fn export_bytes(&self) -> usize {
+        TILE_CELLS * export_bytes_per_cell(self.semantic_classes)
+    }
+}
+
+/// Bytes a dense export of one cell takes while it is written: the raster's log-odds and
+/// known flag (5), the writers' buffers (4: measured, the corridor world at 1 mm and at
+/// 2.5 mm peaked 8–9 bytes a cell of raster above its tiles), and with a semantic layer
+/// its best class, probability and per-class probabilities (2 + 4 + 4 a class), the
+/// dynamic layer's probability (4) and their pictures' pixels (4).
+pub fn export_bytes_per_cell(semantic_classes: usize) -> usize {
+    let semantic = if semantic_classes > 0 { 2 + 4 + 4 * semantic_classes + 4 + 4 } else { 0 };
+    5 + 4 + semantic
 }
 
 /// Which limit bounds the maps.
@@ -57,7 +79,8 @@ pub(super) struct MapBudget {
     pub limits: LimitsConfig,
     /// Tiles each map may hold.
     pub tiles: usize,
-    /// Bytes a tile of all the maps together can hold (one tile of each map).
+    /// Bytes a tile of all the maps together can hold (one tile of each map), with the
+    /// largest map's export of a tile.
     pub bytes_per_tile: usize,
     /// The limit that sets `tiles`.
     pub key: BudgetKey,
@@ -66,7 +89,8 @@ pub(super) struct MapBudget {
 impl MapBudget {
     /// The budget for maps whose tiles carry `layers` (one entry a map).
     pub fn new(limits: LimitsConfig, layers: &[TileLayers]) -> Self {
-        let bytes_per_tile = layers.iter().map(TileLayers::tile_bytes).sum::<usize>().max(1);
+        let export = layers.iter().map(TileLayers::export_bytes).max().unwrap_or(0);
+        let bytes_per_tile = (layers.iter().map(TileLayers::tile_bytes).sum::<usize>() + export).max(1);
         let by_memory = usize::try_from(limits.memory_bytes() / bytes_per_tile as u64).unwrap_or(usize::MAX).max(1);
         let by_cells = limits.map_tiles();
         let (tiles, key) =
@@ -90,9 +114,12 @@ mod tests {
         let limits = LimitsConfig { memory_mib: 64, ..Default::default() };
         let one = MapBudget::new(limits, &[plain]);
         assert_eq!(one.key, BudgetKey::MemoryMib);
-        assert_eq!(one.tiles, (64 << 20) / a);
-        // Two maps share the budget.
-        assert_eq!(MapBudget::new(limits, &[plain, plain]).tiles, (64 << 20) / (2 * a));
+        let export = plain.export_bytes();
+        assert_eq!(export, 9 * TILE_CELLS);
+        assert_eq!(one.tiles, (64 << 20) / (a + export));
+        // Two maps share the budget; they are exported one at a time.
+        assert_eq!(MapBudget::new(limits, &[plain, plain]).tiles, (64 << 20) / (2 * a + export));
+        assert_eq!(full.export_bytes(), (9 + 14 + 80) * TILE_CELLS);
         // A cell cap below the memory's takes over.
         let cells = MapBudget::new(LimitsConfig { map_cells: 10 * 4096, ..limits }, &[full]);
         assert_eq!((cells.tiles, cells.key), (10, BudgetKey::MapCells));

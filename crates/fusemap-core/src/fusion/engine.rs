@@ -191,6 +191,18 @@ impl Engine {
         }
     }
 
+    /// Bytes `[limits] memory_mib` leaves for exporting one map beside the tiles all the
+    /// maps hold now, and the bytes a cell of `map`'s dense export takes (see `budget.rs`);
+    /// `None` without limits. A map's tiles always fit it; a dense raster of its observed
+    /// box may not.
+    pub fn export_room(&self, map: &MapEntry) -> Option<(u64, usize)> {
+        let b = self.budget?;
+        let held: u64 =
+            self.maps.iter().map(|m| (m.grid().tile_count() * self.tile_layers(m).tile_bytes()) as u64).sum();
+        let per_cell = super::budget::export_bytes_per_cell(self.tile_layers(map).semantic_classes);
+        Some((b.limits.memory_bytes().saturating_sub(held), per_cell))
+    }
+
     /// The layers `map`'s tiles may come to carry.
     fn tile_layers(&self, map: &MapEntry) -> TileLayers {
         let semantic_classes = (self.sensors.iter().enumerate())

@@ -75,7 +75,13 @@ fn a_camera_with_many_classes_and_the_dynamic_layer_shrink_the_tiles_a_map_may_h
     let lidar_only = e.budget.expect("set").tiles;
     e.set_dynamic(crate::grid::DynamicParams::default(), false);
     let dynamic = e.budget.expect("set").tiles;
-    assert!(dynamic < lidar_only / 3, "{dynamic} vs {lidar_only}");
+    // Each tile also reserves its export (see budget.rs), the same for both.
+    use crate::fusion::budget::TileLayers;
+    let bytes = |l: TileLayers| l.tile_bytes() + l.export_bytes();
+    let memory = LimitsConfig::default().memory_bytes() as usize;
+    assert_eq!(lidar_only, memory / bytes(TileLayers::default()));
+    assert_eq!(dynamic, memory / bytes(TileLayers { dynamic: true, ..Default::default() }));
+    assert!(3 * dynamic < 2 * lidar_only, "{dynamic} vs {lidar_only}");
 }
 
 mod observed {

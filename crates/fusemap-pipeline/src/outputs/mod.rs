@@ -11,7 +11,7 @@ pub mod write;
 
 pub use set::{prepare, OutputFiles, Outputs};
 pub use summary::Summary;
-pub use view::{crop_area, parse_crop, Crop, ExportOptions, MapView};
+pub use view::{crop_area, parse_crop, view_of, Crop, ExportOptions, ExportRoom, MapView};
 pub use write::{finish, layers_of, Layers, RunRecord};
 
 use std::path::PathBuf;

@@ -101,16 +101,58 @@ pub fn crop_area(geometry: &GridGeometry, c: &Crop, limit: u64) -> Result<CellBo
     Ok(area)
 }
 
-/// Chooses the view of `grid` to export under `options`; a note says why when it is not
-/// the dense known box.
+/// The memory a dense export may take: the bytes `[limits] memory_mib` leaves beside the
+/// maps' tiles, and the bytes a cell of the raster (with its layers) takes
+/// ([`Engine::export_room`](fusemap_core::fusion::Engine::export_room)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExportRoom {
+    /// Bytes left.
+    pub bytes: u64,
+    /// Bytes a cell.
+    pub per_cell: usize,
+}
+
+impl ExportRoom {
+    /// The room of `(bytes, per_cell)`, as the engine gives it.
+    pub fn of(room: Option<(u64, usize)>) -> Option<Self> {
+        room.map(|(bytes, per_cell)| Self { bytes, per_cell })
+    }
+
+    /// Bytes `n` cells need.
+    fn needs(&self, n: u128) -> u128 {
+        n.saturating_mul(self.per_cell as u128)
+    }
+
+    /// True when `n` cells fit.
+    fn fits(&self, n: u128) -> bool {
+        self.needs(n) <= self.bytes as u128
+    }
+}
+
+/// Chooses the view of `grid` to export under `options`, within `room` when the run has a
+/// memory budget; a note says why when it is not the dense known box.
 pub fn view_of<L: ExtraLayers>(
     grid: &LayeredGrid<L>,
     options: &ExportOptions,
+    room: Option<ExportRoom>,
     notes: &mut Vec<String>,
 ) -> Result<MapView, OutputError> {
     let limit = options.export_cells;
     if let Some(c) = options.crop {
         let area = crop_area(grid.geometry(), &c, limit)?;
+        if let Some(r) = room.filter(|r| !r.fits(cells(area))) {
+            return Err(OutputError::Crop(format!(
+                "--crop {},{},{},{}: its {} cells need {} MiB as rasters, more than the {} MiB limits.memory_mib \
+                 leaves beside the maps; crop a smaller region or raise limits.memory_mib",
+                c.min.x,
+                c.min.y,
+                c.max.x,
+                c.max.y,
+                cells(area),
+                r.needs(cells(area)) >> 20,
+                r.bytes >> 20
+            )));
+        }
         let raster = grid.raster(area);
         if raster.known_count() == 0 {
             notes.push("no observed cell lies inside --crop: the map files are all unknown".into());
@@ -119,7 +161,8 @@ pub fn view_of<L: ExtraLayers>(
     }
     let Some(area) = grid.known_box() else { return Ok(MapView::Empty) };
     let n = cells(area);
-    if n <= limit as u128 {
+    let over_memory = room.filter(|r| !r.fits(n));
+    if n <= limit as u128 && over_memory.is_none() {
         return Ok(match grid.known_raster() {
             Some(r) => MapView::Dense(r),
             None => MapView::Empty,
@@ -127,11 +170,19 @@ pub fn view_of<L: ExtraLayers>(
     }
     let Some((overview, factor)) = grid.overview(OVERVIEW_SIDE) else { return Ok(MapView::Empty) };
     let tiles = grid.sparse_tiles();
+    let why = match over_memory {
+        Some(r) if n <= limit as u128 => format!(
+            "whose rasters need {} MiB, more than the {} MiB limits.memory_mib leaves beside the maps",
+            r.needs(n) >> 20,
+            r.bytes >> 20
+        ),
+        _ => format!("over limits.export_cells = {limit}"),
+    };
     notes.push(format!(
-        "the observed area spans {} x {} = {n} cells, over limits.export_cells = {limit}: the map is written \
+        "the observed area spans {} x {} = {n} cells, {why}: the map is written \
          sparsely (map.npz holds its {} tiles of 64 x 64 cells with their keys; map.png is an overview at one \
          pixel per {factor} x {factor} cells; no map.pgm/map.yaml); give --crop x0,y0,x1,y1 for a dense region, \
-         or raise limits.export_cells",
+         or raise the limit",
         area.width(),
         area.height(),
         tiles.keys.len()
@@ -169,10 +220,10 @@ mod tests {
         let g = two_sites(50.0);
         let mut notes = Vec::new();
         let within = ExportOptions { crop: None, export_cells: 1_000 };
-        assert!(matches!(view_of(&g, &within, &mut notes).unwrap(), MapView::Dense(_)));
+        assert!(matches!(view_of(&g, &within, None, &mut notes).unwrap(), MapView::Dense(_)));
         assert!(notes.is_empty());
         let tight = ExportOptions { crop: None, export_cells: 100 };
-        let MapView::Sparse { tiles, overview, .. } = view_of(&g, &tight, &mut notes).unwrap() else {
+        let MapView::Sparse { tiles, overview, .. } = view_of(&g, &tight, None, &mut notes).unwrap() else {
             panic!("sparse")
         };
         assert_eq!(tiles.keys.len(), g.tile_count());
@@ -180,11 +231,31 @@ mod tests {
         assert!(notes[0].contains("limits.export_cells = 100") && notes[0].contains("--crop"), "{}", notes[0]);
         assert_eq!(overview.log_odds, g.known_raster().unwrap().log_odds);
         let crop = ExportOptions { crop: Some(parse_crop("49,-1,53,1").unwrap()), export_cells: 1_000 };
-        let MapView::Dense(r) = view_of(&g, &crop, &mut notes).unwrap() else { panic!("dense") };
+        let MapView::Dense(r) = view_of(&g, &crop, None, &mut notes).unwrap() else { panic!("dense") };
         assert_eq!((r.width, r.height), (41, 21));
         assert!(r.known_count() > 0);
         let big = ExportOptions { crop: Some(parse_crop("0,0,100,100").unwrap()), export_cells: 1_000 };
-        let e = view_of(&g, &big, &mut notes).err().unwrap().to_string();
+        let e = view_of(&g, &big, None, &mut notes).err().unwrap().to_string();
         assert!(e.contains("limits.export_cells = 1000") && e.contains("1001 x 1001"), "{e}");
+    }
+
+    #[test]
+    fn a_dense_raster_the_memory_budget_cannot_hold_is_written_sparsely() {
+        let g = two_sites(50.0);
+        let n = g.known_box().map(cells).unwrap() as u64;
+        let (mut notes, options) = (Vec::new(), ExportOptions { crop: None, export_cells: 1_000_000 });
+        let ample = ExportRoom { bytes: 9 * n, per_cell: 9 };
+        assert!(matches!(view_of(&g, &options, Some(ample), &mut notes).unwrap(), MapView::Dense(_)));
+        let short = ExportRoom { bytes: 9 * n - 1, per_cell: 9 };
+        let MapView::Sparse { tiles, .. } = view_of(&g, &options, Some(short), &mut notes).unwrap() else {
+            panic!("sparse")
+        };
+        assert_eq!(tiles.keys.len(), g.tile_count());
+        assert!(notes[0].contains("limits.memory_mib leaves beside the maps"), "{}", notes[0]);
+        // A crop the room cannot hold is refused naming the key.
+        let crop = ExportOptions { crop: Some(parse_crop("0,-1,4,1").unwrap()), ..options };
+        let tiny = ExportRoom { bytes: 1000, per_cell: 9 };
+        let e = view_of(&g, &crop, Some(tiny), &mut notes).err().unwrap().to_string();
+        assert!(e.contains("limits.memory_mib"), "{e}");
     }
 }

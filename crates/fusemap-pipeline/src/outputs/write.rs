@@ -5,7 +5,7 @@
 
 use super::set::{OutputFiles, Outputs};
 use super::summary::{CellsUpdated, MapInfo, Summary};
-use super::view::{view_of, ExportOptions, MapView};
+use super::view::{view_of, ExportOptions, ExportRoom, MapView};
 use super::OutputError;
 use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells};
 use fusemap_core::fusion::Engine;
@@ -177,7 +177,8 @@ pub fn finish(
 ) -> Result<Summary, OutputError> {
     let RunRecord { source_kind, source, started, mut notes, log, trajectory } = record;
     let grid = engine.grid();
-    let view = view_of(grid, export, &mut notes)?;
+    let room = ExportRoom::of(engine.export_room(engine.maps().primary()));
+    let view = view_of(grid, export, room, &mut notes)?;
     let raster = match &view {
         MapView::Dense(r) => Some(r),
         _ => None,
