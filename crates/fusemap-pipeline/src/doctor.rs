@@ -153,7 +153,7 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
         findings.push(format!("cannot be mapped: {why}"));
     }
 
-    crate::pose_sensors_report::gnss_quality(&log, &mut out, &mut findings)?;
+    crate::pose_sensors_report::gnss_quality(plan, &log, &mut out, &mut findings)?;
     crate::pose_sensors_report::odometry_vs_gyro(&log, &mut out, &mut findings)?;
 
     if let Some(cut) = &log.truncated {

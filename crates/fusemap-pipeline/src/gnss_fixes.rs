@@ -59,10 +59,19 @@ fn problem(f: &GnssMessage, band: [f64; 2]) -> Result<(), FixProblem> {
     check_fix(f.status, f.position_covariance_type, [f.latitude, f.longitude, f.altitude], band)
 }
 
-/// A fix with a position, under the default altitude band (the doctor's rule, the same
+/// A fix with a position, within the altitude band `band` (the doctor's rule, the same
 /// checks as a run's).
-pub fn usable_fix(f: &GnssMessage) -> bool {
-    problem(f, DEFAULT_ALTITUDE_RANGE_M).is_ok()
+pub fn usable_fix(f: &GnssMessage, band: [f64; 2]) -> bool {
+    problem(f, band).is_ok()
+}
+
+/// The altitude band a run applies to the fixes of `topic`: its GNSS table's (by topic, or
+/// the one table without a topic, which binds the log's only fix topic), else the default.
+pub fn altitude_band(plan: &fusemap_core::config::Plan, topic: &str) -> [f64; 2] {
+    let gnss = || plan.sensors.iter().filter(|s| s.kind == fusemap_core::config::SensorKind::Gnss);
+    (gnss().find(|s| s.topic.as_deref() == Some(topic)))
+        .or_else(|| gnss().find(|s| s.topic.is_none()))
+        .map_or(DEFAULT_ALTITUDE_RANGE_M, |s| s.altitude_range_m)
 }
 
 /// How far apart two fixes can be and still agree, metres: a generous receiver error plus

@@ -3,15 +3,18 @@
 //! bias or a mis-mounted IMU; bursts are wheel slip).
 
 use crate::recording::Inventory;
+use fusemap_core::config::Plan;
 use fusemap_core::geometry::normalize_angle;
 use fusemap_core::time::Stamp;
 use fusemap_io::log::GnssMessage;
 use std::fmt::Write as _;
 
 /// GNSS fix quality over time: for each fix topic, ten equal stretches of its span with
-/// the fixes of each status, and the longest stretch without a usable fix.
-pub fn gnss_quality(inv: &Inventory, out: &mut String, findings: &mut Vec<String>) -> std::fmt::Result {
+/// the fixes of each status, and the longest stretch without a usable fix (usable as the
+/// plan's GNSS table for the topic judges it, altitude band included).
+pub fn gnss_quality(plan: &Plan, inv: &Inventory, out: &mut String, findings: &mut Vec<String>) -> std::fmt::Result {
     for (topic, fixes) in &inv.gnss {
+        let band = crate::gnss_fixes::altitude_band(plan, topic);
         let (Some(first), Some(last)) = (fixes.iter().map(|f| f.stamp).min(), fixes.iter().map(|f| f.stamp).max())
         else {
             continue;
@@ -24,7 +27,7 @@ pub fn gnss_quality(inv: &Inventory, out: &mut String, findings: &mut Vec<String
         let mut bins = [[0u64; 4]; 10];
         for f in fixes {
             let b = (((f.stamp.0 - first.0) as i128 * 10 / span as i128) as usize).min(9);
-            let k = if !crate::gnss_fixes::usable_fix(f) {
+            let k = if !crate::gnss_fixes::usable_fix(f, band) {
                 3
             } else {
                 match f.status {
@@ -39,7 +42,8 @@ pub fn gnss_quality(inv: &Inventory, out: &mut String, findings: &mut Vec<String
             let (a, z) = (span as f64 * i as f64 / 10.0 * 1e-9, span as f64 * (i + 1) as f64 / 10.0 * 1e-9);
             writeln!(out, "| {a:.1} | {z:.1} | {} | {} | {} | {} |", b[0], b[1], b[2], b[3])?;
         }
-        let mut good: Vec<Stamp> = fixes.iter().filter(|f| crate::gnss_fixes::usable_fix(f)).map(|f| f.stamp).collect();
+        let mut good: Vec<Stamp> =
+            fixes.iter().filter(|f| crate::gnss_fixes::usable_fix(f, band)).map(|f| f.stamp).collect();
         good.sort_unstable();
         if good.is_empty() {
             findings.push(format!("{topic}: no usable fix at all (every one NO_FIX, NaN or out of range)"));

@@ -99,6 +99,11 @@ fn an_altitude_outside_the_configured_band_is_a_receiver_fault() {
     let alt = rec.datum.altitude();
     assert!(alt > 10.0, "the simulated site is above the band ({alt} m)");
     assert_eq!(g["out_of_range"], g["read"], "{g}");
+    // The doctor judges the fixes by the same band: none of them is usable.
+    let dir = fusemap_io::testdata::temp_dir("altitude-band-doctor");
+    fusemap_sim::bag::write_bag(&rec, &dir.join("bag"), true).expect("the bag is written");
+    let report = fusemap_pipeline::doctor::report(&cfg.validate().unwrap(), &dir.join("bag")).unwrap();
+    assert!(report.text.contains("no usable fix at all"), "{}", report.text);
     let bad = Config {
         sensor: vec![SensorConfig { altitude_range_m: Some([5.0, -5.0]), ..SensorConfig::new(SensorKind::Gnss) }],
         ..Config::default()
