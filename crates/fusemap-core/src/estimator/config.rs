@@ -189,30 +189,7 @@ impl EstimatorConfig {
     /// Checks every field; the error names the first bad one in its TOML path
     /// (`estimator.gate_probability`).
     pub fn validate(&self) -> Result<(), FieldError> {
-        let positive = [
-            ("heading_init_distance_m", self.heading_init_distance_m),
-            ("heading_init_max_fix_sigma_m", self.heading_init_max_fix_sigma_m),
-            ("heading_init_max_residual_m", self.heading_init_max_residual_m),
-            ("max_odometry_gap_s", self.max_odometry_gap_s),
-            ("gyro_rate_sigma", self.gyro_rate_sigma),
-            ("max_gyro_rate_rad_s", self.max_gyro_rate_rad_s),
-            ("max_gyro_gap_s", self.max_gyro_gap_s),
-            ("initial_position_sigma_m", self.initial_position_sigma_m),
-            ("initial_gyro_bias_sigma", self.initial_gyro_bias_sigma),
-            ("initial_scale_sigma", self.initial_scale_sigma),
-            ("fallback_fix_sigma_m", self.fallback_fix_sigma_m),
-            ("fallback_heading_sigma_rad", self.fallback_heading_sigma_rad),
-            ("fallback_pose_sigma_m", self.fallback_pose_sigma_m),
-            ("fallback_pose_sigma_rad", self.fallback_pose_sigma_rad),
-            ("slip_window_s", self.slip_window_s),
-            ("slip_sigma", self.slip_sigma),
-            ("slip_fix_window_s", self.slip_fix_window_s),
-            ("slip_fix_max_sigma_m", self.slip_fix_max_sigma_m),
-            ("stationary_min_s", self.stationary_min_s),
-            ("max_sample_gap_s", self.max_sample_gap_s),
-            ("rtk_fix_max_sigma_m", self.rtk_fix_max_sigma_m),
-        ];
-        for (name, v) in positive {
+        for (name, v) in self.positive_fields() {
             if !(v.is_finite() && v > 0.0) {
                 return Err(FieldError::new(
                     format!("estimator.{name}"),
@@ -220,23 +197,7 @@ impl EstimatorConfig {
                 ));
             }
         }
-        let non_negative = [
-            ("odometry_translation_noise", self.odometry_translation_noise),
-            ("gate_reset_max_drift", self.gate_reset_max_drift),
-            ("odometry_translation_noise_per_sqrt_s", self.odometry_translation_noise_per_sqrt_s),
-            ("odometry_rotation_noise_per_rad", self.odometry_rotation_noise_per_rad),
-            ("odometry_rotation_noise_per_m", self.odometry_rotation_noise_per_m),
-            ("gap_speed_sigma_mps", self.gap_speed_sigma_mps),
-            ("heading_noise_per_sqrt_s", self.heading_noise_per_sqrt_s),
-            ("gyro_bias_random_walk", self.gyro_bias_random_walk),
-            ("odometry_scale_random_walk", self.odometry_scale_random_walk),
-            ("slip_merge_gap_s", self.slip_merge_gap_s),
-            ("stationary_max_speed_mps", self.stationary_max_speed_mps),
-            ("stationary_max_rate", self.stationary_max_rate),
-            ("fix_correlation_time_s", self.fix_correlation_time_s),
-            ("rtk_fix_correlation_time_s", self.rtk_fix_correlation_time_s),
-        ];
-        for (name, v) in non_negative {
+        for (name, v) in self.non_negative_fields() {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(FieldError::new(
                     format!("estimator.{name}"),
@@ -244,26 +205,7 @@ impl EstimatorConfig {
                 ));
             }
         }
-        let sigmas = [
-            ("gyro_rate_sigma", self.gyro_rate_sigma),
-            ("initial_position_sigma_m", self.initial_position_sigma_m),
-            ("initial_gyro_bias_sigma", self.initial_gyro_bias_sigma),
-            ("initial_scale_sigma", self.initial_scale_sigma),
-            ("fallback_fix_sigma_m", self.fallback_fix_sigma_m),
-            ("fallback_heading_sigma_rad", self.fallback_heading_sigma_rad),
-            ("fallback_pose_sigma_m", self.fallback_pose_sigma_m),
-            ("fallback_pose_sigma_rad", self.fallback_pose_sigma_rad),
-            ("slip_sigma", self.slip_sigma),
-            ("odometry_translation_noise", self.odometry_translation_noise),
-            ("odometry_translation_noise_per_sqrt_s", self.odometry_translation_noise_per_sqrt_s),
-            ("odometry_rotation_noise_per_rad", self.odometry_rotation_noise_per_rad),
-            ("odometry_rotation_noise_per_m", self.odometry_rotation_noise_per_m),
-            ("gap_speed_sigma_mps", self.gap_speed_sigma_mps),
-            ("heading_noise_per_sqrt_s", self.heading_noise_per_sqrt_s),
-            ("gyro_bias_random_walk", self.gyro_bias_random_walk),
-            ("odometry_scale_random_walk", self.odometry_scale_random_walk),
-        ];
-        for (name, v) in sigmas {
+        for (name, v) in self.sigma_fields() {
             if v > MAX_SIGMA {
                 return Err(FieldError::new(
                     format!("estimator.{name}"),
@@ -287,6 +229,76 @@ impl EstimatorConfig {
             ));
         }
         Ok(())
+    }
+
+    /// The fields that must be positive and finite.
+    fn positive_fields(&self) -> [(&'static str, f64); 21] {
+        [
+            ("heading_init_distance_m", self.heading_init_distance_m),
+            ("heading_init_max_fix_sigma_m", self.heading_init_max_fix_sigma_m),
+            ("heading_init_max_residual_m", self.heading_init_max_residual_m),
+            ("max_odometry_gap_s", self.max_odometry_gap_s),
+            ("gyro_rate_sigma", self.gyro_rate_sigma),
+            ("max_gyro_rate_rad_s", self.max_gyro_rate_rad_s),
+            ("max_gyro_gap_s", self.max_gyro_gap_s),
+            ("initial_position_sigma_m", self.initial_position_sigma_m),
+            ("initial_gyro_bias_sigma", self.initial_gyro_bias_sigma),
+            ("initial_scale_sigma", self.initial_scale_sigma),
+            ("fallback_fix_sigma_m", self.fallback_fix_sigma_m),
+            ("fallback_heading_sigma_rad", self.fallback_heading_sigma_rad),
+            ("fallback_pose_sigma_m", self.fallback_pose_sigma_m),
+            ("fallback_pose_sigma_rad", self.fallback_pose_sigma_rad),
+            ("slip_window_s", self.slip_window_s),
+            ("slip_sigma", self.slip_sigma),
+            ("slip_fix_window_s", self.slip_fix_window_s),
+            ("slip_fix_max_sigma_m", self.slip_fix_max_sigma_m),
+            ("stationary_min_s", self.stationary_min_s),
+            ("max_sample_gap_s", self.max_sample_gap_s),
+            ("rtk_fix_max_sigma_m", self.rtk_fix_max_sigma_m),
+        ]
+    }
+
+    /// The fields that must be non-negative and finite.
+    fn non_negative_fields(&self) -> [(&'static str, f64); 14] {
+        [
+            ("odometry_translation_noise", self.odometry_translation_noise),
+            ("gate_reset_max_drift", self.gate_reset_max_drift),
+            ("odometry_translation_noise_per_sqrt_s", self.odometry_translation_noise_per_sqrt_s),
+            ("odometry_rotation_noise_per_rad", self.odometry_rotation_noise_per_rad),
+            ("odometry_rotation_noise_per_m", self.odometry_rotation_noise_per_m),
+            ("gap_speed_sigma_mps", self.gap_speed_sigma_mps),
+            ("heading_noise_per_sqrt_s", self.heading_noise_per_sqrt_s),
+            ("gyro_bias_random_walk", self.gyro_bias_random_walk),
+            ("odometry_scale_random_walk", self.odometry_scale_random_walk),
+            ("slip_merge_gap_s", self.slip_merge_gap_s),
+            ("stationary_max_speed_mps", self.stationary_max_speed_mps),
+            ("stationary_max_rate", self.stationary_max_rate),
+            ("fix_correlation_time_s", self.fix_correlation_time_s),
+            ("rtk_fix_correlation_time_s", self.rtk_fix_correlation_time_s),
+        ]
+    }
+
+    /// The standard deviations and noise densities, at most [`MAX_SIGMA`].
+    fn sigma_fields(&self) -> [(&'static str, f64); 17] {
+        [
+            ("gyro_rate_sigma", self.gyro_rate_sigma),
+            ("initial_position_sigma_m", self.initial_position_sigma_m),
+            ("initial_gyro_bias_sigma", self.initial_gyro_bias_sigma),
+            ("initial_scale_sigma", self.initial_scale_sigma),
+            ("fallback_fix_sigma_m", self.fallback_fix_sigma_m),
+            ("fallback_heading_sigma_rad", self.fallback_heading_sigma_rad),
+            ("fallback_pose_sigma_m", self.fallback_pose_sigma_m),
+            ("fallback_pose_sigma_rad", self.fallback_pose_sigma_rad),
+            ("slip_sigma", self.slip_sigma),
+            ("odometry_translation_noise", self.odometry_translation_noise),
+            ("odometry_translation_noise_per_sqrt_s", self.odometry_translation_noise_per_sqrt_s),
+            ("odometry_rotation_noise_per_rad", self.odometry_rotation_noise_per_rad),
+            ("odometry_rotation_noise_per_m", self.odometry_rotation_noise_per_m),
+            ("gap_speed_sigma_mps", self.gap_speed_sigma_mps),
+            ("heading_noise_per_sqrt_s", self.heading_noise_per_sqrt_s),
+            ("gyro_bias_random_walk", self.gyro_bias_random_walk),
+            ("odometry_scale_random_walk", self.odometry_scale_random_walk),
+        ]
     }
 }
 
