@@ -334,7 +334,23 @@ impl SlamConfig {
         if angular > 180.0 || lc_angular > 180.0 || rescue_angular > 180.0 {
             return Err(err("slam", "angular search windows must be at most 180°"));
         }
-        let params = SlamParams {
+        let params = self.matching(res, hit, miss, angular, rescue_angular)?;
+        let params = self.with_loop_closure(params, ratio, lc_angular, score)?;
+        check_search_cost(&params)?;
+        Ok(params)
+    }
+
+    /// The scan matcher's, the submaps' and the odometry edges' parameters (every other
+    /// field the default, set by [`SlamConfig::with_loop_closure`]).
+    fn matching(
+        &self,
+        res: f64,
+        hit: f64,
+        miss: f64,
+        angular: f64,
+        rescue_angular: f64,
+    ) -> Result<SlamParams, FieldError> {
+        Ok(SlamParams {
             resolution: res,
             submap: SubmapBounds {
                 distance_m: positive("submap_distance_m", self.submap_distance_m)?,
@@ -370,6 +386,19 @@ impl SlamConfig {
             odometry_floor_m: positive("odometry_floor_m", self.odometry_floor_m)?,
             odometry_rotation_per_rad: non_negative("odometry_rotation_per_rad", self.odometry_rotation_per_rad)?,
             odometry_floor_rad: positive("odometry_floor_deg", self.odometry_floor_deg)?.to_radians(),
+            ..SlamParams::default()
+        })
+    }
+
+    /// `params` with the loop closure's, the optimisation's and the fix priors' parameters.
+    fn with_loop_closure(
+        &self,
+        params: SlamParams,
+        ratio: f64,
+        lc_angular: f64,
+        score: f64,
+    ) -> Result<SlamParams, FieldError> {
+        Ok(SlamParams {
             loop_closure: self.loop_closure,
             loop_closure_sampling_ratio: ratio,
             loop_closure_node_spacing_m: non_negative("loop_closure_node_spacing_m", self.loop_closure_node_spacing_m)?,
@@ -445,9 +474,8 @@ impl SlamConfig {
             fixes: self.fixes,
             fix_max_offset_s: non_negative("fix_max_offset_s", self.fix_max_offset_s)?.min(60.0),
             fix_huber: positive("fix_huber", self.fix_huber)?,
-        };
-        check_search_cost(&params)?;
-        Ok(params)
+            ..params
+        })
     }
 }
 
