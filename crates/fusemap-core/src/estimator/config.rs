@@ -279,26 +279,27 @@ impl EstimatorConfig {
     }
 
     /// The standard deviations and noise densities, at most [`MAX_SIGMA`].
-    fn sigma_fields(&self) -> [(&'static str, f64); 17] {
-        [
-            ("gyro_rate_sigma", self.gyro_rate_sigma),
-            ("initial_position_sigma_m", self.initial_position_sigma_m),
-            ("initial_gyro_bias_sigma", self.initial_gyro_bias_sigma),
-            ("initial_scale_sigma", self.initial_scale_sigma),
-            ("fallback_fix_sigma_m", self.fallback_fix_sigma_m),
-            ("fallback_heading_sigma_rad", self.fallback_heading_sigma_rad),
-            ("fallback_pose_sigma_m", self.fallback_pose_sigma_m),
-            ("fallback_pose_sigma_rad", self.fallback_pose_sigma_rad),
-            ("slip_sigma", self.slip_sigma),
-            ("odometry_translation_noise", self.odometry_translation_noise),
-            ("odometry_translation_noise_per_sqrt_s", self.odometry_translation_noise_per_sqrt_s),
-            ("odometry_rotation_noise_per_rad", self.odometry_rotation_noise_per_rad),
-            ("odometry_rotation_noise_per_m", self.odometry_rotation_noise_per_m),
-            ("gap_speed_sigma_mps", self.gap_speed_sigma_mps),
-            ("heading_noise_per_sqrt_s", self.heading_noise_per_sqrt_s),
-            ("gyro_bias_random_walk", self.gyro_bias_random_walk),
-            ("odometry_scale_random_walk", self.odometry_scale_random_walk),
-        ]
+    fn sigma_fields(&self) -> impl Iterator<Item = (&'static str, f64)> {
+        const SIGMAS: [&str; 17] = [
+            "gyro_rate_sigma",
+            "initial_position_sigma_m",
+            "initial_gyro_bias_sigma",
+            "initial_scale_sigma",
+            "fallback_fix_sigma_m",
+            "fallback_heading_sigma_rad",
+            "fallback_pose_sigma_m",
+            "fallback_pose_sigma_rad",
+            "slip_sigma",
+            "odometry_translation_noise",
+            "odometry_translation_noise_per_sqrt_s",
+            "odometry_rotation_noise_per_rad",
+            "odometry_rotation_noise_per_m",
+            "gap_speed_sigma_mps",
+            "heading_noise_per_sqrt_s",
+            "gyro_bias_random_walk",
+            "odometry_scale_random_walk",
+        ];
+        self.positive_fields().into_iter().chain(self.non_negative_fields()).filter(|(n, _)| SIGMAS.contains(n))
     }
 }
 
@@ -309,6 +310,8 @@ mod tests {
     #[test]
     fn default_is_valid_and_bad_fields_are_named() {
         assert_eq!(EstimatorConfig::default().validate(), Ok(()));
+        // Every σ key names a field of the two lists.
+        assert_eq!(EstimatorConfig::default().sigma_fields().count(), 17);
         let cfg = EstimatorConfig { gate_probability: 1.0, ..Default::default() };
         assert_eq!(cfg.validate().unwrap_err().field, "estimator.gate_probability");
         let cfg = EstimatorConfig { gyro_rate_sigma: f64::NAN, ..Default::default() };
