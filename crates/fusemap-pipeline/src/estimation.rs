@@ -152,7 +152,7 @@ fn imu_inputs(
     let m3 = sensor_mount(s, cfg, tree, &frame, msgs.first().map(|m| m.stamp), &mut all.notes)?;
     let r = m3.rotation();
     let q_mount = m3.quaternion();
-    let (mut stale, mut stale_count) = (StaleOrientation::default(), 0u64);
+    let (mut stale, mut stale_count, mut floored) = (StaleOrientation::default(), 0u64, 0u64);
     for m in msgs {
         let stamp = s.stamp(m.stamp);
         // `angular_velocity_covariance[0] = -1`: no rate in this message.
@@ -172,9 +172,19 @@ fn imu_inputs(
             let q = world_from_imu.compose(&Pose3::new([0.0; 3], q_mount).inverse()).rotation;
             let yaw = quaternion_yaw(q);
             if yaw.is_finite() && var.is_finite() && var > 0.0 {
-                all.inputs.push(EstimatorInput::Heading { stamp, yaw, variance: var });
+                let floor = all.config.imu_heading_floor_sigma_rad.powi(2);
+                floored += u64::from(var < floor);
+                all.inputs.push(EstimatorInput::Heading { stamp, yaw, variance: var.max(floor) });
             }
         }
+    }
+    if floored > 0 {
+        all.notes.push(format!(
+            "IMU `{}`: {floored} orientation readings claimed a heading σ below estimator.imu_heading_floor_sigma_rad \
+             = {:.2}° and were given that σ",
+            s.topic,
+            all.config.imu_heading_floor_sigma_rad.to_degrees()
+        ));
     }
     if stale_count > 0 {
         all.notes.push(format!(

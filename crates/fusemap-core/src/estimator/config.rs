@@ -73,6 +73,11 @@ pub struct EstimatorConfig {
     pub fallback_fix_sigma_m: f64,
     /// Heading standard deviation used when a heading's variance is not positive, radians.
     pub fallback_heading_sigma_rad: f64,
+    /// The least heading standard deviation an IMU's orientation may claim, radians: a
+    /// smaller covariance is raised to it (and counted). An attitude filter's absolute
+    /// yaw is good to a degree or so indoors, a navigation-grade INS to about 0.1°; a
+    /// covariance of 10⁻¹² rad² would pin the track to every error of the reading.
+    pub imu_heading_floor_sigma_rad: f64,
     /// Position standard deviation used when a pose's covariance is not positive definite, metres.
     pub fallback_pose_sigma_m: f64,
     /// Heading standard deviation used when a pose's covariance is not positive definite, radians.
@@ -155,6 +160,7 @@ impl Default for EstimatorConfig {
             initial_scale_sigma: 0.05,
             fallback_fix_sigma_m: 1.0,
             fallback_heading_sigma_rad: 0.1,
+            imu_heading_floor_sigma_rad: 0.002,
             fallback_pose_sigma_m: 0.5,
             fallback_pose_sigma_rad: 0.1,
             slip_window_s: 0.5,
@@ -232,7 +238,7 @@ impl EstimatorConfig {
     }
 
     /// The fields that must be positive and finite.
-    fn positive_fields(&self) -> [(&'static str, f64); 21] {
+    fn positive_fields(&self) -> [(&'static str, f64); 22] {
         [
             ("heading_init_distance_m", self.heading_init_distance_m),
             ("heading_init_max_fix_sigma_m", self.heading_init_max_fix_sigma_m),
@@ -246,6 +252,7 @@ impl EstimatorConfig {
             ("initial_scale_sigma", self.initial_scale_sigma),
             ("fallback_fix_sigma_m", self.fallback_fix_sigma_m),
             ("fallback_heading_sigma_rad", self.fallback_heading_sigma_rad),
+            ("imu_heading_floor_sigma_rad", self.imu_heading_floor_sigma_rad),
             ("fallback_pose_sigma_m", self.fallback_pose_sigma_m),
             ("fallback_pose_sigma_rad", self.fallback_pose_sigma_rad),
             ("slip_window_s", self.slip_window_s),
@@ -280,13 +287,14 @@ impl EstimatorConfig {
 
     /// The standard deviations and noise densities, at most [`MAX_SIGMA`].
     fn sigma_fields(&self) -> impl Iterator<Item = (&'static str, f64)> {
-        const SIGMAS: [&str; 17] = [
+        const SIGMAS: [&str; 18] = [
             "gyro_rate_sigma",
             "initial_position_sigma_m",
             "initial_gyro_bias_sigma",
             "initial_scale_sigma",
             "fallback_fix_sigma_m",
             "fallback_heading_sigma_rad",
+            "imu_heading_floor_sigma_rad",
             "fallback_pose_sigma_m",
             "fallback_pose_sigma_rad",
             "slip_sigma",
@@ -311,7 +319,7 @@ mod tests {
     fn default_is_valid_and_bad_fields_are_named() {
         assert_eq!(EstimatorConfig::default().validate(), Ok(()));
         // Every σ key names a field of the two lists.
-        assert_eq!(EstimatorConfig::default().sigma_fields().count(), 17);
+        assert_eq!(EstimatorConfig::default().sigma_fields().count(), 18);
         let cfg = EstimatorConfig { gate_probability: 1.0, ..Default::default() };
         assert_eq!(cfg.validate().unwrap_err().field, "estimator.gate_probability");
         let cfg = EstimatorConfig { gyro_rate_sigma: f64::NAN, ..Default::default() };

@@ -222,6 +222,9 @@ fn an_imu_orientation_frozen_while_the_gyro_turns_is_left_out() {
     let note = frozen.notes.iter().find(|n| n.contains("orientation readings left out as stale"));
     println!("ATE with the true orientation {a:.4} m, frozen from 10 s {b:.4} m; {note:?}");
     assert!(!good.notes.iter().any(|n| n.contains("stale")), "{:?}", good.notes);
+    // The readings claim σ = 1 mrad, below the floor: raised to it, and counted.
+    let floor = good.notes.iter().find(|n| n.contains("below estimator.imu_heading_floor_sigma_rad"));
+    assert!(floor.is_some_and(|n| n.contains("0.11°")), "{:?}", good.notes);
     assert!(note.is_some(), "{:?}", frozen.notes);
     assert!(b < a + 0.02, "true orientation {a:.4} m, frozen {b:.4} m");
 }
