@@ -11,7 +11,8 @@ use super::linalg::{all_finite, identity, spd_inverse, Mat};
 use super::models;
 use super::report::{CorrectionReport, FixQualityCount, FixRejection, RejectedFix};
 use super::slip_fixes::FixSlipCheck;
-use super::streams::{GyroTrack, OdometryTrack, SlipDetector};
+use super::streams::{GyroTrack, Interval, OdometryTrack, SlipDetector};
+use crate::geometry::Pose2;
 use crate::time::Stamp;
 
 /// What the forward pass counts.
@@ -191,6 +192,101 @@ pub(crate) struct MotionSources<'a> {
     pub fix_slip: &'a FixSlipCheck,
 }
 
+/// The chi-square gates of `estimator.gate_probability` for 1, 2 and 3 degrees of freedom.
+fn gates(cfg: &EstimatorConfig) -> Result<Gates, EstimatorError> {
+    let p = cfg.gate_probability;
+    let q = |dof| {
+        chi_square_quantile(dof, p).ok_or_else(|| EstimatorError::Config(format!("estimator.gate_probability {p}")))
+    };
+    Ok(Gates { one: q(1)?, two: q(2)?, three: q(3)? })
+}
+
+/// Counts a correction outside the odometry's span: there is no state to correct there.
+fn count_outside(stamp: Stamp, c: &Correction, counts: &mut RunCounts) {
+    match c {
+        Correction::Position { .. } => {
+            counts.fixes.ignored_outside_track += 1;
+            counts.rejected_fixes.push(RejectedFix { stamp, reason: FixRejection::OutsideTrack, nis: f64::NAN });
+        }
+        Correction::Heading { .. } => counts.headings.ignored_outside_track += 1,
+        Correction::Pose { .. } => counts.poses.ignored_outside_track += 1,
+    }
+}
+
+/// The factor on a slipping increment's distance. Spinning wheels report distance the
+/// robot did not drive; its speed rarely jumps while they spin, so a slipping increment
+/// keeps the speed of the odometry before the slip (in the odometry's direction), its
+/// inflated noise covering the rest. Otherwise 1, and the held speed follows the odometry.
+fn speed_factor(slipping: bool, iv: &Interval, held_speed: &mut f64, cfg: &EstimatorConfig) -> f64 {
+    let iv_d = iv.delta.x.hypot(iv.delta.y);
+    if slipping && cfg.slip_hold_speed && iv_d > 0.0 {
+        (*held_speed * iv.dt / iv_d).clamp(0.0, 1.0)
+    } else {
+        // Standing still counts too: a robot that spins its wheels when starting off
+        // is slow, not at the speed it had before it stopped.
+        let a = (-iv.dt / SPEED_TIME_CONSTANT_S).exp();
+        *held_speed = a * *held_speed + (1.0 - a) * iv_d / iv.dt;
+        1.0
+    }
+}
+
+/// How one odometry interval is driven: its increment's noise inflation and distance factor.
+#[derive(Clone, Copy)]
+struct Drive<'a> {
+    iv: &'a Interval,
+    inflation: f64,
+    speed_factor: f64,
+}
+
+impl Filter<'_> {
+    /// Predicts over `dt` seconds of `drive` moving by `inc` (odometry) and `gyro_angle`
+    /// (the gyro's integral, with its variance), and while standing still corrects with
+    /// the gyro's zero rate. Returns the prediction and its Jacobian.
+    fn predict_step(
+        &mut self,
+        drive: Drive,
+        inc: Pose2,
+        dt: f64,
+        gyro_angle: Option<(f64, f64)>,
+    ) -> ([f64; N], Mat<N, N>, Mat<N, N>) {
+        let (iv, cfg) = (drive.iv, self.cfg);
+        let frac = dt / iv.dt;
+        let mut cov = iv.cov;
+        for v in cov.iter_mut().flatten() {
+            *v *= frac * drive.inflation;
+        }
+        let heading = if iv.stationary {
+            HeadingMotion::Still
+        } else if let Some((angle, var)) = gyro_angle {
+            HeadingMotion::Gyro { angle, var, dt }
+        } else {
+            self.counts.steps_without_gyro += 1;
+            HeadingMotion::Odometry
+        };
+        let motion = Motion {
+            dx: inc.x * drive.speed_factor,
+            dy: inc.y * drive.speed_factor,
+            dtheta: inc.theta,
+            cov,
+            heading,
+            heading_noise: cfg.heading_noise_per_sqrt_s.powi(2) * dt,
+            bias_noise: cfg.gyro_bias_random_walk.powi(2) * dt,
+            scale_noise: cfg.odometry_scale_random_walk.powi(2) * inc.x.hypot(inc.y),
+        };
+        self.driven_since_fix_m += inc.x.hypot(inc.y);
+        let (x_pred, p_pred, jac) = predict(&self.x, &self.p, &motion);
+        self.x = x_pred;
+        self.p = p_pred;
+        if let (true, Some((angle, var))) = (iv.stationary && dt > 0.0, gyro_angle) {
+            let (nu, h) = models::zero_rate(&self.x, angle / dt);
+            let g = update(&mut self.x, &mut self.p, nu, &h, &[[var / (dt * dt)]], self.gates.one);
+            record(&mut self.counts.zero_rate, g, g.accepted);
+            self.counts.stationary_s += dt;
+        }
+        (x_pred, p_pred, jac)
+    }
+}
+
 /// Runs the filter over the whole track.
 pub(crate) fn run(
     motion: &MotionSources,
@@ -200,11 +296,7 @@ pub(crate) fn run(
     counts: &mut RunCounts,
 ) -> Result<RunOutput, EstimatorError> {
     let MotionSources { odo, gyro, slip, fix_slip } = *motion;
-    let p = cfg.gate_probability;
-    let q = |dof| {
-        chi_square_quantile(dof, p).ok_or_else(|| EstimatorError::Config(format!("estimator.gate_probability {p}")))
-    };
-    let gates = Gates { one: q(1)?, two: q(2)?, three: q(3)? };
+    let gates = gates(cfg)?;
     let (t0, t_last) = odo.span();
     let mut records = Vec::with_capacity(odo.stamps.len() + corrections.len());
     let mut slips = vec![false; odo.intervals.len()];
@@ -220,20 +312,8 @@ pub(crate) fn run(
         reset_refused: false,
     };
     let mut j = 0;
-    let outside = |(stamp, c): &(Stamp, Correction), counts: &mut RunCounts| match c {
-        Correction::Position { .. } => {
-            counts.fixes.ignored_outside_track += 1;
-            counts.rejected_fixes.push(RejectedFix {
-                stamp: *stamp,
-                reason: FixRejection::OutsideTrack,
-                nis: f64::NAN,
-            });
-        }
-        Correction::Heading { .. } => counts.headings.ignored_outside_track += 1,
-        Correction::Pose { .. } => counts.poses.ignored_outside_track += 1,
-    };
     while j < corrections.len() && corrections[j].0 < t0 {
-        outside(&corrections[j], f.counts);
+        count_outside(corrections[j].0, &corrections[j].1, f.counts);
         j += 1;
     }
     while j < corrections.len() && corrections[j].0 == t0 {
@@ -248,61 +328,16 @@ pub(crate) fn run(
         let t_end = odo.stamps[i + 1];
         slips[i] = !iv.stationary && (slip.slips(i, f.x[3]) || fix_slip.slips(t_cur, t_end, odo, &f.x, &f.p));
         let inflation = if slips[i] { cfg.slip_noise_inflation } else { 1.0 };
-        // Spinning wheels report distance the robot did not drive; its speed rarely jumps
-        // while they spin, so a slipping increment keeps the speed of the odometry before
-        // the slip (in the odometry's direction), its inflated noise covering the rest.
-        let iv_d = iv.delta.x.hypot(iv.delta.y);
-        let speed_factor = if slips[i] && cfg.slip_hold_speed && iv_d > 0.0 {
-            (held_speed * iv.dt / iv_d).clamp(0.0, 1.0)
-        } else {
-            // Standing still counts too: a robot that spins its wheels when starting off
-            // is slow, not at the speed it had before it stopped.
-            let a = (-iv.dt / SPEED_TIME_CONSTANT_S).exp();
-            held_speed = a * held_speed + (1.0 - a) * iv_d / iv.dt;
-            1.0
-        };
+        let drive = Drive { iv, inflation, speed_factor: speed_factor(slips[i], iv, &mut held_speed, cfg) };
         loop {
             let t = match corrections.get(j) {
                 Some(&(tc, _)) if tc <= t_end => tc,
                 _ => t_end,
             };
-            let dt = t.secs_since(t_cur);
             let odo_t = odo.pose_at(t);
             let inc = odo_cur.inverse().compose(odo_t);
-            let frac = dt / iv.dt;
-            let mut cov = iv.cov;
-            for v in cov.iter_mut().flatten() {
-                *v *= frac * inflation;
-            }
             let gyro_angle = gyro.and_then(|g| g.integral(t_cur, t));
-            let heading = if iv.stationary {
-                HeadingMotion::Still
-            } else if let Some((angle, var)) = gyro_angle {
-                HeadingMotion::Gyro { angle, var, dt }
-            } else {
-                f.counts.steps_without_gyro += 1;
-                HeadingMotion::Odometry
-            };
-            let motion = Motion {
-                dx: inc.x * speed_factor,
-                dy: inc.y * speed_factor,
-                dtheta: inc.theta,
-                cov,
-                heading,
-                heading_noise: cfg.heading_noise_per_sqrt_s.powi(2) * dt,
-                bias_noise: cfg.gyro_bias_random_walk.powi(2) * dt,
-                scale_noise: cfg.odometry_scale_random_walk.powi(2) * inc.x.hypot(inc.y),
-            };
-            f.driven_since_fix_m += inc.x.hypot(inc.y);
-            let (x_pred, p_pred, jac) = predict(&f.x, &f.p, &motion);
-            f.x = x_pred;
-            f.p = p_pred;
-            if let (true, Some((angle, var))) = (iv.stationary && dt > 0.0, gyro_angle) {
-                let (nu, h) = models::zero_rate(&f.x, angle / dt);
-                let g = update(&mut f.x, &mut f.p, nu, &h, &[[var / (dt * dt)]], f.gates.one);
-                record(&mut f.counts.zero_rate, g, g.accepted);
-                f.counts.stationary_s += dt;
-            }
+            let (x_pred, p_pred, jac) = f.predict_step(drive, inc, t.secs_since(t_cur), gyro_angle);
             while j < corrections.len() && corrections[j].0 == t {
                 f.correct(corrections[j].0, &corrections[j].1);
                 j += 1;
@@ -319,9 +354,8 @@ pub(crate) fn run(
         }
     }
     debug_assert_eq!(t_cur, t_last);
-    while j < corrections.len() {
-        outside(&corrections[j], f.counts);
-        j += 1;
+    for (stamp, c) in &corrections[j..] {
+        count_outside(*stamp, c, f.counts);
     }
     Ok(RunOutput { records, slip: slips })
 }
