@@ -183,124 +183,162 @@ fn finite3(m: &Mat<3, 3>) -> bool {
 pub(crate) fn sort_inputs(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> (Sorted, InputCounts) {
     let mut order: Vec<usize> = (0..inputs.len()).collect();
     order.sort_by_key(|&i| inputs[i].stamp());
-    let mut counts = InputCounts {
-        odometry: OdometryReport::default(),
-        gyro: GyroReport::default(),
-        fixes: CorrectionReport::new(2),
-        poses: CorrectionReport::new(3),
-        headings: CorrectionReport::new(1),
-        rejected_fixes: Vec::new(),
+    let mut s = Sorter {
+        cfg,
+        counts: InputCounts {
+            odometry: OdometryReport::default(),
+            gyro: GyroReport::default(),
+            fixes: CorrectionReport::new(2),
+            poses: CorrectionReport::new(3),
+            headings: CorrectionReport::new(1),
+            rejected_fixes: Vec::new(),
+        },
+        odometry: RawOdometry { stamps: Vec::new(), poses: Vec::new(), covariances: Vec::new() },
+        gyro: RawGyro { stamps: Vec::new(), rates: Vec::new(), variances: Vec::new() },
+        corrections: Vec::new(),
     };
-    let mut odometry = RawOdometry { stamps: Vec::new(), poses: Vec::new(), covariances: Vec::new() };
-    let mut gyro = RawGyro { stamps: Vec::new(), rates: Vec::new(), variances: Vec::new() };
-    let mut corrections = Vec::new();
-    let fix_var = cfg.fallback_fix_sigma_m.powi(2);
     for i in order {
         if !sane(inputs[i].stamp()) {
-            count_insane(&inputs[i], &mut counts);
+            count_insane(&inputs[i], &mut s.counts);
             continue;
         }
         match inputs[i] {
-            EstimatorInput::Odometry { stamp, pose, covariance } => {
-                counts.odometry.received += 1;
-                if !pose.is_position() {
-                    counts.odometry.not_finite += 1;
-                    continue;
-                }
-                if odometry.stamps.last() == Some(&stamp) {
-                    counts.odometry.duplicate_stamps += 1;
-                    continue;
-                }
-                let cov = match covariance {
-                    Some(c) if cfg.use_odometry_covariance => {
-                        if finite3(&c) && is_spd(&c) {
-                            Some(c)
-                        } else {
-                            counts.odometry.covariance_fallbacks += 1;
-                            None
-                        }
-                    }
-                    _ => None,
-                };
-                odometry.stamps.push(stamp);
-                odometry.poses.push(pose);
-                odometry.covariances.push(cov);
-            }
-            EstimatorInput::Gyro { stamp, yaw_rate, variance } => {
-                counts.gyro.received += 1;
-                if !yaw_rate.is_finite() {
-                    counts.gyro.not_finite += 1;
-                    continue;
-                }
-                if yaw_rate.abs() > cfg.max_gyro_rate_rad_s {
-                    counts.gyro.implausible += 1;
-                    continue;
-                }
-                if gyro.stamps.last() == Some(&stamp) {
-                    continue;
-                }
-                let var = match variance {
-                    Some(v) if v.is_finite() && v > 0.0 => v,
-                    Some(_) => {
-                        counts.gyro.variance_fallbacks += 1;
-                        cfg.gyro_rate_sigma.powi(2)
-                    }
-                    None => cfg.gyro_rate_sigma.powi(2),
-                };
-                gyro.stamps.push(stamp);
-                gyro.rates.push(yaw_rate);
-                gyro.variances.push(var);
-            }
-            EstimatorInput::Heading { stamp, yaw, variance } => {
-                counts.headings.received += 1;
-                if !yaw.is_finite() {
-                    counts.headings.rejected_not_finite += 1;
-                    continue;
-                }
-                let var = if variance.is_finite() && variance > 0.0 {
-                    variance
-                } else {
-                    counts.headings.covariance_fallbacks += 1;
-                    cfg.fallback_heading_sigma_rad.powi(2)
-                };
-                corrections.push((stamp, Correction::Heading { yaw, var }));
-            }
+            EstimatorInput::Odometry { stamp, pose, covariance } => s.odometry(stamp, pose, covariance),
+            EstimatorInput::Gyro { stamp, yaw_rate, variance } => s.gyro(stamp, yaw_rate, variance),
+            EstimatorInput::Heading { stamp, yaw, variance } => s.heading(stamp, yaw, variance),
             EstimatorInput::Position { stamp, enu, covariance, antenna, quality } => {
-                counts.fixes.received += 1;
-                let far = enu[0].abs().max(enu[1].abs()) > crate::geometry::MAX_POSITION_M;
-                if !(enu[0].is_finite() && enu[1].is_finite() && antenna.is_finite()) || far {
-                    counts.fixes.rejected_not_finite += 1;
-                    counts.rejected_fixes.push(RejectedFix { stamp, reason: FixRejection::NotFinite, nis: f64::NAN });
-                    continue;
-                }
-                let r = if is_spd(&covariance) {
-                    covariance
-                } else {
-                    counts.fixes.covariance_fallbacks += 1;
-                    [[fix_var, 0.0], [0.0, fix_var]]
-                };
-                corrections.push((stamp, Correction::Position { z: enu, r, antenna, quality }));
+                s.position(stamp, enu, covariance, antenna, quality)
             }
-            EstimatorInput::Pose { stamp, pose, covariance } => {
-                counts.poses.received += 1;
-                if !pose.is_position() {
-                    counts.poses.rejected_not_finite += 1;
-                    continue;
-                }
-                let r = if finite3(&covariance) && is_spd(&covariance) {
-                    covariance
-                } else {
-                    counts.poses.covariance_fallbacks += 1;
-                    let (m, a) = (cfg.fallback_pose_sigma_m.powi(2), cfg.fallback_pose_sigma_rad.powi(2));
-                    [[m, 0.0, 0.0], [0.0, m, 0.0], [0.0, 0.0, a]]
-                };
-                corrections.push((stamp, Correction::Pose { z: [pose.x, pose.y, pose.theta], r }));
-            }
+            EstimatorInput::Pose { stamp, pose, covariance } => s.pose(stamp, pose, covariance),
         }
     }
+    let Sorter { mut counts, odometry, gyro, corrections, .. } = s;
     counts.odometry.used = odometry.stamps.len();
     counts.gyro.used = gyro.stamps.len();
     (Sorted { odometry, gyro, corrections }, counts)
+}
+
+/// The streams [`sort_inputs`] builds, input by input in stamp order, with what it counts.
+struct Sorter<'a> {
+    cfg: &'a EstimatorConfig,
+    counts: InputCounts,
+    odometry: RawOdometry,
+    gyro: RawGyro,
+    corrections: Vec<(Stamp, Correction)>,
+}
+
+impl Sorter<'_> {
+    /// An odometry pose: a position, at a new stamp; its covariance where it is usable
+    /// and asked for.
+    fn odometry(&mut self, stamp: Stamp, pose: Pose2, covariance: Option<[[f64; 3]; 3]>) {
+        let counts = &mut self.counts.odometry;
+        counts.received += 1;
+        if !pose.is_position() {
+            counts.not_finite += 1;
+            return;
+        }
+        if self.odometry.stamps.last() == Some(&stamp) {
+            counts.duplicate_stamps += 1;
+            return;
+        }
+        let cov = match covariance {
+            Some(c) if self.cfg.use_odometry_covariance => {
+                if finite3(&c) && is_spd(&c) {
+                    Some(c)
+                } else {
+                    counts.covariance_fallbacks += 1;
+                    None
+                }
+            }
+            _ => None,
+        };
+        self.odometry.stamps.push(stamp);
+        self.odometry.poses.push(pose);
+        self.odometry.covariances.push(cov);
+    }
+
+    /// A yaw rate: finite, within `max_gyro_rate_rad_s`, at a new stamp.
+    fn gyro(&mut self, stamp: Stamp, yaw_rate: f64, variance: Option<f64>) {
+        let (counts, cfg) = (&mut self.counts.gyro, self.cfg);
+        counts.received += 1;
+        if !yaw_rate.is_finite() {
+            counts.not_finite += 1;
+            return;
+        }
+        if yaw_rate.abs() > cfg.max_gyro_rate_rad_s {
+            counts.implausible += 1;
+            return;
+        }
+        if self.gyro.stamps.last() == Some(&stamp) {
+            return;
+        }
+        let var = match variance {
+            Some(v) if v.is_finite() && v > 0.0 => v,
+            Some(_) => {
+                counts.variance_fallbacks += 1;
+                cfg.gyro_rate_sigma.powi(2)
+            }
+            None => cfg.gyro_rate_sigma.powi(2),
+        };
+        self.gyro.stamps.push(stamp);
+        self.gyro.rates.push(yaw_rate);
+        self.gyro.variances.push(var);
+    }
+
+    /// An absolute heading, with the fallback variance where its own is unusable.
+    fn heading(&mut self, stamp: Stamp, yaw: f64, variance: f64) {
+        let counts = &mut self.counts.headings;
+        counts.received += 1;
+        if !yaw.is_finite() {
+            counts.rejected_not_finite += 1;
+            return;
+        }
+        let var = if variance.is_finite() && variance > 0.0 {
+            variance
+        } else {
+            counts.covariance_fallbacks += 1;
+            self.cfg.fallback_heading_sigma_rad.powi(2)
+        };
+        self.corrections.push((stamp, Correction::Heading { yaw, var }));
+    }
+
+    /// A GNSS position in the ENU frame: finite and within reach of the map frame.
+    fn position(&mut self, stamp: Stamp, enu: [f64; 2], covariance: Mat<2, 2>, antenna: Point2, q: FixQuality) {
+        let counts = &mut self.counts;
+        counts.fixes.received += 1;
+        let far = enu[0].abs().max(enu[1].abs()) > crate::geometry::MAX_POSITION_M;
+        if !(enu[0].is_finite() && enu[1].is_finite() && antenna.is_finite()) || far {
+            counts.fixes.rejected_not_finite += 1;
+            counts.rejected_fixes.push(RejectedFix { stamp, reason: FixRejection::NotFinite, nis: f64::NAN });
+            return;
+        }
+        let r = if is_spd(&covariance) {
+            covariance
+        } else {
+            counts.fixes.covariance_fallbacks += 1;
+            let fix_var = self.cfg.fallback_fix_sigma_m.powi(2);
+            [[fix_var, 0.0], [0.0, fix_var]]
+        };
+        self.corrections.push((stamp, Correction::Position { z: enu, r, antenna, quality: q }));
+    }
+
+    /// A full pose (a localiser's), with the fallback covariance where its own is unusable.
+    fn pose(&mut self, stamp: Stamp, pose: Pose2, covariance: Mat<3, 3>) {
+        let counts = &mut self.counts.poses;
+        counts.received += 1;
+        if !pose.is_position() {
+            counts.rejected_not_finite += 1;
+            return;
+        }
+        let r = if finite3(&covariance) && is_spd(&covariance) {
+            covariance
+        } else {
+            counts.covariance_fallbacks += 1;
+            let (m, a) = (self.cfg.fallback_pose_sigma_m.powi(2), self.cfg.fallback_pose_sigma_rad.powi(2));
+            [[m, 0.0, 0.0], [0.0, m, 0.0], [0.0, 0.0, a]]
+        };
+        self.corrections.push((stamp, Correction::Pose { z: [pose.x, pose.y, pose.theta], r }));
+    }
 }
 
 #[cfg(test)]
