@@ -358,73 +358,24 @@ fn iterate(
             break;
         }
         report.iterations += 1;
-        damped.copy_from_slice(&h);
-        for (j, d) in st.diag.iter().enumerate() {
-            for (c, &p) in d.iter().enumerate() {
-                let s = h[p + c].clamp(MIN_DIAGONAL, MAX_DIAGONAL);
-                scale[3 * j + c] = s;
-                damped[p + c] += lambda * s;
-            }
-        }
+        damp(st, &h, lambda, &mut damped, &mut scale);
         for (d, g) in delta.iter_mut().zip(&grad) {
             *d = -g;
         }
-        let Structure { col_ptr, row_idx, symbolic, mem, factor, .. } = &mut *st;
-        let stack = MemStack::new(mem);
-        let matrix = SparseColMatRef::new(SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx), &damped);
-        match symbolic.factorize_numeric_llt(
-            factor,
-            matrix,
-            Side::Upper,
-            LltRegularization::default(),
-            Par::Seq,
-            stack,
-            Default::default(),
-        ) {
-            Ok(llt) => {
-                llt.solve_in_place_with_conj(
-                    Conj::No,
-                    MatMut::from_column_major_slice_mut(&mut delta, n, 1),
-                    Par::Seq,
-                    stack,
-                );
-                last_failed_factorization = false;
-            }
-            Err(_) => {
-                last_failed_factorization = true;
-                lambda *= nu;
-                nu *= 2.0;
-                continue;
-            }
+        last_failed_factorization = !solve_in_place(st, &damped, &mut delta);
+        if last_failed_factorization {
+            lambda *= nu;
+            nu *= 2.0;
+            continue;
         }
-
-        let step_norm = delta.iter().map(|d| d * d).sum::<f64>().sqrt();
-        let x_norm = graph
-            .nodes
-            .iter()
-            .zip(&st.free)
-            .filter(|(_, &f)| f != FIXED)
-            .map(|(p, _)| p.x * p.x + p.y * p.y + p.theta * p.theta)
-            .sum::<f64>()
-            .sqrt();
-        if step_norm <= opts.parameter_tolerance * (x_norm + opts.parameter_tolerance) {
+        if step_is_negligible(graph, st, &delta, opts) {
             report.converged = true;
             break;
         }
-        for ((t, x), &f) in trial.iter_mut().zip(&graph.nodes).zip(&st.free) {
-            *t = if f == FIXED {
-                *x
-            } else {
-                let d = &delta[3 * f..3 * f + 3];
-                Pose2::new(x.x + d[0], x.y + d[1], normalize_angle(x.theta + d[2]))
-            };
-        }
+        apply_step(graph, st, &delta, &mut trial);
         let new_cost = total_cost(graph, &trial);
-        // Decrease predicted by the damped quadratic model: ½ δᵀ(λ D δ − g).
-        let predicted: f64 =
-            0.5 * delta.iter().zip(&grad).zip(&scale).map(|((d, g), s)| d * (lambda * s * d - g)).sum::<f64>();
         if new_cost.is_finite() && new_cost < cost {
-            let gain = (cost - new_cost) / predicted.max(f64::MIN_POSITIVE);
+            let gain = (cost - new_cost) / predicted_decrease(&delta, &grad, &scale, lambda).max(f64::MIN_POSITIVE);
             std::mem::swap(&mut graph.nodes, &mut trial);
             report.accepted_steps += 1;
             let relative = (cost - new_cost) / cost;
@@ -447,6 +398,74 @@ fn iterate(
     }
     report.final_cost = cost;
     Ok(())
+}
+
+/// `damped` = `h` with `λ` times its clamped diagonal added (Levenberg–Marquardt with
+/// Marquardt's scaling); `scale` receives that diagonal.
+fn damp(st: &Structure, h: &[f64], lambda: f64, damped: &mut [f64], scale: &mut [f64]) {
+    damped.copy_from_slice(h);
+    for (j, d) in st.diag.iter().enumerate() {
+        for (c, &p) in d.iter().enumerate() {
+            let s = h[p + c].clamp(MIN_DIAGONAL, MAX_DIAGONAL);
+            scale[3 * j + c] = s;
+            damped[p + c] += lambda * s;
+        }
+    }
+}
+
+/// Solves `damped · x = delta` in place by sparse Cholesky on the symbolic factorisation of
+/// `st`; false when the numeric factorisation fails (not positive definite).
+fn solve_in_place(st: &mut Structure, damped: &[f64], delta: &mut [f64]) -> bool {
+    let n = delta.len();
+    let Structure { col_ptr, row_idx, symbolic, mem, factor, .. } = st;
+    let stack = MemStack::new(mem);
+    let matrix = SparseColMatRef::new(SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx), damped);
+    match symbolic.factorize_numeric_llt(
+        factor,
+        matrix,
+        Side::Upper,
+        LltRegularization::default(),
+        Par::Seq,
+        stack,
+        Default::default(),
+    ) {
+        Ok(llt) => {
+            llt.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(delta, n, 1), Par::Seq, stack);
+            true
+        }
+        Err(_) => false,
+    }
+}
+
+/// True when the step is below `parameter_tolerance` relative to the free poses' norm.
+fn step_is_negligible(graph: &PoseGraph, st: &Structure, delta: &[f64], opts: &OptimizeOptions) -> bool {
+    let step_norm = delta.iter().map(|d| d * d).sum::<f64>().sqrt();
+    let x_norm = graph
+        .nodes
+        .iter()
+        .zip(&st.free)
+        .filter(|(_, &f)| f != FIXED)
+        .map(|(p, _)| p.x * p.x + p.y * p.y + p.theta * p.theta)
+        .sum::<f64>()
+        .sqrt();
+    step_norm <= opts.parameter_tolerance * (x_norm + opts.parameter_tolerance)
+}
+
+/// `trial` = the graph's poses moved by `delta` (fixed poses unchanged).
+fn apply_step(graph: &PoseGraph, st: &Structure, delta: &[f64], trial: &mut [Pose2]) {
+    for ((t, x), &f) in trial.iter_mut().zip(&graph.nodes).zip(&st.free) {
+        *t = if f == FIXED {
+            *x
+        } else {
+            let d = &delta[3 * f..3 * f + 3];
+            Pose2::new(x.x + d[0], x.y + d[1], normalize_angle(x.theta + d[2]))
+        };
+    }
+}
+
+/// The decrease of the cost the damped quadratic model predicts: ½ δᵀ(λ D δ − g).
+fn predicted_decrease(delta: &[f64], grad: &[f64], scale: &[f64], lambda: f64) -> f64 {
+    0.5 * delta.iter().zip(grad).zip(scale).map(|((d, g), s)| d * (lambda * s * d - g)).sum::<f64>()
 }
 
 /// `∇F` at the current estimates with every node free (for derivative checks).
