@@ -11,6 +11,8 @@ mod fusion;
 mod limits;
 mod log;
 mod map;
+mod plan;
+mod pose_sensor;
 mod sensor;
 mod slam;
 
@@ -19,7 +21,8 @@ pub use fusion::FusionConfig;
 pub use limits::LimitsConfig;
 pub use log::{ExtrinsicsSource, LogConfig, PoseSource, SyncConfig};
 pub use map::MapConfig;
-pub use sensor::{auto_sensor, GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
+pub use plan::auto_sensor;
+pub use sensor::{GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 pub use slam::{SlamConfig, SlamMode};
 
 use crate::estimator::EstimatorConfig;
@@ -141,8 +144,8 @@ impl Config {
     /// Checks every field and builds the plan. The first problem found is returned.
     pub fn validate(&self) -> Result<Plan, FieldError> {
         let (geometry, occupancy) = self.map.validate()?;
-        let sensor::PlannedSensors { mut lidars, cameras, others: sensors } =
-            sensor::plan_sensors(&self.sensor, occupancy.prior)?;
+        let plan::PlannedSensors { mut lidars, cameras, others: sensors } =
+            plan::plan_sensors(&self.sensor, occupancy.prior)?;
         let lidar_listed = self.sensor.iter().any(|s| s.kind == SensorKind::Lidar);
         if lidars.is_empty() && !lidar_listed {
             lidars.push(sensor::default_lidar());

@@ -7,7 +7,7 @@
 //!
 //! Kinds not listed at all are looked for in the log under their usual topics (`/scan` or
 //! the log's only scan topic, `/odom`, `/imu`, `/fix`), so a log with no config still maps
-//! (cameras excepted: a camera is used only when listed);
+//! (a camera on `/camera/labels`, `/camera/depth` and `/camera/camera_info`);
 //! a kind that is listed is used exactly as written (its topic must be in the log), and
 //! `enabled = false` switches a kind off, auto-detection included.
 
@@ -15,7 +15,6 @@ use crate::geometry::{Mount3, PlanarMount};
 use crate::sensor::{LidarModel, LidarParams, MaxRangePolicy, ScanFilters};
 use serde::{Deserialize, Serialize};
 
-use super::camera::{plan_camera, PlannedCamera};
 use super::{check_mount, err, finite, probability, FieldError};
 
 /// What a sensor is.
@@ -171,7 +170,7 @@ pub struct SensorConfig {
     pub sigma_unknown_m: Option<f64>,
     /// GNSS: the altitudes a fix may have, `[lowest, highest]` metres above the WGS 84
     /// ellipsoid; fixes outside are dropped as receiver faults (default
-    /// [`DEFAULT_ALTITUDE_RANGE_M`]).
+    /// [`crate::estimator::DEFAULT_ALTITUDE_RANGE_M`]).
     #[serde(default)]
     pub altitude_range_m: Option<[f64; 2]>,
 
@@ -274,7 +273,7 @@ impl SensorConfig {
     }
 
     /// The keys given that belong to another kind, by name.
-    fn foreign_keys(&self) -> Vec<&'static str> {
+    pub(super) fn foreign_keys(&self) -> Vec<&'static str> {
         let mut v = Vec::new();
         let mut check = |given: bool, key: &'static str, kind: SensorKind| {
             if given && self.kind != kind {
@@ -336,7 +335,6 @@ pub struct OdometryNoise {
 
 /// GNSS σ floors by fix status (the estimator's measurement model).
 pub use crate::estimator::GnssNoise;
-use crate::estimator::DEFAULT_ALTITUDE_RANGE_M;
 
 /// What a sensor adds to a run, validated.
 #[derive(Clone, Debug, PartialEq)]
@@ -394,134 +392,7 @@ pub struct PlannedLidar {
     pub explicit: bool,
 }
 
-/// The `[[sensor]]` tables, validated and sorted by what the run does with them.
-pub(super) struct PlannedSensors {
-    pub lidars: Vec<PlannedLidar>,
-    pub cameras: Vec<PlannedCamera>,
-    pub others: Vec<PlannedSensor>,
-}
-
-/// Validates the `[[sensor]]` tables into lidars, cameras and the other sensors. `prior`
-/// is the map's prior (lidar probabilities must straddle it; camera free evidence must be
-/// below it).
-pub(super) fn plan_sensors(tables: &[SensorConfig], prior: f64) -> Result<PlannedSensors, FieldError> {
-    let mut lidars = Vec::new();
-    let mut cameras = Vec::new();
-    let mut others = Vec::new();
-    let mut names: Vec<String> = Vec::new();
-    for (i, s) in tables.iter().enumerate() {
-        let f = |name: &str| format!("sensor[{i}].{name}");
-        if let Some(k) = s.foreign_keys().first() {
-            return Err(err(f(k), format!("not a key of a `{}` sensor", s.kind.as_str())));
-        }
-        let same_kind = tables[..i].iter().filter(|o| o.kind == s.kind).count();
-        let name = match &s.name {
-            Some(n) if n.trim().is_empty() => return Err(err(f("name"), "must not be empty")),
-            Some(n) => n.clone(),
-            None if same_kind == 0 => s.kind.default_name().to_string(),
-            None => format!("{}{}", s.kind.default_name(), same_kind + 1),
-        };
-        if names.contains(&name) {
-            return Err(err(f("name"), format!("`{name}` is used by two sensors")));
-        }
-        names.push(name.clone());
-        if let Some(t) = &s.topic {
-            if t.trim().is_empty() {
-                return Err(err(f("topic"), "must not be empty (leave it out to look for the usual topic)"));
-            }
-            let same = |o: &SensorConfig| o.enabled && o.kind == s.kind && o.topic.as_ref() == Some(t);
-            if let Some(j) = tables[..i].iter().position(same).filter(|_| s.enabled) {
-                return Err(err(
-                    f("topic"),
-                    format!("`{t}` is read by sensor[{j}] already: one `{}` table per topic", s.kind.as_str()),
-                ));
-            }
-        }
-        let offset = finite(&f("time_offset_s"), s.time_offset_s)?;
-        if offset.abs() > 3600.0 {
-            return Err(err(f("time_offset_s"), format!("must be within ±3600 s, got {offset}")));
-        }
-        if !s.enabled {
-            continue;
-        }
-        if s.kind == SensorKind::Lidar {
-            lidars.push(plan_lidar(i, s, name, prior)?);
-            continue;
-        }
-        if s.kind == SensorKind::Camera {
-            cameras.push(plan_camera(i, s, name, prior)?);
-            continue;
-        }
-        let pos = |k: &str, v: Option<f64>| -> Result<Option<f64>, FieldError> {
-            match v {
-                Some(x) if finite(&f(k), x)? <= 0.0 => Err(err(f(k), format!("must be > 0, got {x}"))),
-                v => Ok(v),
-            }
-        };
-        let odometry = OdometryNoise {
-            translation_per_sqrt_m: pos("translation_noise_per_sqrt_m", s.translation_noise_per_sqrt_m)?,
-            rotation_per_sqrt_rad: pos("rotation_noise_per_sqrt_rad", s.rotation_noise_per_sqrt_rad)?,
-            rotation_per_sqrt_m: pos("rotation_noise_per_sqrt_m", s.rotation_noise_per_sqrt_m)?,
-        };
-        let gyro = pos("gyro_noise_rad_s", s.gyro_noise_rad_s)?;
-        if let Some([lat, lon, alt]) = s.datum {
-            for v in [lat, lon, alt] {
-                finite(&f("datum"), v)?;
-            }
-            if lat.abs() > 90.0 || lon.abs() > 180.0 {
-                return Err(err(
-                    f("datum"),
-                    format!("latitude must be within ±90° and longitude ±180°, got {lat}, {lon}"),
-                ));
-            }
-        }
-        let gnss = GnssNoise {
-            floor_rtk_m: s.sigma_floor_rtk_m.unwrap_or(0.02),
-            floor_sbas_m: s.sigma_floor_sbas_m.unwrap_or(0.5),
-            floor_fix_m: s.sigma_floor_fix_m.unwrap_or(0.5),
-            unknown_m: s.sigma_unknown_m.unwrap_or(3.0),
-        };
-        for (k, v) in [
-            ("sigma_floor_rtk_m", gnss.floor_rtk_m),
-            ("sigma_floor_sbas_m", gnss.floor_sbas_m),
-            ("sigma_floor_fix_m", gnss.floor_fix_m),
-            ("sigma_unknown_m", gnss.unknown_m),
-        ] {
-            if finite(&f(k), v)? <= 0.0 {
-                return Err(err(f(k), format!("must be > 0 metres, got {v}")));
-            }
-        }
-        let altitude_range_m = s.altitude_range_m.unwrap_or(DEFAULT_ALTITUDE_RANGE_M);
-        let [low, high] = altitude_range_m;
-        if finite(&f("altitude_range_m"), low)? >= finite(&f("altitude_range_m"), high)? {
-            return Err(err(f("altitude_range_m"), format!("must be [lowest, highest], got [{low}, {high}]")));
-        }
-        let pose_noise =
-            (pos("position_noise_m", s.position_noise_m)?, pos("yaw_noise_deg", s.yaw_noise_deg)?.map(f64::to_radians));
-        if let Some(m) = &s.base_from_sensor {
-            check_mount(f, m)?;
-        }
-        others.push(PlannedSensor {
-            kind: s.kind,
-            name,
-            topic: s.topic.clone(),
-            frame: s.frame.clone(),
-            time_offset_s: offset,
-            base_from_sensor: s.base_from_sensor,
-            odometry,
-            gyro_noise_rad_s: gyro,
-            use_orientation: s.use_orientation.unwrap_or(true),
-            datum: s.datum,
-            gnss,
-            altitude_range_m,
-            pose_noise,
-            explicit: true,
-        });
-    }
-    Ok(PlannedSensors { lidars, cameras, others })
-}
-
-fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<PlannedLidar, FieldError> {
+pub(super) fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<PlannedLidar, FieldError> {
     let f = |name: &str| format!("sensor[{i}].{name}");
     let d = LidarParams::default();
     let p_occ = probability(&f("p_occ"), s.p_occ.unwrap_or(d.p_occ))?;
@@ -568,16 +439,6 @@ fn plan_lidar(i: usize, s: &SensorConfig, name: String, prior: f64) -> Result<Pl
         time_offset_s: s.time_offset_s,
         explicit: true,
     })
-}
-
-/// The sensor a kind gets when the config lists none of it: looked for under its usual
-/// topic, with default noise figures.
-/// `None` for [`SensorKind::Lidar`], whose default is [`PlannedLidar`]'s, and for
-/// [`SensorKind::Camera`], which is mapped only when the config lists it.
-pub fn auto_sensor(kind: SensorKind) -> Option<PlannedSensor> {
-    let mut s = plan_sensors(&[SensorConfig::new(kind)], 0.5).ok()?.others.pop()?;
-    s.explicit = false;
-    Some(s)
 }
 
 /// The lidar mapped when the config lists none: the document's inverse model (§3.2),
