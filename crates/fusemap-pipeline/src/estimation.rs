@@ -171,10 +171,15 @@ fn imu_inputs(
             let world_from_imu = Pose3::new([0.0; 3], orientation);
             let q = world_from_imu.compose(&Pose3::new([0.0; 3], q_mount).inverse()).rotation;
             let yaw = quaternion_yaw(q);
-            if yaw.is_finite() && var.is_finite() && var > 0.0 {
-                let floor = all.config.imu_heading_floor_sigma_rad.powi(2);
-                floored += u64::from(var < floor);
-                all.inputs.push(EstimatorInput::Heading { stamp, yaw, variance: var.max(floor) });
+            // A variance that is not positive (all zeros: "unknown", REP 145) goes to the
+            // estimator as it is, which gives it `fallback_heading_sigma_rad` and counts it;
+            // a positive one below the floor is raised to it.
+            let floor = all.config.imu_heading_floor_sigma_rad.powi(2);
+            let raised = var > 0.0 && var < floor;
+            floored += u64::from(raised);
+            let variance = if raised { floor } else { var };
+            if yaw.is_finite() {
+                all.inputs.push(EstimatorInput::Heading { stamp, yaw, variance });
             }
         }
     }

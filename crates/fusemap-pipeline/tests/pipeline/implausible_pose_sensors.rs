@@ -229,6 +229,29 @@ fn an_imu_orientation_frozen_while_the_gyro_turns_is_left_out() {
     assert!(b < a + 0.02, "true orientation {a:.4} m, frozen {b:.4} m");
 }
 
+/// An orientation whose covariance is all zeros ("unknown", REP 145) is used with
+/// `estimator.fallback_heading_sigma_rad`, counted as a fallback, not dropped.
+#[test]
+fn an_imu_orientation_of_unknown_covariance_gets_the_fallback_sigma() {
+    let clean = short_run();
+    let mut rec = with_orientation(&clean, 1e9);
+    for m in rec.messages.iter_mut() {
+        if let SimMessage::Imu(i) = m {
+            i.orientation_covariance = [0.0; 9];
+        }
+    }
+    let mut cfg = estimator_only(Some(&clean));
+    cfg.sensor.push(SensorConfig { use_orientation: Some(true), ..SensorConfig::new(SensorKind::Imu) });
+    let run = map(&rec, "orientation-unknown-covariance", &cfg);
+    let report = serde_json::to_value(&run.report).unwrap();
+    let headings = &report["estimator"]["estimator"]["headings"];
+    println!("{headings}");
+    assert!(headings["received"].as_u64().unwrap() > 100, "{headings}");
+    assert_eq!(headings["covariance_fallbacks"], headings["received"], "{headings}");
+    assert!(!run.notes.iter().any(|n| n.contains("imu_heading_floor_sigma_rad")), "{:?}", run.notes);
+    assert!(ate(&run.trajectory, &clean.truth_trajectory) < 0.05);
+}
+
 #[test]
 fn fixes_too_imprecise_to_give_the_heading_are_dropped_with_a_note() {
     let mut rec = short_run();
