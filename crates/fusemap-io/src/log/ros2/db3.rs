@@ -46,6 +46,108 @@ fn uri_path(path: &Path) -> String {
     out
 }
 
+/// A file-level SQLite error in words that name the file.
+fn sql_error(path: &Path, what: &str, e: rusqlite::Error) -> Error {
+    Error::format(path, Location::File, format!("SQLite: {what}: {}", error_chain(&e)))
+}
+
+/// Every statement's time budget: a crafted file must not run a query forever. SQLite's
+/// progress handler stops the statement running once the deadline set by [`arm`] passes.
+///
+/// [`arm`]: QueryBudget::arm
+struct QueryBudget {
+    /// The running statement's deadline, nanoseconds after `started`.
+    deadline: Arc<AtomicU64>,
+    started: Instant,
+}
+
+impl QueryBudget {
+    /// The budget, installed on `conn`.
+    fn on(conn: &Connection) -> rusqlite::Result<Self> {
+        let deadline = Arc::new(AtomicU64::new(0));
+        let started = Instant::now();
+        let shared = Arc::clone(&deadline);
+        conn.progress_handler(
+            PROGRESS_OPS,
+            Some(move || started.elapsed().as_nanos() as u64 > shared.load(Ordering::Relaxed)),
+        )?;
+        Ok(Self { deadline, started })
+    }
+
+    /// Gives the next statement [`QUERY_BUDGET`] from now.
+    fn arm(&self) {
+        self.deadline.store((self.started.elapsed() + QUERY_BUDGET).as_nanos() as u64, Ordering::Relaxed);
+    }
+}
+
+/// `table` is a table of the rosbag2 schema (a view can be any query, a virtual table any
+/// code). The type is the one SQLite gave the object it loaded (`pragma_table_list`), not
+/// the `type` column of `sqlite_master`, which a crafted file can set to `table` over a
+/// `CREATE VIEW`.
+fn check_table(conn: &Connection, path: &Path, table: &str) -> Result<()> {
+    let query = || {
+        conn.query_row("SELECT type FROM pragma_table_list WHERE schema = 'main' AND name = ?1", [table], |row| {
+            row.get(0)
+        })
+        .optional()
+    };
+    let kind: Option<String> = match query() {
+        // SQLite refuses a file shorter than its header says (a cut bag) as malformed
+        // before reading anything, unless `writable_schema` is on; on a read-only
+        // connection that only lifts this check, so the intact pages can be read (and a
+        // damaged row is met as a truncation, in `read_order`).
+        Err(e) if is_corrupt(&e) => {
+            conn.pragma_update(None, "writable_schema", true)
+                .map_err(|e| sql_error(path, "reading a damaged database", e))?;
+            query()
+        }
+        other => other,
+    }
+    .map_err(|e| sql_error(path, "reading the schema", e))?;
+    let why = match kind.as_deref() {
+        Some("table") => return Ok(()),
+        Some(other) => format!("`{table}` is a {other}, not a table: not a rosbag2 database"),
+        None => format!("no table `{table}`: not a rosbag2 database"),
+    };
+    Err(Error::format(path, Location::File, why))
+}
+
+/// The `topics` table by id.
+fn read_topics(conn: &Connection) -> rusqlite::Result<HashMap<i64, Topic>> {
+    let mut stmt = conn.prepare("SELECT id, name, type, serialization_format FROM topics")?;
+    let rows = stmt.query_map([], |row| {
+        Ok((row.get::<_, i64>(0)?, Topic { name: row.get(1)?, type_name: row.get(2)?, encoding: row.get(3)? }))
+    })?;
+    rows.collect()
+}
+
+/// The message rows in timestamp order, and why the rest was lost when the file is cut
+/// or damaged: rosbag2 writes rows in receive order, so the rows a scan of the table
+/// reaches before the damage are the log's intact start.
+fn read_order(conn: &Connection, path: &Path, budget: &QueryBudget) -> Result<(Vec<i64>, Option<String>)> {
+    let e = match message_order(conn) {
+        Ok(order) => return Ok((order, None)),
+        Err(e) if is_corrupt(&e) => e,
+        Err(e) => return Err(sql_error(path, "reading table `messages`", e)),
+    };
+    budget.arm();
+    let (order, stop) = intact_rows(conn).map_err(|e| sql_error(path, "reading table `messages`", e))?;
+    match stop {
+        // The index was damaged, the table whole: every row is read.
+        None => Ok((order, None)),
+        Some(_) if order.is_empty() => Err(sql_error(path, "reading table `messages`", e)),
+        Some(stop) => {
+            let why = format!(
+                "SQLite: the database is damaged after {} rows of table `messages` ({}): it is truncated or \
+                 corrupt; those rows are read, the rest is lost",
+                order.len(),
+                error_chain(&stop)
+            );
+            Ok((order, Some(why)))
+        }
+    }
+}
+
 /// One `.db3` file being read.
 pub(crate) struct Db3Source {
     path: PathBuf,
@@ -54,9 +156,8 @@ pub(crate) struct Db3Source {
     /// Row ids in timestamp order.
     order: Vec<i64>,
     next: usize,
-    /// The running statement's deadline, nanoseconds after `started`.
-    deadline: Arc<AtomicU64>,
-    started: Instant,
+    /// The running statement's time budget.
+    budget: QueryBudget,
     /// The most bytes one message's `data` may hold (`limits.decompressed_mib`).
     max_message: u64,
     /// Why only part of `messages` could be read (a cut or damaged file), reported as a
@@ -109,124 +210,26 @@ impl Db3Source {
     pub(crate) fn open(path: &Path, max_message: u64) -> Result<Self> {
         // SQLite would create a missing file; report it as the OS would.
         std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
-        let sql_error = |what: &str, e: rusqlite::Error| {
-            Error::format(path, Location::File, format!("SQLite: {what}: {}", error_chain(&e)))
-        };
         // Read-only and immutable: SQLite then takes no locks and writes no `-wal`/`-shm`
         // file beside the input (which also lets a bag on read-only media be read).
         let uri = format!("file:{}?immutable=1", uri_path(path));
         let flags = OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_URI | OpenFlags::SQLITE_OPEN_NO_MUTEX;
-        let conn = Connection::open_with_flags(uri, flags).map_err(|e| sql_error("cannot open", e))?;
-        // Every statement gets a time budget: a crafted file must not run a query forever.
-        let deadline = Arc::new(AtomicU64::new(0));
-        let started = Instant::now();
-        {
-            let deadline = Arc::clone(&deadline);
-            conn.progress_handler(
-                PROGRESS_OPS,
-                Some(move || started.elapsed().as_nanos() as u64 > deadline.load(Ordering::Relaxed)),
-            )
-            .map_err(|e| sql_error("setting a time budget", e))?;
-        }
-        let arm = || deadline.store((started.elapsed() + QUERY_BUDGET).as_nanos() as u64, Ordering::Relaxed);
-        // The rosbag2 schema: `topics` and `messages` are tables (a view can be any query,
-        // a virtual table any code). The type is the one SQLite gave the object it loaded
-        // (`pragma_table_list`), not the `type` column of `sqlite_master`, which a crafted
-        // file can set to `table` over a `CREATE VIEW`.
+        let conn = Connection::open_with_flags(uri, flags).map_err(|e| sql_error(path, "cannot open", e))?;
+        let budget = QueryBudget::on(&conn).map_err(|e| sql_error(path, "setting a time budget", e))?;
         for table in ["topics", "messages"] {
-            arm();
-            let query = || {
-                conn.query_row(
-                    "SELECT type FROM pragma_table_list WHERE schema = 'main' AND name = ?1",
-                    [table],
-                    |row| row.get(0),
-                )
-                .optional()
-            };
-            let kind: Option<String> = match query() {
-                // SQLite refuses a file shorter than its header says (a cut bag) as
-                // malformed before reading anything, unless `writable_schema` is on; on a
-                // read-only connection that only lifts this check, so the intact pages
-                // can be read (and a damaged row is met as a truncation, below).
-                Err(e) if is_corrupt(&e) => {
-                    conn.pragma_update(None, "writable_schema", true)
-                        .map_err(|e| sql_error("reading a damaged database", e))?;
-                    query()
-                }
-                other => other,
-            }
-            .map_err(|e| sql_error("reading the schema", e))?;
-            match kind.as_deref() {
-                Some("table") => {}
-                Some(other) => {
-                    return Err(Error::format(
-                        path,
-                        Location::File,
-                        format!("`{table}` is a {other}, not a table: not a rosbag2 database"),
-                    ))
-                }
-                None => {
-                    return Err(Error::format(
-                        path,
-                        Location::File,
-                        format!("no table `{table}`: not a rosbag2 database"),
-                    ))
-                }
-            }
+            budget.arm();
+            check_table(&conn, path, table)?;
         }
-        arm();
-
-        let mut topics = HashMap::new();
-        {
-            let mut stmt = conn
-                .prepare("SELECT id, name, type, serialization_format FROM topics")
-                .map_err(|e| sql_error("reading table `topics`", e))?;
-            let rows = stmt
-                .query_map([], |row| {
-                    Ok((
-                        row.get::<_, i64>(0)?,
-                        Topic { name: row.get(1)?, type_name: row.get(2)?, encoding: row.get(3)? },
-                    ))
-                })
-                .map_err(|e| sql_error("reading table `topics`", e))?;
-            for row in rows {
-                let (id, topic) = row.map_err(|e| sql_error("reading table `topics`", e))?;
-                topics.insert(id, topic);
-            }
-        }
-
-        arm();
-        let (order, damaged) = match message_order(&conn) {
-            Ok(order) => (order, None),
-            // A cut or damaged file: rosbag2 writes rows in receive order, so the rows a
-            // scan of the table reaches before the damage are the log's intact start.
-            Err(e) if is_corrupt(&e) => {
-                arm();
-                let (order, stop) = intact_rows(&conn).map_err(|e| sql_error("reading table `messages`", e))?;
-                match stop {
-                    // The index was damaged, the table whole: every row is read.
-                    None => (order, None),
-                    Some(_) if order.is_empty() => return Err(sql_error("reading table `messages`", e)),
-                    Some(stop) => {
-                        let why = format!(
-                            "SQLite: the database is damaged after {} rows of table `messages` ({}): it is \
-                             truncated or corrupt; those rows are read, the rest is lost",
-                            order.len(),
-                            error_chain(&stop)
-                        );
-                        (order, Some(why))
-                    }
-                }
-            }
-            Err(e) => return Err(sql_error("reading table `messages`", e)),
-        };
-
-        Ok(Self { path: path.to_path_buf(), conn, topics, order, next: 0, deadline, started, max_message, damaged })
+        budget.arm();
+        let topics = read_topics(&conn).map_err(|e| sql_error(path, "reading table `topics`", e))?;
+        budget.arm();
+        let (order, damaged) = read_order(&conn, path, &budget)?;
+        Ok(Self { path: path.to_path_buf(), conn, topics, order, next: 0, budget, max_message, damaged })
     }
 
     /// Fetches row `id` and hands it to `visit`, its payload borrowed from SQLite.
     fn fetch(&mut self, index: u64, id: i64, visit: &mut dyn FnMut(RawMessage<'_>)) -> Result<()> {
-        self.deadline.store((self.started.elapsed() + QUERY_BUDGET).as_nanos() as u64, Ordering::Relaxed);
+        self.budget.arm();
         let path = &self.path;
         let at = |topic: String, message: String| Error::format(path, Location::Message { index, topic }, message);
         let topics = &self.topics;
