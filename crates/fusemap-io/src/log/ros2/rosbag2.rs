@@ -93,97 +93,117 @@ impl Rosbag2Dir {
             let location = if line == 0 { Location::File } else { Location::Line(line) };
             Error::format(&meta_path, location, message)
         })?;
-        let field_error = |key: &str, message: String| Error::format(&meta_path, Location::Field(key.into()), message);
-
-        let mode = meta.compression_mode.to_ascii_lowercase();
-        let format = meta.compression_format.to_ascii_lowercase();
-        let (zstd_file, zstd_messages) = match mode.as_str() {
-            "" | "none" => (false, false),
-            "file" | "message" if format != "zstd" => {
-                return Err(field_error(
-                    "compression_format",
-                    format!(
-                        "compression `{}` is not supported; fusemap reads zstd-compressed bags",
-                        meta.compression_format
-                    ),
-                ))
-            }
-            "file" => (true, false),
-            "message" => (false, true),
-            _ => {
-                return Err(field_error(
-                    "compression_mode",
-                    format!("unknown compression mode `{}` (expected file or message)", meta.compression_mode),
-                ))
-            }
-        };
-
+        let field_error =
+            |(key, message): (&str, String)| Error::format(&meta_path, Location::Field(key.into()), message);
+        let (zstd_file, zstd_messages) = compression(&meta).map_err(field_error)?;
         if meta.relative_file_paths.is_empty() {
-            return Err(field_error("relative_file_paths", "the bag lists no storage files".into()));
+            return Err(field_error(("relative_file_paths", "the bag lists no storage files".into())));
         }
-        let storage = meta.storage_identifier.to_ascii_lowercase();
         let mut files = Vec::new();
         let mut seen: Vec<(PathBuf, &str)> = Vec::new();
         for rel in &meta.relative_file_paths {
-            // The bag names its files relative to its own directory: an absolute path or a
-            // `..` would let a bag someone sent make fusemap open any file.
-            if !stays_inside(rel) {
-                return Err(field_error(
-                    "relative_file_paths",
-                    format!("lists `{}`, which is outside the bag directory; refused", rel.escape_debug()),
-                ));
-            }
-            let path = resolve(dir, rel).ok_or_else(|| {
-                field_error("relative_file_paths", format!("lists `{rel}`, which is not in {}", dir.display()))
-            })?;
-            // One file listed twice (or by two spellings) would be read, and mapped, twice.
-            let canonical = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
-            if let Some((_, first)) = seen.iter().find(|(p, _)| *p == canonical) {
-                return Err(field_error(
-                    "relative_file_paths",
-                    format!(
-                        "lists the storage file `{}` twice (as `{}` and `{}`): every message would be read twice; \
-                         remove the repeat",
-                        canonical.display(),
-                        first.escape_debug(),
-                        rel.escape_debug()
-                    ),
-                ));
-            }
-            seen.push((canonical, rel));
-            let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-            let compressed = zstd_file || name.ends_with(".zstd");
-            let base = name.trim_end_matches(".zstd");
-            let is_mcap = match storage.as_str() {
-                "mcap" => true,
-                "sqlite3" => false,
-                _ if base.ends_with(".mcap") => true,
-                _ if base.ends_with(".db3") => false,
-                _ => {
-                    return Err(field_error(
-                        "storage_identifier",
-                        format!(
-                            "storage `{}` is not supported (fusemap reads `mcap` and `sqlite3` bags)",
-                            meta.storage_identifier
-                        ),
-                    ))
-                }
-            };
-            if is_mcap {
-                files.push(PendingFile::Mcap { path, zstd: compressed });
-            } else if compressed {
-                return Err(field_error(
-                    "compression_mode",
-                    format!(
-                        "`{rel}` is a whole-file zstd-compressed SQLite bag; decompress it first \
-                         (`zstd -d`, then list the .db3 in metadata.yaml) or convert the bag to MCAP"
-                    ),
-                ));
-            } else {
-                files.push(PendingFile::Db3 { path });
-            }
+            let path = storage_file(dir, rel, &mut seen).map_err(field_error)?;
+            files.push(pending_file(&meta, path, rel, zstd_file).map_err(field_error)?);
         }
         Ok(Self { files, zstd_messages })
+    }
+}
+
+/// A metadata key and why its value is refused.
+type KeyError = (&'static str, String);
+
+/// Whether the bag's files, or else its messages, are zstd-compressed.
+fn compression(meta: &Metadata) -> std::result::Result<(bool, bool), KeyError> {
+    let mode = meta.compression_mode.to_ascii_lowercase();
+    let format = meta.compression_format.to_ascii_lowercase();
+    match mode.as_str() {
+        "" | "none" => Ok((false, false)),
+        "file" | "message" if format != "zstd" => Err((
+            "compression_format",
+            format!("compression `{}` is not supported; fusemap reads zstd-compressed bags", meta.compression_format),
+        )),
+        "file" => Ok((true, false)),
+        "message" => Ok((false, true)),
+        _ => Err((
+            "compression_mode",
+            format!("unknown compression mode `{}` (expected file or message)", meta.compression_mode),
+        )),
+    }
+}
+
+/// The storage file `rel` names inside `dir`, refused when it lies outside the bag or
+/// repeats one already listed (`seen`, canonical paths with their spellings).
+fn storage_file<'a>(
+    dir: &Path,
+    rel: &'a str,
+    seen: &mut Vec<(PathBuf, &'a str)>,
+) -> std::result::Result<PathBuf, KeyError> {
+    // The bag names its files relative to its own directory: an absolute path or a `..`
+    // would let a bag someone sent make fusemap open any file.
+    if !stays_inside(rel) {
+        return Err((
+            "relative_file_paths",
+            format!("lists `{}`, which is outside the bag directory; refused", rel.escape_debug()),
+        ));
+    }
+    let path = resolve(dir, rel)
+        .ok_or_else(|| ("relative_file_paths", format!("lists `{rel}`, which is not in {}", dir.display())))?;
+    // One file listed twice (or by two spellings) would be read, and mapped, twice.
+    let canonical = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
+    if let Some((_, first)) = seen.iter().find(|(p, _)| *p == canonical) {
+        return Err((
+            "relative_file_paths",
+            format!(
+                "lists the storage file `{}` twice (as `{}` and `{}`): every message would be read twice; remove \
+                 the repeat",
+                canonical.display(),
+                first.escape_debug(),
+                rel.escape_debug()
+            ),
+        ));
+    }
+    seen.push((canonical, rel));
+    Ok(path)
+}
+
+/// The storage file at `path` (listed as `rel`) as the bag's storage plugin, or its name,
+/// says to read it.
+fn pending_file(
+    meta: &Metadata,
+    path: PathBuf,
+    rel: &str,
+    zstd_file: bool,
+) -> std::result::Result<PendingFile, KeyError> {
+    let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    let compressed = zstd_file || name.ends_with(".zstd");
+    let base = name.trim_end_matches(".zstd");
+    let is_mcap = match meta.storage_identifier.to_ascii_lowercase().as_str() {
+        "mcap" => true,
+        "sqlite3" => false,
+        _ if base.ends_with(".mcap") => true,
+        _ if base.ends_with(".db3") => false,
+        _ => {
+            return Err((
+                "storage_identifier",
+                format!(
+                    "storage `{}` is not supported (fusemap reads `mcap` and `sqlite3` bags)",
+                    meta.storage_identifier
+                ),
+            ))
+        }
+    };
+    if is_mcap {
+        Ok(PendingFile::Mcap { path, zstd: compressed })
+    } else if compressed {
+        Err((
+            "compression_mode",
+            format!(
+                "`{rel}` is a whole-file zstd-compressed SQLite bag; decompress it first (`zstd -d`, then list the \
+                 .db3 in metadata.yaml) or convert the bag to MCAP"
+            ),
+        ))
+    } else {
+        Ok(PendingFile::Db3 { path })
     }
 }
 
