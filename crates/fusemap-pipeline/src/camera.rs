@@ -122,18 +122,9 @@ pub(crate) fn build_camera(
             list(inv.camera_info.keys())
         ))
     })?;
-    for t in [&c.topic, &c.depth_topic] {
-        if let (false, Some((n, first))) = (inv.images.contains_key(t), inv.stats.malformed_by_topic.get(t)) {
-            return unusable(format!("the log's {n} messages on `{t}` are all malformed; the first: {first}"));
-        }
-        if !inv.images.contains_key(t) {
-            return Err(refuse(format!(
-                "the log has no images on `{t}`; log image topics: {}",
-                list(inv.images.keys())
-            )));
-        }
+    if let Some(why) = image_streams(c, inv).map_err(refuse)? {
+        return unusable(why);
     }
-    over_image_pixels(c, inv).map_or(Ok(()), |m| Err(refuse(m)))?;
     let i = &info.first;
     let pinhole = match Pinhole::from_camera_info(i.width, i.height, i.k, &i.distortion_model, &i.d) {
         Ok(p) => p,
@@ -184,6 +175,21 @@ pub(crate) fn build_camera(
         ..Default::default()
     };
     Ok(BuiltCamera::Ready(Box::new((model, report))))
+}
+
+/// The camera's label and depth topics as the first pass found them: why they are
+/// unusable (every message malformed), or the refusal (a topic the log lacks, images over
+/// `limits.image_pixels`).
+fn image_streams(c: &PlannedCamera, inv: &Inventory) -> Result<Option<String>, String> {
+    for t in [&c.topic, &c.depth_topic] {
+        if let (false, Some((n, first))) = (inv.images.contains_key(t), inv.stats.malformed_by_topic.get(t)) {
+            return Ok(Some(format!("the log's {n} messages on `{t}` are all malformed; the first: {first}")));
+        }
+        if !inv.images.contains_key(t) {
+            return Err(format!("the log has no images on `{t}`; log image topics: {}", list(inv.images.keys())));
+        }
+    }
+    over_image_pixels(c, inv).map_or(Ok(None), Err)
 }
 
 /// The refusal the second pass would give at the camera's first image over
