@@ -439,44 +439,13 @@ pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
     };
     let bad = |msg: String| Error::format(path, field.clone(), msg);
 
-    let mut pre = [0u8; 8];
-    entry.read_exact(&mut pre).map_err(|e| bad(format!("truncated .npy header: {e}")))?;
-    if &pre[..6] != NPY_MAGIC {
-        return Err(bad("not a .npy file (bad magic)".into()));
-    }
-    let header_len = match pre[6] {
-        1 => {
-            let mut l = [0u8; 2];
-            entry.read_exact(&mut l).map_err(|e| bad(format!("truncated .npy header: {e}")))?;
-            u16::from_le_bytes(l) as usize
-        }
-        2 | 3 => {
-            let mut l = [0u8; 4];
-            entry.read_exact(&mut l).map_err(|e| bad(format!("truncated .npy header: {e}")))?;
-            u32::from_le_bytes(l) as usize
-        }
-        v => return Err(bad(format!("unsupported .npy version {v}.{}", pre[7]))),
-    };
-    if header_len > 1 << 20 {
-        return Err(bad(format!("implausible .npy header length {header_len}")));
-    }
-    let mut header = vec![0u8; header_len];
-    entry.read_exact(&mut header).map_err(|e| bad(format!("truncated .npy header: {e}")))?;
-    let header = String::from_utf8(header).map_err(|_| bad("header is not text".into()))?;
+    let header = read_npy_header(&mut entry).map_err(bad)?;
     let (descr, fortran, shape) = parse_header(&header).map_err(bad)?;
     if fortran {
         return Err(bad("Fortran-order arrays are not supported".into()));
     }
     let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).ok_or_else(|| bad("shape overflows".into()))?;
-    let str_width = descr.strip_prefix("<U").and_then(|n| n.parse::<usize>().ok());
-    let item = match (descr.as_str(), str_width) {
-        ("<f4" | "<i4", _) => 4,
-        ("<f8" | "<i8", _) => 8,
-        ("<i2", _) => 2,
-        ("|b1" | "|u1", _) => 1,
-        (_, Some(n)) => n.checked_mul(4).ok_or_else(|| bad(format!("unsupported dtype `{descr}`")))?,
-        (d, None) => return Err(bad(format!("unsupported dtype `{d}`"))),
-    };
+    let item = item_size(&descr).map_err(bad)?;
     let bytes = count.checked_mul(item).ok_or_else(|| bad("shape overflows".into()))?;
     if bytes as u64 > entry.size() {
         return Err(bad(format!("shape {shape:?} needs {bytes} bytes but the member holds {}", entry.size())));
@@ -491,7 +460,56 @@ pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
             raw.len()
         )));
     }
-    let values = match descr.as_str() {
+    let values = decode(&descr, item, raw);
+    Ok(NpyOwned { shape, values })
+}
+
+/// The header text of a `.npy` stream: magic, version 1 to 3, and a header length of at
+/// most 1 MiB.
+fn read_npy_header(entry: &mut impl Read) -> std::result::Result<String, String> {
+    let truncated = |e: std::io::Error| format!("truncated .npy header: {e}");
+    let mut pre = [0u8; 8];
+    entry.read_exact(&mut pre).map_err(truncated)?;
+    if &pre[..6] != NPY_MAGIC {
+        return Err("not a .npy file (bad magic)".into());
+    }
+    let header_len = match pre[6] {
+        1 => {
+            let mut l = [0u8; 2];
+            entry.read_exact(&mut l).map_err(truncated)?;
+            u16::from_le_bytes(l) as usize
+        }
+        2 | 3 => {
+            let mut l = [0u8; 4];
+            entry.read_exact(&mut l).map_err(truncated)?;
+            u32::from_le_bytes(l) as usize
+        }
+        v => return Err(format!("unsupported .npy version {v}.{}", pre[7])),
+    };
+    if header_len > 1 << 20 {
+        return Err(format!("implausible .npy header length {header_len}"));
+    }
+    let mut header = vec![0u8; header_len];
+    entry.read_exact(&mut header).map_err(truncated)?;
+    String::from_utf8(header).map_err(|_| "header is not text".into())
+}
+
+/// Bytes one item of dtype `descr` takes (`<Un`: n UTF-32 characters).
+fn item_size(descr: &str) -> std::result::Result<usize, String> {
+    let str_width = descr.strip_prefix("<U").and_then(|n| n.parse::<usize>().ok());
+    match (descr, str_width) {
+        ("<f4" | "<i4", _) => Ok(4),
+        ("<f8" | "<i8", _) => Ok(8),
+        ("<i2", _) => Ok(2),
+        ("|b1" | "|u1", _) => Ok(1),
+        (_, Some(n)) => n.checked_mul(4).ok_or_else(|| format!("unsupported dtype `{descr}`")),
+        (d, None) => Err(format!("unsupported dtype `{d}`")),
+    }
+}
+
+/// The little-endian items of `raw` as dtype `descr` (of `item` bytes each).
+fn decode(descr: &str, item: usize, raw: Vec<u8>) -> NpyValues {
+    match descr {
         "<f4" => NpyValues::F32(raw.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),
         "<i4" => NpyValues::I32(raw.chunks_exact(4).map(|c| i32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()),
         "<i8" => NpyValues::I64(
@@ -514,8 +532,7 @@ pub fn read_npz(path: &Path, name: &str) -> Result<NpyOwned> {
                 })
                 .collect(),
         ),
-    };
-    Ok(NpyOwned { shape, values })
+    }
 }
 
 /// Reads a `float32` array of an `.npz`: its shape and values (see [`read_npz`]).
