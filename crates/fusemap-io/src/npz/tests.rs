@@ -1,6 +1,9 @@
+use super::read::parse_header;
 use super::*;
 use fusemap_core::geometry::Point2;
 use fusemap_core::grid::{CellIndex, OccupancyParams};
+use std::fs::File;
+use zip::ZipArchive;
 
 fn temp_dir(tag: &str) -> crate::testdata::TestDir {
     crate::testdata::temp_dir(&format!("npz-{tag}"))
