@@ -77,6 +77,50 @@ impl McapSource {
         )
     }
 
+    /// The error for a record the reader could not read: a length past the end of a file
+    /// that is complete (corrupt), the end of a file that is not (truncated), or a record
+    /// over the size limit.
+    fn read_error(&self, e: mcap::McapError) -> Error {
+        match e {
+            mcap::McapError::UnexpectedEof if self.complete => {
+                let what = format!(
+                    "a record's length reaches past the end of the file after {} bytes, although the file ends \
+                     with MCAP's closing magic: the length is corrupt",
+                    self.bytes_read
+                );
+                self.container_error(&what)
+            }
+            mcap::McapError::UnexpectedEof => Error::truncated(
+                &self.path,
+                Location::File,
+                format!("MCAP: the file ends after {} bytes, inside a record: it is truncated", self.bytes_read),
+            ),
+            e => {
+                let mut what = error_chain(&e);
+                if matches!(e, mcap::McapError::ChunkTooLarge(_) | mcap::McapError::RecordTooLarge { .. }) {
+                    what +=
+                        &format!(", over the limit of {} bytes (limits.decompressed_mib raises it)", self.max_record);
+                }
+                self.container_error(&what)
+            }
+        }
+    }
+
+    /// Reads up to `need` bytes of the file into the reader's buffer.
+    fn fill(&mut self, need: usize) -> Result<()> {
+        let buf = self.reader.insert(need);
+        let n = loop {
+            match self.input.read(buf) {
+                Ok(n) => break n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(Error::io(&self.path, e)),
+            }
+        };
+        self.reader.notify_read(n);
+        self.bytes_read += n as u64;
+        Ok(())
+    }
+
     /// Advances to the next message record, handling schema and channel records on the
     /// way, and hands it to `visit` where the reader holds it. `Ok(false)` at the end of
     /// the file.
@@ -85,48 +129,10 @@ impl McapSource {
             let event = match self.reader.next_event() {
                 None => return Ok(false),
                 Some(Ok(event)) => event,
-                Some(Err(mcap::McapError::UnexpectedEof)) if self.complete => {
-                    let what = format!(
-                        "a record's length reaches past the end of the file after {} bytes, although the file ends \
-                         with MCAP's closing magic: the length is corrupt",
-                        self.bytes_read
-                    );
-                    return Err(self.container_error(&what));
-                }
-                Some(Err(mcap::McapError::UnexpectedEof)) => {
-                    return Err(Error::truncated(
-                        &self.path,
-                        Location::File,
-                        format!(
-                            "MCAP: the file ends after {} bytes, inside a record: it is truncated",
-                            self.bytes_read
-                        ),
-                    ));
-                }
-                Some(Err(e)) => {
-                    let mut what = error_chain(&e);
-                    if matches!(e, mcap::McapError::ChunkTooLarge(_) | mcap::McapError::RecordTooLarge { .. }) {
-                        what += &format!(
-                            ", over the limit of {} bytes (limits.decompressed_mib raises it)",
-                            self.max_record
-                        );
-                    }
-                    return Err(self.container_error(&what));
-                }
+                Some(Err(e)) => return Err(self.read_error(e)),
             };
             match event {
-                LinearReadEvent::ReadRequest(need) => {
-                    let buf = self.reader.insert(need);
-                    let n = loop {
-                        match self.input.read(buf) {
-                            Ok(n) => break n,
-                            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                            Err(e) => return Err(Error::io(&self.path, e)),
-                        }
-                    };
-                    self.reader.notify_read(n);
-                    self.bytes_read += n as u64;
-                }
+                LinearReadEvent::ReadRequest(need) => self.fill(need)?,
                 LinearReadEvent::Record { opcode, data } => {
                     // Only schemas, channels and messages matter here; the others (indexes,
                     // statistics, attachments, metadata) are not parsed at all.
