@@ -26,7 +26,7 @@ use super::odometry::OdometryAgreement;
 use super::optimisation::Pending;
 use super::parallel::{join, on_worker};
 use super::params::SlamParams;
-use super::pose_graph::{Edge, EdgeKind, Loss, PoseGraph};
+use super::pose_graph::PoseGraph;
 use super::report::SlamReport;
 use super::submap::Submaps;
 use crate::geometry::{normalize_angle, Point2, Pose2};
@@ -141,14 +141,6 @@ pub struct SlamResult {
 fn same_bits(a: Pose2, b: Pose2) -> bool {
     [a.x, a.y, a.theta].map(f64::to_bits) == [b.x, b.y, b.theta].map(f64::to_bits)
 }
-
-/// The information floor of a match edge, σ: enough to keep the graph solvable where a
-/// match says nothing (along a corridor), and far below the odometry's, so that there the
-/// odometry and the fixes place the node, not the submap it went into. (A floor of 0.5 m
-/// counted the odometry twice along a corridor: each submap stiffened the odometry's
-/// scale error over its length.)
-const FLOOR_M: f64 = 10.0;
-const FLOOR_DEG: f64 = 30.0;
 
 /// A match whose translational information is this well conditioned (smallest over largest
 /// eigenvalue) constrains both directions of the plane: a room, not a corridor.
@@ -425,26 +417,6 @@ impl Slam {
         (m.pose, ScanOutcome::Matched, Some(m.information))
     }
 
-    /// The information of a scan's local pose as a graph edge: the match's own (positive
-    /// semi-definite, from its curvature) plus a floor — an unmatched or degenerate
-    /// direction is as good as the odometry, not infinitely bad — and scaled down as a
-    /// whole if it claims more than a few millimetres, which stays positive definite.
-    fn match_information(&self, info: Option<[[f64; 3]; 3]>) -> [[f64; 3]; 3] {
-        let floor = information_diag(FLOOR_M, FLOOR_DEG.to_radians());
-        let cap = information_diag(0.005, 0.05f64.to_radians());
-        let mut out = info.unwrap_or([[0.0; 3]; 3]);
-        for (i, f) in floor.iter().enumerate() {
-            out[i][i] += f[i];
-        }
-        for (i, j) in [(1, 0), (2, 0), (2, 1)] {
-            let v = 0.5 * (out[i][j] + out[j][i]);
-            (out[i][j], out[j][i]) = (v, v);
-        }
-        let over = (0..3).map(|i| out[i][i] / cap[i][i]).fold(1.0, f64::max);
-        out.iter_mut().flatten().for_each(|v| *v /= over);
-        out
-    }
-
     #[allow(clippy::too_many_arguments)]
     fn add_node(
         &mut self,
@@ -474,55 +446,8 @@ impl Slam {
         if self.nodes.is_empty() {
             self.graph.set_fixed(g, true);
         }
-        // Every node is tied to the submaps it went into by its match's information, a
-        // submap's first node too: tied rigidly, it carried the odometry's stretch along a
-        // corridor (where the match says nothing) into the whole submap (a 27 cm error at
-        // each submap's start on the corridor of `fixes_tests.rs`, 11 cm without). Only a
-        // first node that was not matched (the run's first) defines its submap's frame: its
-        // heading stiffly (a turn on the spot has nothing else to hold the submap's
-        // rotation), its position to 5 cm.
-        let info = self.match_information(information);
-        for &s in &into {
-            let sm = &self.submaps.all()[s];
-            let defines = sm.scans == 1 && information.is_none();
-            let e = Edge {
-                from: self.submap_graph[s],
-                to: g,
-                measurement: sm.local_pose.inverse().compose(local),
-                information: if defines { information_diag(0.05, 0.01f64.to_radians()) } else { info },
-                loss: Loss::Trivial,
-                kind: EdgeKind::Match,
-            };
-            // A match far out (a pose from nowhere) can give a non-finite curvature or
-            // measurement: that edge is left out and counted, never a panic.
-            if self.graph.add_edge(e).is_err() {
-                self.report.edges_refused += 1;
-            }
-        }
-        if let Some((prev, before, now)) = self.nodes.last().and_then(|p| Some((p, p.track?, track?))) {
-            let d = before.inverse().compose(now);
-            let (st, sr) = self.odometry.sigmas(&self.p, d);
-            // Odometry that disagrees with the matched motion by more than 5 σ (a jump, a
-            // stall, a slip) is left out of the graph and counted, not averaged in.
-            let m = prev.local.inverse().compose(local);
-            // The test is never tighter than the configured model: learnt-stiff odometry
-            // still agrees with the matches only to their own noise.
-            let consistent = self.odometry.plausible(&self.p, d, m, 5.0);
-            if !consistent {
-                self.report.odometry_edges_rejected += 1;
-            }
-            let e = Edge {
-                from: prev.graph,
-                to: g,
-                measurement: d,
-                information: information_diag(st, sr),
-                loss: Loss::Trivial,
-                kind: EdgeKind::Odometry,
-            };
-            if d.is_finite() && consistent && self.graph.add_edge(e).is_err() {
-                self.report.edges_refused += 1;
-            }
-        }
+        self.add_match_edges(g, local, &into, information);
+        self.add_odometry_edge(g, local, track);
         // The global search's cost grows with the farthest point (its angular step), so
         // it looks at the returns within `loop_closure_max_range_m`.
         let r2 = self.p.loop_closure_max_range_m * self.p.loop_closure_max_range_m;

@@ -1,4 +1,5 @@
 use super::*;
+use crate::slam::pose_graph::{Edge, EdgeKind, Loss};
 use crate::slam::test_world::World;
 
 /// A deterministic pseudo-random sequence in [-1, 1) (a 64-bit LCG), so the tests' noise

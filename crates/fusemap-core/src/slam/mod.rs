@@ -27,6 +27,7 @@ pub mod interpolation;
 pub mod local_match;
 mod loop_closure;
 mod mapper;
+mod node_edges;
 mod odometry;
 mod optimisation;
 mod parallel;
