@@ -19,7 +19,7 @@ use fusemap_core::geometry::Pose3;
 use fusemap_core::measurement::{ObservationId, SensorId};
 use fusemap_core::sensor::camera::{CameraModel, ClassTable, Pinhole, PixelCounts};
 use fusemap_core::time::{Stamp, SyncMode};
-use fusemap_io::log::ImageMessage;
+use fusemap_io::log::{image_over_limit, ImageMessage};
 use serde::Serialize;
 
 /// What happened to one camera's images.
@@ -199,11 +199,9 @@ fn over_image_pixels(c: &PlannedCamera, inv: &Inventory) -> Option<String> {
     let max = inv.limits.max_image_pixels;
     [&c.topic, &c.depth_topic].into_iter().find_map(|t| {
         let sizes = &inv.images.get(t)?.sizes;
-        let (&(w, h), n) = sizes.iter().find(|(&(w, h), _)| u64::from(w) * u64::from(h) > max)?;
-        Some(format!(
-            "{n} images on `{t}` are {w} × {h}, {} pixels, over the limit of {max} (limits.image_pixels raises it)",
-            u64::from(w) * u64::from(h)
-        ))
+        sizes
+            .iter()
+            .find_map(|(&(w, h), n)| image_over_limit(w, h, max).map(|why| format!("{n} images on `{t}`: {why}")))
     })
 }
 

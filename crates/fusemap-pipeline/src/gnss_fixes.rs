@@ -9,9 +9,7 @@ use crate::recording::Inventory;
 use crate::sensors::{Bound, BoundSensor};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, SensorKind};
-use fusemap_core::estimator::{
-    check_fix, EstimatorInput, FixProblem, FixQuality, GnssCovarianceKind, DEFAULT_ALTITUDE_RANGE_M,
-};
+use fusemap_core::estimator::{check_fix, EstimatorInput, FixProblem, FixQuality, GnssCovarianceKind};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{geodetic::Datum, Point2};
 use fusemap_core::time::Stamp;
@@ -63,15 +61,6 @@ fn problem(f: &GnssMessage, band: [f64; 2]) -> Result<(), FixProblem> {
 /// checks as a run's).
 pub fn usable_fix(f: &GnssMessage, band: [f64; 2]) -> bool {
     problem(f, band).is_ok()
-}
-
-/// The altitude band a run applies to the fixes of `topic`: its GNSS table's (by topic, or
-/// the one table without a topic, which binds the log's only fix topic), else the default.
-pub fn altitude_band(plan: &fusemap_core::config::Plan, topic: &str) -> [f64; 2] {
-    let gnss = || plan.sensors.iter().filter(|s| s.kind == fusemap_core::config::SensorKind::Gnss);
-    (gnss().find(|s| s.topic.as_deref() == Some(topic)))
-        .or_else(|| gnss().find(|s| s.topic.is_none()))
-        .map_or(DEFAULT_ALTITUDE_RANGE_M, |s| s.altitude_range_m)
 }
 
 /// How far apart two fixes can be and still agree, metres: a generous receiver error plus

@@ -3,7 +3,8 @@
 //! bias or a mis-mounted IMU; bursts are wheel slip).
 
 use crate::recording::Inventory;
-use fusemap_core::config::Plan;
+use fusemap_core::config::{Plan, SensorKind};
+use fusemap_core::estimator::DEFAULT_ALTITUDE_RANGE_M;
 use fusemap_core::geometry::normalize_angle;
 use fusemap_core::time::Stamp;
 use fusemap_io::log::GnssMessage;
@@ -13,8 +14,17 @@ use std::fmt::Write as _;
 /// the fixes of each status, and the longest stretch without a usable fix (usable as the
 /// plan's GNSS table for the topic judges it, altitude band included).
 pub fn gnss_quality(plan: &Plan, inv: &Inventory, out: &mut String, findings: &mut Vec<String>) -> std::fmt::Result {
+    // The band of the GNSS table each topic is bound to, as the run binds it (the default
+    // where binding fails: doctor then reports why).
+    let bound = crate::sensors::bind(plan, &crate::run::topics_by_kind(inv)).ok();
+    let band_of = |topic: &str| {
+        bound
+            .as_ref()
+            .and_then(|b| b.sensors.iter().find(|s| s.sensor.kind == SensorKind::Gnss && s.topic == topic))
+            .map_or(DEFAULT_ALTITUDE_RANGE_M, |s| s.sensor.altitude_range_m)
+    };
     for (topic, fixes) in &inv.gnss {
-        let band = crate::gnss_fixes::altitude_band(plan, topic);
+        let band = band_of(topic);
         let (Some(first), Some(last)) = (fixes.iter().map(|f| f.stamp).min(), fixes.iter().map(|f| f.stamp).max())
         else {
             continue;

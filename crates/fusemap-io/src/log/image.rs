@@ -209,18 +209,20 @@ impl ReadOptions {
     pub fn over_limit(&self, message: &LogMessage) -> Option<String> {
         match message {
             LogMessage::Scan(s) => scan_over_limit(s.scan.ranges.len(), self.max_scan_beams),
-            LogMessage::Image(i) => {
-                let pixels = u64::from(i.width) * u64::from(i.height);
-                (pixels > self.max_image_pixels).then(|| {
-                    format!(
-                        "a {} × {} image is {pixels} pixels, over the limit of {} (limits.image_pixels raises it)",
-                        i.width, i.height, self.max_image_pixels
-                    )
-                })
-            }
+            LogMessage::Image(i) => image_over_limit(i.width, i.height, self.max_image_pixels),
             _ => None,
         }
     }
+}
+
+/// The words for a `width` × `height` image past a limit of `max` pixels, if it is.
+pub fn image_over_limit(width: u32, height: u32, max: u64) -> Option<String> {
+    let pixels = u64::from(width) * u64::from(height);
+    (pixels > max).then(|| {
+        format!(
+            "a {width} × {height} image is {pixels} pixels, over the limit of {max} (limits.image_pixels raises it)"
+        )
+    })
 }
 
 /// The words for a scan of `beams` beams past a limit of `max`, if it is.

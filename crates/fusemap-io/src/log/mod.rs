@@ -28,8 +28,8 @@ pub mod ros1;
 pub mod ros2;
 
 pub use image::{
-    bytes_per_pixel, check_image_layout, CameraInfoMessage, ImageHeader, ImageMessage, ImagePayloads, ReadOptions,
-    DEFAULT_MAX_DECOMPRESSED_BYTES,
+    bytes_per_pixel, check_image_layout, image_over_limit, CameraInfoMessage, ImageHeader, ImageMessage, ImagePayloads,
+    ReadOptions, DEFAULT_MAX_DECOMPRESSED_BYTES,
 };
 pub use open::{detect, open_log, open_log_with, LogFormat, OpenedLog};
 
