@@ -51,6 +51,21 @@ enum Command {
         #[arg(long, value_parser = fusemap_pipeline::outputs::parse_crop, allow_hyphen_values = true)]
         crop: Option<fusemap_pipeline::outputs::Crop>,
     },
+    /// The design document's §5 on a log: the lidar-only (M1), camera-only (M2) and
+    /// fused (M3) maps built from the log's earlier part, the held-out later part's points
+    /// projected onto each (hit rates), their entropies, and a verdict: fusion_helps,
+    /// no_gain or check_sync_and_extrinsics (naming the sensor). Writes the fused map,
+    /// DIR/fusion_validate.npz and summary.json's `validation`; exits 0 whatever the verdict.
+    Validate {
+        /// Config file (TOML); its [validate] table sets the held-out share and thresholds.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Output directory (created if needed).
+        #[arg(long)]
+        out: PathBuf,
+        /// The log, recognised by its content.
+        log: PathBuf,
+    },
     /// Check a log's timing: rates, jitter, delays, stamps going backwards, gaps, and how
     /// many scans get a pose.
     Doctor {
@@ -167,6 +182,7 @@ fn main() {
         Command::Map { config, world, out, log, crop } => {
             commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out, crop)
         }
+        Command::Validate { config, out, log } => commands::validate::run(config.as_deref(), &log, &out),
         Command::Doctor { config, log } => commands::doctor::run(config.as_deref(), &log),
         Command::Relations { relations, trajectory, tolerance_ms, max_gap_ms, sensor_in_base, json } => {
             let sensor = sensor_in_base.as_deref();

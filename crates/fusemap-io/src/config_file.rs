@@ -321,6 +321,7 @@ mod tests {
         // out the default class table.
         assert_eq!(format!("{:?}", c.fusion), format!("{:?}", d.fusion));
         assert_eq!(format!("{:?}", c.limits), format!("{:?}", d.limits));
+        assert_eq!(c.validate, d.validate);
         assert_eq!(plan.classes, default.classes);
         assert_eq!(c.class.len(), default.classes.len());
         // The whole plan but how its lidar came to be (the example lists it; the default

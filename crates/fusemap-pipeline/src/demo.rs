@@ -64,7 +64,7 @@ impl DemoJob {
         rec.messages = Vec::new();
         let inv = crate::recording::Inventory::read_with(&sim.bag.dir, &plan.limits)?;
         let (bound, chosen, track_s) = crate::run::prepare(plan, &inv)?;
-        let run = crate::map_with_track(plan, &inv, &bound, chosen, track_s, Some(three_maps(plan)), progress)?;
+        let run = crate::map_with_track(plan, &inv, &bound, chosen, track_s, three_maps(plan).into(), progress)?;
         let truth_occupancy = rec.truth_occupancy(plan.geometry)?;
         let truth_semantic = rec.truth_semantic(plan.geometry)?;
         let truth = Truth {
@@ -97,6 +97,7 @@ impl DemoJob {
             notes,
             log: Some(log),
             trajectory: Some(&run.trajectory),
+            validation: None,
         };
         let summary = finish(&run.engine, files, &export, record)?;
         Ok(DemoRun { summary, scores, other_maps })

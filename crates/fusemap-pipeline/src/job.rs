@@ -186,6 +186,7 @@ impl MapJob {
                     notes: run.notes,
                     log,
                     trajectory: Some(&run.trajectory),
+                    validation: None,
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }
@@ -199,6 +200,7 @@ impl MapJob {
                     notes: run.notes,
                     log: None,
                     trajectory: None,
+                    validation: None,
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }

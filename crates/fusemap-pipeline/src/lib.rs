@@ -22,6 +22,7 @@
 //! | a command's arguments checked and resolved into a run | [`job`] |
 //! | the production-line demo: simulated, mapped three ways, scored, drawn | [`demo`] |
 //! | the log doctor's figures | [`doctor`] |
+//! | §5's validation: M1, M2, M3, held-out hit rates, entropy, verdict | [`validate`] |
 //! | GNSS quality over time, odometry against the gyro | [`pose_sensors_report`] |
 
 #![warn(missing_docs)]
@@ -52,9 +53,10 @@ pub mod slam_bench;
 pub mod slam_summary;
 pub mod sync;
 pub mod track;
+pub mod validate;
 pub mod world;
 
-pub use run::{map_inventory, map_log, map_with_track, MapRun, Progress};
+pub use run::{map_inventory, map_log, map_with_track, MapRun, PassMaps, Progress};
 
 pub(crate) use sync::offset_ns;
 

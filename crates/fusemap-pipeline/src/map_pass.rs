@@ -95,19 +95,35 @@ struct Streams {
     planned: Vec<PlannedCamera>,
 }
 
+/// The maps a pass builds, and whether the log's later part is held out of them.
+#[derive(Default)]
+pub struct PassMaps {
+    /// Several maps fed in one pass, each from its own subset of sensors (the design
+    /// document's leave-one-out maps, §5.2); the lidars get sensor ids 0, 1, … in the order
+    /// of `bound.lidars`. `None`: one map of every sensor.
+    pub set: Option<MapSet>,
+    /// The share of the log, at its end, held out of the maps: its observations' endpoints
+    /// are counted instead ([`Engine::held_out`]), §5.2's later period. By time span on a
+    /// timed track; by scan count on poses of the scan lines, whose stamps may be broken.
+    pub holdout_share: Option<f64>,
+}
+
+impl From<MapSet> for PassMaps {
+    fn from(set: MapSet) -> Self {
+        Self { set: Some(set), holdout_share: None }
+    }
+}
+
 /// Maps a recording whose first pass is done with a given pose track (a calibration
-/// search, or a comparison of tracks on one log, maps the same scans with several).
-///
-/// `maps`: several maps fed in this one pass, each from its own subset of sensors (the
-/// design document's leave-one-out maps, §5.2); the lidars get sensor ids 0, 1, … in the
-/// order of `bound.lidars`. `None`: one map of every sensor.
+/// search, or a comparison of tracks on one log, maps the same scans with several), into
+/// `maps`.
 pub fn map_with_track(
     plan: &Plan,
     inv: &Inventory,
     bound: &Bound,
     mut chosen: ChosenTrack,
     track_s: f64,
-    maps: Option<MapSet>,
+    maps: PassMaps,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MapRun, PipelineError> {
     let cfg = &plan.log;
@@ -117,7 +133,7 @@ pub fn map_with_track(
         return Err(PipelineError::Refused("no lidar to map: every [[sensor]] of kind lidar is disabled".into()));
     }
     let mode = sync_mode(cfg, &inv.scans[&bound.lidars[0].topic].stamps);
-    let mut engine = match maps {
+    let mut engine = match maps.set {
         Some(m) => Engine::with_maps(m),
         None => Engine::new(FusionGrid::new(plan.geometry, plan.occupancy)),
     };
@@ -128,7 +144,8 @@ pub fn map_with_track(
     let mut streams = Streams::open(&input, &mut engine, &mut notes)?;
 
     let t_map = Instant::now();
-    let placed = streams.run(&input, &mut engine, mode, progress)?;
+    let hold_from = maps.holdout_share.map(|share| streams.holdout_key(&input, share));
+    let placed = streams.run(&input, &mut engine, mode, hold_from, progress)?;
     let map_s = t_map.elapsed().as_secs_f64();
     let trajectory = match &chosen.track {
         Track::ScanLine(_) => placed,
@@ -310,6 +327,7 @@ impl Streams {
         input: &Inputs,
         engine: &mut Engine,
         mode: SyncMode,
+        hold_from: Option<i64>,
         progress: &mut dyn FnMut(Progress),
     ) -> Result<Vec<(Stamp, Pose2)>, PipelineError> {
         let inv = input.inv;
@@ -338,12 +356,14 @@ impl Streams {
                 progress(Progress::Advance(1));
             }
             while let Some((s, key, msg)) = self.merge.pop_ready() {
+                hold_out_from(inserter.engine, hold_from, key);
                 release(&mut inserter, &mut self.lidars, &mut self.cameras, s, Stamp(key), msg)?;
                 progress(Progress::Advance(1));
             }
             Ok(())
         })?;
         while let Some((s, key, msg)) = self.merge.pop_final() {
+            hold_out_from(inserter.engine, hold_from, key);
             release(&mut inserter, &mut self.lidars, &mut self.cameras, s, Stamp(key), msg)?;
             progress(Progress::Advance(1));
         }
@@ -352,6 +372,31 @@ impl Streams {
         }
         progress(Progress::Done);
         Ok(std::mem::take(&mut inserter.placed))
+    }
+
+    /// The merge key from which the later `share` of the log is held out: by the stamps'
+    /// span (with each sensor's clock offset) on a timed track, by the scan count on poses
+    /// of the scan lines (their keys count the scans).
+    fn holdout_key(&self, input: &Inputs, share: f64) -> i64 {
+        let inv = input.inv;
+        if matches!(input.track, Track::ScanLine(_)) {
+            let n: u64 = self.lidars.iter().map(|l| l.report.scans_read).sum();
+            return ((1.0 - share) * n as f64).floor() as i64 + 1;
+        }
+        let lidar = self.lidars.iter().map(|l| (&inv.scans[&l.report.topic].stamps, l.offset_ns));
+        let camera =
+            self.cameras.iter().filter_map(|c| inv.images.get(&c.report.topic).map(|i| (&i.stamps, c.offset_ns)));
+        let (mut lo, mut hi) = (i64::MAX, i64::MIN);
+        for (stamps, offset) in lidar.chain(camera) {
+            for s in stamps {
+                let k = s.0.saturating_add(offset);
+                (lo, hi) = (lo.min(k), hi.max(k));
+            }
+        }
+        if lo > hi {
+            return i64::MAX;
+        }
+        lo.saturating_add(((1.0 - share) * (hi as f64 - lo as f64)) as i64)
     }
 
     /// The merge stream of a message and its merge key (its stamp with the sensor's time
@@ -386,6 +431,13 @@ impl Streams {
         } else if let Some(c) = self.cameras.iter_mut().find(|c| c.label_stream == stream || c.depth_stream == stream) {
             c.report.frames_skipped.late += 1;
         }
+    }
+}
+
+/// Holds the rest of the pass out of the maps once the merge reaches `hold_from`.
+fn hold_out_from(engine: &mut Engine, hold_from: Option<i64>, key: i64) {
+    if hold_from.is_some_and(|h| key >= h) {
+        engine.hold_out();
     }
 }
 

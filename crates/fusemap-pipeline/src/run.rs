@@ -8,7 +8,7 @@
 //! de-skewed). Every scan that cannot be posed is skipped and counted with its reason;
 //! clock faults are reported, and the usable part of the log is still mapped.
 
-pub use crate::map_pass::{map_with_track, MapRun};
+pub use crate::map_pass::{map_with_track, MapRun, PassMaps};
 pub use crate::progress::Progress;
 use crate::recording::Inventory;
 use crate::sensors::{bind, Bound};
@@ -80,12 +80,26 @@ pub fn prepare_with(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<(Bound, ChosenTrack, f64), PipelineError> {
     let (bound, chosen, track_s) = prepare_track(plan, inv)?;
-    let (on, reason) = crate::slam::applies(plan, inv, &bound, &chosen);
+    let (chosen, track_s) = correct(plan, inv, &bound, chosen, track_s, progress)?;
+    Ok((bound, chosen, track_s))
+}
+
+/// SLAM's correction of the track from [`prepare_track`], when [`crate::slam::applies`]
+/// says so (else the track as it is); the seconds spent on the track so far.
+pub fn correct(
+    plan: &Plan,
+    inv: &Inventory,
+    bound: &Bound,
+    chosen: ChosenTrack,
+    track_s: f64,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(ChosenTrack, f64), PipelineError> {
+    let (on, reason) = crate::slam::applies(plan, inv, bound, &chosen);
     if !on {
-        return Ok((bound, chosen, track_s));
+        return Ok((chosen, track_s));
     }
     let t0 = Instant::now();
-    let mut run = crate::slam::run(plan, inv, &bound, &chosen, reason, progress)?;
+    let mut run = crate::slam::run(plan, inv, bound, &chosen, reason, progress)?;
     let mut track = crate::slam::track(chosen, &mut run, &plan.log);
     // Scans SLAM was given but left without an optimised pose: a few (a refused reading)
     // are normal; more means the run did not correct the log (equal stamps collapsing the
@@ -117,7 +131,7 @@ pub fn prepare_with(
         track.notes.push(format!("SLAM: {f}"));
     }
     track.slam = Some(Box::new(run.summary));
-    Ok((bound, track, track_s + t0.elapsed().as_secs_f64()))
+    Ok((track, track_s + t0.elapsed().as_secs_f64()))
 }
 
 /// Maps a recording whose first pass is done.
@@ -127,5 +141,5 @@ pub fn map_inventory(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MapRun, PipelineError> {
     let (bound, chosen, track_s) = prepare_with(plan, inv, progress)?;
-    map_with_track(plan, inv, &bound, chosen, track_s, None, progress)
+    map_with_track(plan, inv, &bound, chosen, track_s, Default::default(), progress)
 }

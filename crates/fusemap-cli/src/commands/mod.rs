@@ -7,6 +7,7 @@ pub mod map;
 pub mod relations;
 pub mod simulate;
 pub mod slam_bench;
+pub mod validate;
 
 /// The validated plan of `--config FILE`, or of the defaults without one
 /// ([`fusemap_pipeline::job::plan_of`]).

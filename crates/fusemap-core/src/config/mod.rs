@@ -15,6 +15,7 @@ mod plan;
 mod pose_sensor;
 mod sensor;
 mod slam;
+mod validate;
 
 pub use camera::{default_camera, default_class_color, ClassConfig, PlannedCamera, DEFAULT_PAIR_TOLERANCE_S};
 pub use fusion::FusionConfig;
@@ -24,6 +25,7 @@ pub use map::MapConfig;
 pub use plan::auto_sensor;
 pub use sensor::{GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 pub use slam::{SlamConfig, SlamMode};
+pub use validate::ValidateConfig;
 
 use crate::estimator::EstimatorConfig;
 use crate::grid::{GridGeometry, OccupancyParams};
@@ -59,6 +61,9 @@ pub struct Config {
     /// none: [`ClassTable::production_default`].
     #[serde(default)]
     pub class: Vec<ClassConfig>,
+    /// `fusemap validate`: the held-out share and the verdict's thresholds (§5).
+    #[serde(default)]
+    pub validate: ValidateConfig,
 }
 
 /// A configuration error names the field ([`FieldError`], the error of every parameter
@@ -138,6 +143,10 @@ pub struct Plan {
     pub slam: crate::slam::SlamParams,
     /// The resource budgets (`[limits]`).
     pub limits: LimitsConfig,
+    /// `fusemap validate`'s held-out share (`[validate]`).
+    pub holdout_share: f64,
+    /// The validation verdict's thresholds (`[validate]`).
+    pub validation: crate::metrics::Thresholds,
 }
 
 impl Config {
@@ -165,6 +174,7 @@ impl Config {
         let motion = self.log.motion_limits();
         (slam.max_track_speed_m_s, slam.max_track_turn_rate_rad_s) = (motion.max_speed_m_s, motion.max_turn_rate_rad_s);
         self.limits.validate()?;
+        let validation = self.validate.validate(self.log.extrinsics_tolerance_deg)?;
         self.check_rays(geometry.resolution(), &lidars, &cameras, &slam)?;
         self.check_correlated(&lidars, &cameras, &sensors)?;
         Ok(Plan {
@@ -182,6 +192,8 @@ impl Config {
             slam_mode: self.slam.mode,
             slam,
             limits: self.limits,
+            holdout_share: self.validate.holdout_share,
+            validation,
         })
     }
 

@@ -30,7 +30,7 @@ use super::budget::{BudgetKey, MapBudget, TileLayers};
 use super::camera::FrameCells;
 use super::correlation::Correlator;
 use super::sensors::SensorSlot;
-use super::{Correlation, InsertContext, MapEntry, MapSet, SensorModel, SensorSelection, SensorStats};
+use super::{Correlation, HeldOut, InsertContext, MapEntry, MapSet, SensorModel, SensorSelection, SensorStats};
 use crate::geometry::Pose2;
 use crate::grid::{DynamicParams, DynamicUpdate, FusionGrid, Group, InsertStats};
 use crate::measurement::{Evidence, ObservationId, RangeData, SensorId, SensorKind};
@@ -144,6 +144,9 @@ pub struct Engine {
     stats: EngineStats,
     /// `[limits]` as tiles per map, once set (the grids hold it).
     budget: Option<MapBudget>,
+    /// Once [`Engine::hold_out`] is called: the later period's endpoints, counted instead
+    /// of inserted.
+    held_out: Option<HeldOut>,
 }
 
 impl Engine {
@@ -167,7 +170,20 @@ impl Engine {
             dynamic: None,
             stats: EngineStats::default(),
             budget: None,
+            held_out: None,
         }
+    }
+
+    /// From now on, observations are not inserted: their endpoints are counted in a
+    /// [`HeldOut`] (the later period of §5.2's validation). The maps keep what the earlier
+    /// period made of them.
+    pub fn hold_out(&mut self) {
+        self.held_out.get_or_insert_with(HeldOut::default);
+    }
+
+    /// The held-out period's endpoints, if [`Engine::hold_out`] was called.
+    pub fn held_out(&self) -> Option<&HeldOut> {
+        self.held_out.as_ref()
     }
 
     /// Holds the maps to `[limits] memory_mib` and `map_cells` (see
@@ -359,6 +375,11 @@ impl Engine {
         }
         self.camera_scratch.stamp = stamp;
         self.camera_scratch.sensor = sensor;
+        if let Some(held) = &mut self.held_out {
+            held.add_camera(&self.camera_scratch, model.classes(), self.maps.primary().grid().geometry());
+            slot.stats.held_out += 1;
+            return Ok(InsertStats::default());
+        }
         let group = self.admit(sensor, stamp, id)?;
         let ctx = self.context(stamp, group);
         let slot = &mut self.sensors[sensor.0 as usize];
@@ -497,10 +518,17 @@ impl Engine {
                 return Err(EngineError::UnknownSensor(sensor));
             }
         };
+        let model = model.limited_to(range_min, range_max);
+        if let Some(held) = &mut self.held_out {
+            let slot = &mut self.sensors[sensor.0 as usize];
+            model.scan_to_range_data_with(sensor, scan, pose_of_beam, &mut self.scratch, &mut slot.stats.returns);
+            held.add_range_data(&self.scratch, self.maps.primary().grid().geometry());
+            slot.stats.held_out += 1;
+            return Ok(InsertStats::default());
+        }
         let group = self.admit(sensor, scan.stamp, id)?;
         let ctx = self.context(scan.stamp, group);
         let slot = &mut self.sensors[sensor.0 as usize];
-        let model = model.limited_to(range_min, range_max);
         model.scan_to_range_data_with(sensor, scan, pose_of_beam, &mut self.scratch, &mut slot.stats.returns);
         let (maps, stats, slot) = (&mut self.maps, &mut self.stats, &mut slot.stats);
         let s = apply(maps, stats, slot, SensorKind::Lidar, &self.scratch, &ctx);
@@ -524,6 +552,15 @@ impl Engine {
     }
 
     fn range_data(&mut self, id: Option<ObservationId>, data: &RangeData) -> Result<InsertStats, EngineError> {
+        if let Some(held) = &mut self.held_out {
+            let Some(slot) = self.sensors.get_mut(data.sensor.0 as usize) else {
+                self.stats.unknown_sensor += 1;
+                return Err(EngineError::UnknownSensor(data.sensor));
+            };
+            held.add_range_data(data, self.maps.primary().grid().geometry());
+            slot.stats.held_out += 1;
+            return Ok(InsertStats::default());
+        }
         let group = self.admit(data.sensor, data.stamp, id)?;
         let ctx = self.context(data.stamp, group);
         let slot = &mut self.sensors[data.sensor.0 as usize];

@@ -7,6 +7,7 @@ pub mod camera;
 mod camera_tests;
 mod correlation;
 mod engine;
+mod holdout;
 mod mapset;
 #[cfg(test)]
 mod merge_tests;
@@ -16,5 +17,6 @@ mod sensors;
 pub use budget::BudgetKey;
 pub use correlation::Correlation;
 pub use engine::{Engine, EngineError, EngineStats};
+pub use holdout::{HeldOut, HitRate, OBSTACLE_PROBABILITY};
 pub use mapset::{InsertContext, MapEntry, MapSet, SensorSelection};
 pub use sensors::{SensorModel, SensorStats};

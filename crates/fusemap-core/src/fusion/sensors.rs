@@ -55,6 +55,8 @@ pub struct SensorStats {
     pub out_of_order: u64,
     /// Observations whose id an earlier observation of the same instant already carried.
     pub shared_ids: u64,
+    /// Observations of the held-out period (§5.2), counted, not inserted.
+    pub held_out: u64,
     /// Map insertions: each observation counts once per map that took it.
     pub maps_fed: u64,
     /// What its observations did, summed over the maps that took them.

@@ -62,6 +62,21 @@ pub fn sparse_entropy(tiles: &SparseTiles, cells: u64, prior: f32) -> EntropyRep
     }
 }
 
+/// Mean binary entropy of `raster`'s cells where `mask` holds (unknown cells at the
+/// prior), and how many there are: maps compared over the same cells, as §5.1 asks.
+/// `None` when the mask does not match the raster or selects nothing.
+pub fn entropy_where(raster: &Raster, mask: &[bool]) -> Option<(f64, u64)> {
+    if mask.len() != raster.log_odds.len() {
+        return None;
+    }
+    let (mut sum, mut n) = (0.0, 0u64);
+    for (&l, _) in raster.log_odds.iter().zip(mask).filter(|(_, &m)| m) {
+        sum += binary_entropy(probability(l as f64));
+        n += 1;
+    }
+    (n > 0).then(|| (sum / n as f64, n))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -93,6 +108,11 @@ mod tests {
         assert_eq!(e.known_cells, 1);
         assert!((e.known_share - 0.5).abs() < 1e-12);
         assert!((e.mean_entropy_nats - (std::f64::consts::LN_2 + binary_entropy(1.0)) / 2.0).abs() < 1e-9);
+        // Over a mask: the selected cells only, unknown ones at the prior.
+        assert_eq!(entropy_where(&r, &[true, false]), Some((binary_entropy(0.5), 1)));
+        assert_eq!(entropy_where(&r, &[false, true]).map(|e| e.1), Some(1));
+        assert_eq!(entropy_where(&r, &[false, false]), None);
+        assert_eq!(entropy_where(&r, &[true]), None);
     }
 
     #[test]

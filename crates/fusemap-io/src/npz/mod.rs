@@ -373,7 +373,7 @@ pub fn write_map_npz_with(path: &Path, raster: &Raster, layers: &NpzLayers<'_>) 
 
 /// Writes `arrays` as an `.npz` at `path`, atomically; an array whose shape did not match
 /// its data (`None`) is an error naming it, and nothing is written.
-fn write_arrays(path: &Path, arrays: Vec<(&str, Option<NpyArray<'_>>)>) -> Result<()> {
+pub fn write_arrays(path: &Path, arrays: Vec<(&str, Option<NpyArray<'_>>)>) -> Result<()> {
     let mut all = Vec::with_capacity(arrays.len());
     for (name, array) in arrays {
         let array = array.ok_or_else(|| {

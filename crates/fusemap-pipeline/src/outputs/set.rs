@@ -50,7 +50,7 @@ impl OutputFiles {
 
     /// The file names of a run's set, for removing an earlier run's files this run does
     /// not write.
-    pub const NAMES: [&'static str; 10] = [
+    pub const NAMES: [&'static str; 11] = [
         "map.npz",
         "map.yaml",
         "map.pgm",
@@ -61,6 +61,7 @@ impl OutputFiles {
         "semantic.png",
         "dynamic.png",
         "slam.png",
+        "fusion_validate.npz",
     ];
 
     pub(crate) fn all(&self) -> [&PathBuf; 10] {

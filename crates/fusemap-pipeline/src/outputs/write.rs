@@ -33,6 +33,8 @@ pub struct RunRecord<'a> {
     pub log: Option<serde_json::Value>,
     /// The base's trajectory, written as `trajectory.tum` when there is one.
     pub trajectory: Option<&'a [(Stamp, Pose2)]>,
+    /// `fusemap validate`'s findings (§5), for `summary.json`'s `validation`.
+    pub validation: Option<serde_json::Value>,
 }
 
 /// The semantic and dynamic layers of a run with a camera, over the occupancy raster's
@@ -175,7 +177,7 @@ pub fn finish(
     export: &ExportOptions,
     record: RunRecord<'_>,
 ) -> Result<Summary, OutputError> {
-    let RunRecord { source_kind, source, started, mut notes, log, trajectory } = record;
+    let RunRecord { source_kind, source, started, mut notes, log, trajectory, validation } = record;
     let grid = engine.grid();
     let room = ExportRoom::of(engine.export_room(engine.maps().primary()));
     let view = view_of(grid, export, room, &mut notes)?;
@@ -230,6 +232,7 @@ pub fn finish(
         wall_time_s: 0.0,
         notes,
         log,
+        validation,
         files: Vec::new(),
     };
     if matches!(view, MapView::Empty) {
@@ -268,6 +271,7 @@ mod tests {
             notes: run.notes,
             log: None,
             trajectory: None,
+            validation: None,
         };
         let summary = finish(&run.engine, outputs, &ExportOptions::default(), record).unwrap();
         assert_eq!((summary.scans, summary.source_kind.as_str()), (40, "world"));

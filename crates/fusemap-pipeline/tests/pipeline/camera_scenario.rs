@@ -22,7 +22,7 @@ struct Fixture {
 fn map(bag: &std::path::Path, plan: &fusemap_core::config::Plan, maps: fusemap_core::fusion::MapSet) -> MapRun {
     let inv = Inventory::read(bag).expect("the bag reads back");
     let (bound, chosen, track_s) = prepare(plan, &inv).expect("the sensors bind");
-    map_with_track(plan, &inv, &bound, chosen, track_s, Some(maps), &mut |_| {}).expect("the bag maps")
+    map_with_track(plan, &inv, &bound, chosen, track_s, maps.into(), &mut |_| {}).expect("the bag maps")
 }
 
 fn scores_of(rec: &SimRecording, run: &MapRun, plan: &fusemap_core::config::Plan) -> Vec<MapScore> {

@@ -13,3 +13,4 @@ mod scan_frames;
 mod sensors;
 mod slam_bench;
 mod slam_benchmark;
+mod validation;

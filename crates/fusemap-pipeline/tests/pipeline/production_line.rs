@@ -195,16 +195,16 @@ fn the_fused_map_scores_far_above_raw_odometry_and_slam_comes_within_003_of_true
     let (bound, fused, track_s) = prepare_track(&f.plan, &f.inv).unwrap();
     assert!(fused.name.starts_with("estimator"), "{}", fused.name);
     let (est_ate, _) = rms(f, |t| timed(&fused, t), None);
-    let fused_map = map_with_track(&f.plan, &f.inv, &bound, fused, track_s, None, &mut quiet).unwrap();
+    let fused_map = map_with_track(&f.plan, &f.inv, &bound, fused, track_s, Default::default(), &mut quiet).unwrap();
     let (bound, slam, track_s) = prepare(&f.plan, &f.inv).unwrap();
     assert!(slam.name.starts_with("SLAM") && slam.name.contains("estimator"), "{}", slam.name);
     let (slam_ate, n) = rms(f, |t| timed(&slam, t), None);
     println!("ATE RMS over {n} true poses: estimator {est_ate:.4} m, SLAM {slam_ate:.4} m");
-    let slam_map = map_with_track(&f.plan, &f.inv, &bound, slam, track_s, None, &mut quiet).unwrap();
+    let slam_map = map_with_track(&f.plan, &f.inv, &bound, slam, track_s, Default::default(), &mut quiet).unwrap();
     let raw = ChosenTrack::given("raw odometry", Box::new(raw_odometry(f)));
-    let raw_map = map_with_track(&f.plan, &f.inv, &bound, raw, 0.0, None, &mut quiet).unwrap();
+    let raw_map = map_with_track(&f.plan, &f.inv, &bound, raw, 0.0, Default::default(), &mut quiet).unwrap();
     let truth = ChosenTrack::given("true poses", Box::new(truth_track(f)));
-    let true_map = map_with_track(&f.plan, &f.inv, &bound, truth, 0.0, None, &mut quiet).unwrap();
+    let true_map = map_with_track(&f.plan, &f.inv, &bound, truth, 0.0, Default::default(), &mut quiet).unwrap();
 
     let g: GridGeometry = f.plan.geometry;
     let t = f.rec.truth_occupancy(g).unwrap();

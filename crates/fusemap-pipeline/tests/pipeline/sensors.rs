@@ -140,7 +140,7 @@ fn one_pass_feeds_several_maps_each_with_its_sensors() {
         SensorSelection::Sensors(vec![SensorId(0)]),
         grid(),
     );
-    let run = fusemap_pipeline::map_with_track(&plan, &inv, &bound, track, s, Some(maps), &mut |_| {}).unwrap();
+    let run = fusemap_pipeline::map_with_track(&plan, &inv, &bound, track, s, maps.into(), &mut |_| {}).unwrap();
     // The first lidar's map from the one pass equals a run that maps only that lidar.
     let only = map_log(&with(vec![lidar("/scan")]).validate().unwrap(), bag(), &mut |_| {}).unwrap();
     let a = run.engine.maps().by_name("first only").unwrap().grid().known_raster().unwrap();
