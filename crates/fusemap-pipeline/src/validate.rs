@@ -276,7 +276,7 @@ fn validate(
     }
     let split = gain_split(&figures, &rasters, &shared);
     let mut judgement = judge(&figures, &motion, &plan.validation);
-    if let (Verdict::NoGain, Some(g)) = (judgement.verdict, &split) {
+    if let (Verdict::NoGain, Some(_), Some(g)) = (judgement.verdict, judgement.fusion_gain_nats, &split) {
         judgement.sentence.push_str(&format!(
             ". Why: the {} map already knows {:.1} % of the cells, and there the fused map is {:.4} nats more \
              certain on average ({:.1} % of them are at a clamp already, where no evidence lowers the entropy: \

@@ -15,3 +15,4 @@ mod simulate;
 mod sync;
 mod tree;
 mod util;
+mod validate;
