@@ -57,7 +57,22 @@ enum Command {
     /// no_gain or check_sync_and_extrinsics (naming the sensor). Writes the fused map,
     /// DIR/fusion_validate.npz and summary.json's `validation`; exits 0 whatever the verdict.
     Validate {
-        /// Config file (TOML); its [validate] table sets the held-out share and thresholds.
+        /// Config file (TOML); its `[validate]` table sets the held-out share and thresholds.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Output directory (created if needed).
+        #[arg(long)]
+        out: PathBuf,
+        /// The log, recognised by its content.
+        log: PathBuf,
+    },
+    /// Estimate from the log what §4.3 tells a user to check by hand: the lidar's mount
+    /// (yaw, x, y) and the wheel odometry's scale, from the lidar's motion (SLAM) against
+    /// the wheels', with 95 % intervals; parameters the log cannot fix are named, not
+    /// invented. Writes DIR/calibration.toml (the `[[sensor]]` table to paste), the map and
+    /// summary.json's `calibration`.
+    Calibrate {
+        /// Config file (TOML), as for `map`.
         #[arg(long)]
         config: Option<PathBuf>,
         /// Output directory (created if needed).
@@ -182,6 +197,7 @@ fn main() {
         Command::Map { config, world, out, log, crop } => {
             commands::map::map(config.as_deref(), world.as_deref(), log.as_deref(), &out, crop)
         }
+        Command::Calibrate { config, out, log } => commands::calibrate::run(config.as_deref(), &log, &out),
         Command::Validate { config, out, log } => commands::validate::run(config.as_deref(), &log, &out),
         Command::Doctor { config, log } => commands::doctor::run(config.as_deref(), &log),
         Command::Relations { relations, trajectory, tolerance_ms, max_gap_ms, sensor_in_base, json } => {

@@ -32,6 +32,7 @@
 
 #![warn(missing_docs)]
 
+pub mod calibration;
 pub mod config;
 pub mod estimator;
 pub mod field_error;

@@ -98,6 +98,7 @@ impl DemoJob {
             log: Some(log),
             trajectory: Some(&run.trajectory),
             validation: None,
+            calibration: None,
         };
         let summary = finish(&run.engine, files, &export, record)?;
         Ok(DemoRun { summary, scores, other_maps })

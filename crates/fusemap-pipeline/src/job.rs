@@ -187,6 +187,7 @@ impl MapJob {
                     log,
                     trajectory: Some(&run.trajectory),
                     validation: None,
+                    calibration: None,
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }
@@ -201,6 +202,7 @@ impl MapJob {
                     log: None,
                     trajectory: None,
                     validation: None,
+                    calibration: None,
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }

@@ -23,10 +23,12 @@
 //! | the production-line demo: simulated, mapped three ways, scored, drawn | [`demo`] |
 //! | the log doctor's figures | [`doctor`] |
 //! | §5's validation: M1, M2, M3, held-out hit rates, entropy, verdict | [`validate`] |
+//! | self-calibration: the lidar's mount and the odometry's scale from their motions | [`calibrate`] |
 //! | GNSS quality over time, odometry against the gyro | [`pose_sensors_report`] |
 
 #![warn(missing_docs)]
 
+pub mod calibrate;
 pub mod camera;
 pub mod demo;
 pub mod doctor;

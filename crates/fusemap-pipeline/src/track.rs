@@ -353,7 +353,7 @@ fn scan_line_track(inv: &Inventory, cfg: &LogConfig, bound: &Bound) -> ChosenTra
 }
 
 /// The wheel odometry's poses, at their stamps with the sensor's time offset.
-fn odometry_track(inv: &Inventory, cfg: &LogConfig, o: &BoundSensor) -> Result<ChosenTrack, PipelineError> {
+pub(crate) fn odometry_track(inv: &Inventory, cfg: &LogConfig, o: &BoundSensor) -> Result<ChosenTrack, PipelineError> {
     let mut counts = TrackCounts::default();
     let msgs = &inv.odom[&o.topic];
     let off = crate::offset_ns(o.sensor.time_offset_s);

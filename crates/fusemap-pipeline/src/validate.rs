@@ -188,6 +188,7 @@ impl ValidateJob {
             log: Some(serde_json::to_value(&run.report)?),
             trajectory: Some(&run.trajectory),
             validation: Some(serde_json::to_value(&validation)?),
+            calibration: None,
         };
         let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
         let summary = finish(&run.engine, outputs, &export, record)?;

@@ -1,7 +1,8 @@
-//! `fusemap validate` through the binary: a lidar-only log gets the maps it can have and
-//! says which it cannot build; a log too short to hold a training period out is refused
-//! with the reason. (The verdicts against ground truth are `fusemap-pipeline`'s
-//! `--test pipeline validation`.)
+//! `fusemap validate` and `fusemap calibrate` through the binary: a lidar-only log gets
+//! the maps it can have and says which it cannot build; a log too short to hold a training
+//! period out is refused with the reason; calibration names what a log without wheel
+//! odometry cannot determine. (The figures against ground truth are `fusemap-pipeline`'s
+//! `--test pipeline validation` and `calibration`.)
 
 use crate::util::{assert_success, read_json, run, stdout, temp_dir, write_file};
 use fusemap_io::npz::read_npz_f32;
@@ -58,4 +59,23 @@ fn a_log_too_short_to_hold_out_is_refused_with_the_reason() {
     assert!(!o.status.success());
     let e = crate::util::one_line_error(&o);
     assert!(e.contains("one.log") && e.contains("nothing to validate") && e.contains("shorter than"), "{e}");
+}
+
+#[test]
+fn calibrate_names_what_a_log_cannot_determine() {
+    let dir = temp_dir("calibrate-carmen");
+    let lines: Vec<String> = (0..100).map(corridor).collect();
+    let log = write_file(&dir, "corridor.log", lines.join("\n") + "\n");
+    let out = dir.join("out");
+    let o = run(&["calibrate", "--out", out.to_str().unwrap(), log.to_str().unwrap()]);
+    assert_success(&o);
+    let text = stdout(&o);
+    assert!(
+        text.contains("undetermined  the lidar's mount and the odometry's scale: the log has no wheel-odometry topic"),
+        "{text}"
+    );
+    let c = read_json(&out.join("summary.json"))["calibration"].clone();
+    assert_eq!(c["sensors"].as_array().unwrap().len(), 0, "{c}");
+    assert!(!out.join("calibration.toml").exists(), "nothing estimated, nothing to paste");
+    assert!(out.join("map.npz").is_file());
 }

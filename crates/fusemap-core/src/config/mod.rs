@@ -25,7 +25,7 @@ pub use map::MapConfig;
 pub use plan::auto_sensor;
 pub use sensor::{GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 pub use slam::{SlamConfig, SlamMode};
-pub use validate::ValidateConfig;
+pub use validate::{Thresholds, ValidateConfig};
 
 use crate::estimator::EstimatorConfig;
 use crate::grid::{GridGeometry, OccupancyParams};
@@ -146,7 +146,7 @@ pub struct Plan {
     /// `fusemap validate`'s held-out share (`[validate]`).
     pub holdout_share: f64,
     /// The validation verdict's thresholds (`[validate]`).
-    pub validation: crate::metrics::Thresholds,
+    pub validation: Thresholds,
 }
 
 impl Config {

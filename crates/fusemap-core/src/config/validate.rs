@@ -3,7 +3,6 @@
 //! ([`crate::metrics::judge`]).
 
 use super::{err, finite, FieldError};
-use crate::metrics::Thresholds;
 use serde::{Deserialize, Serialize};
 
 /// The `[validate]` table.
@@ -47,4 +46,19 @@ impl ValidateConfig {
         }
         Ok(Thresholds { min_gain_nats: gain, hit_rate_drop: drop, min_endpoints: self.min_endpoints, mount_yaw_deg })
     }
+}
+
+/// The thresholds of the verdict.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Thresholds {
+    /// The least entropy gain that counts as help, nats.
+    pub min_gain_nats: f64,
+    /// The least drop of a sensor's hit rate, own map to M3, as a share of its own-map
+    /// rate, that counts as a disagreement (below it: noise of the later period).
+    pub hit_rate_drop: f64,
+    /// The fewest held-out endpoints of a sensor for its hit rates to count.
+    pub min_endpoints: u64,
+    /// The largest disagreement of a lidar's direction of travel with the pose sensors'
+    /// that is not a fault, degrees (`log.extrinsics_tolerance_deg`).
+    pub mount_yaw_deg: f64,
 }

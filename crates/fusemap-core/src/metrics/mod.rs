@@ -21,4 +21,4 @@ pub use trajectory::{
     absolute_trajectory_error, consecutive_relations, revisit_relations, score_index_relations, IndexRelation,
     RevisitRule,
 };
-pub use validation::{judge, Judgement, MapFigures, MapRole, SensorHits, Thresholds, Verdict};
+pub use validation::{judge, Judgement, MapFigures, MapRole, SensorHits, Verdict};

@@ -25,6 +25,7 @@
 //!   (built from it alone) to M3, as a share of its own-map rate.
 
 use super::MotionAgreement;
+use crate::config::Thresholds;
 use crate::fusion::HitRate;
 use crate::measurement::SensorKind;
 use serde::Serialize;
@@ -80,21 +81,6 @@ pub enum Verdict {
     /// A sensor's later observations hit M3 less often than its own map: check its clock
     /// offset and its mount.
     CheckSyncAndExtrinsics,
-}
-
-/// The thresholds of the verdict.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct Thresholds {
-    /// The least entropy gain that counts as help, nats.
-    pub min_gain_nats: f64,
-    /// The least drop of a sensor's hit rate, own map to M3, as a share of its own-map
-    /// rate, that counts as a disagreement (below it: noise of the later period).
-    pub hit_rate_drop: f64,
-    /// The fewest held-out endpoints of a sensor for its hit rates to count.
-    pub min_endpoints: u64,
-    /// The largest disagreement of a lidar's direction of travel with the pose sensors'
-    /// that is not a fault, degrees (`log.extrinsics_tolerance_deg`).
-    pub mount_yaw_deg: f64,
 }
 
 /// The judgement of a validation.

@@ -50,7 +50,7 @@ impl OutputFiles {
 
     /// The file names of a run's set, for removing an earlier run's files this run does
     /// not write.
-    pub const NAMES: [&'static str; 11] = [
+    pub const NAMES: [&'static str; 12] = [
         "map.npz",
         "map.yaml",
         "map.pgm",
@@ -62,6 +62,7 @@ impl OutputFiles {
         "dynamic.png",
         "slam.png",
         "fusion_validate.npz",
+        "calibration.toml",
     ];
 
     pub(crate) fn all(&self) -> [&PathBuf; 10] {

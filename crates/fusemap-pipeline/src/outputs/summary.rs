@@ -51,6 +51,9 @@ pub struct Summary {
     /// `fusemap validate`'s maps, hit rates, entropies and verdict (§5).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub validation: Option<serde_json::Value>,
+    /// `fusemap calibrate`'s estimates with their intervals, and what it could not determine.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<serde_json::Value>,
     /// The other files of this run's set, each with its size and SHA-256: written before
     /// this summary, which comes last (a summary whose files all match is a whole set).
     pub files: Vec<fusemap_io::output_set::OutputFile>,

@@ -35,6 +35,8 @@ pub struct RunRecord<'a> {
     pub trajectory: Option<&'a [(Stamp, Pose2)]>,
     /// `fusemap validate`'s findings (§5), for `summary.json`'s `validation`.
     pub validation: Option<serde_json::Value>,
+    /// `fusemap calibrate`'s estimates, for `summary.json`'s `calibration`.
+    pub calibration: Option<serde_json::Value>,
 }
 
 /// The semantic and dynamic layers of a run with a camera, over the occupancy raster's
@@ -177,7 +179,7 @@ pub fn finish(
     export: &ExportOptions,
     record: RunRecord<'_>,
 ) -> Result<Summary, OutputError> {
-    let RunRecord { source_kind, source, started, mut notes, log, trajectory, validation } = record;
+    let RunRecord { source_kind, source, started, mut notes, log, trajectory, validation, calibration } = record;
     let grid = engine.grid();
     let room = ExportRoom::of(engine.export_room(engine.maps().primary()));
     let view = view_of(grid, export, room, &mut notes)?;
@@ -233,6 +235,7 @@ pub fn finish(
         notes,
         log,
         validation,
+        calibration,
         files: Vec::new(),
     };
     if matches!(view, MapView::Empty) {
@@ -272,6 +275,7 @@ mod tests {
             log: None,
             trajectory: None,
             validation: None,
+            calibration: None,
         };
         let summary = finish(&run.engine, outputs, &ExportOptions::default(), record).unwrap();
         assert_eq!((summary.scans, summary.source_kind.as_str()), (40, "world"));

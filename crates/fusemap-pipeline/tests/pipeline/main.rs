@@ -2,6 +2,7 @@
 //! once (`cargo test -p fusemap-pipeline --test pipeline [module::]`).
 
 mod bad_pose_sensors;
+mod calibration;
 mod camera_bad_input;
 mod camera_scenario;
 mod frames;

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// The production line's bag, written once.
-fn bag() -> &'static Path {
+pub(crate) fn bag() -> &'static Path {
     static BAG: OnceLock<PathBuf> = OnceLock::new();
     BAG.get_or_init(|| {
         let rec = simulate(&Scenario::default()).expect("the default scenario simulates");
@@ -23,8 +23,10 @@ fn bag() -> &'static Path {
 }
 
 /// The production line's configuration with the lidar mounted at `lidar` (x, yaw) and
-/// the camera's yaw turned by `camera_yaw_deg` from the simulator's mounts.
-fn config(lidar: (f64, f64), camera_yaw_deg: f64) -> String {
+/// the camera's yaw turned by `camera_yaw_deg` from the simulator's mounts. Every mount
+/// is written out: `extrinsics = "config"` takes none from the bag's TF (the GNSS
+/// antenna's lever arm included).
+pub(crate) fn config(lidar: (f64, f64), camera_yaw_deg: f64) -> String {
     let lidar = format!(
         "[sensor.base_from_sensor]\nx = {}\ny = 0.0\nz = 0.3\nroll = 0.0\npitch = 0.0\nyaw = {}\n\n",
         lidar.0,
@@ -36,7 +38,11 @@ fn config(lidar: (f64, f64), camera_yaw_deg: f64) -> String {
         -(90f64 + 25.0).to_radians(),
         (-90.0 + camera_yaw_deg).to_radians()
     );
+    let gnss = "\n[sensor.base_from_sensor]\nx = -0.1\ny = 0.0\nz = 0.8\nroll = 0.0\npitch = 0.0\nyaw = 0.0\n";
+    let datum = "datum = [48.137154, 11.576124, 520.0]\n";
+    assert!(PRODUCTION_LINE_CONFIG.contains(datum), "the GNSS table's last line");
     let c = PRODUCTION_LINE_CONFIG
+        .replace(datum, &format!("{datum}{gnss}"))
         .replace("[sensor.filters.shadow]", &format!("{lidar}[sensor.filters.shadow]"))
         .replace("info_topic = \"/camera/camera_info\"\n", &format!("info_topic = \"/camera/camera_info\"\n{camera}"));
     format!("{c}\n[log]\nextrinsics = \"config\"\n")

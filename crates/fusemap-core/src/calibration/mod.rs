@@ -1,0 +1,37 @@
+//! Self-calibration from the data alone: what the design document's §4.3 tells a user to
+//! check by hand (mounts, clock offsets, odometry), estimated with an interval, and left
+//! undetermined, with the reason, where the log cannot fix it.
+
+mod lidar_odometry;
+
+pub use lidar_odometry::{lidar_odometry, steps_of, turn_agreement, LidarOdometry, MotionStep};
+
+use serde::Serialize;
+
+/// An estimated parameter: its value and a 95 % interval.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Interval {
+    /// The estimate.
+    pub value: f64,
+    /// The interval's lower end.
+    pub low: f64,
+    /// The interval's upper end.
+    pub high: f64,
+}
+
+impl Interval {
+    /// `value ± 1.96 σ`.
+    pub fn of(value: f64, sigma: f64) -> Self {
+        Self { value, low: value - 1.96 * sigma, high: value + 1.96 * sigma }
+    }
+
+    /// Whether `x` lies inside.
+    pub fn contains(&self, x: f64) -> bool {
+        self.low <= x && x <= self.high
+    }
+
+    /// Half the interval's width.
+    pub fn half_width(&self) -> f64 {
+        0.5 * (self.high - self.low)
+    }
+}

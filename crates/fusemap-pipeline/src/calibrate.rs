@@ -1,0 +1,365 @@
+//! `fusemap calibrate`, planned and run: what the design document's §4.3 tells a user to
+//! check by hand, estimated from the log with 95 % intervals, and named as undetermined
+//! where the log cannot fix it.
+//!
+//! This version estimates the lidar's planar mount (yaw, x, y) and the wheel odometry's
+//! scale from the two tracks of one robot: SLAM's, which follows the lidar through its
+//! configured mount, and the wheels' ([`fusemap_core::calibration::lidar_odometry`],
+//! after Censi et al. 2013). It needs SLAM on a timed track and a wheel-odometry topic;
+//! without them it says so. The camera's mount and clock offset and the lidar's clock
+//! offset are not estimated yet, and the report says that too.
+
+use crate::job::{plan_of, JobError};
+use crate::outputs::{finish, prepare, ExportOptions, RunRecord};
+use crate::recording::Inventory;
+use crate::sensors::Bound;
+use crate::track::{ChosenTrack, Track};
+use crate::{PipelineError, Progress};
+use fusemap_core::calibration::{lidar_odometry, steps_of, turn_agreement, Interval, LidarOdometry, MotionStep};
+use fusemap_core::config::{Plan, SensorKind};
+use fusemap_core::geometry::{Mount3, Pose2};
+use fusemap_core::time::{Stamp, SyncMode};
+use serde::Serialize;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The file of ready-to-paste `[[sensor]]` tables.
+pub const CALIBRATION_TOML: &str = "calibration.toml";
+
+/// Steps of the two tracks: at least this far along the odometry, metres …
+const STEP_M: f64 = 0.3;
+/// … or this far turned, radians.
+const STEP_RAD: f64 = 0.2;
+/// The widest lever-arm interval reported; wider, the log does not fix x and y.
+const MAX_LEVER_INTERVAL_M: f64 = 0.05;
+
+/// A calibration, planned.
+pub struct CalibrateJob {
+    /// The validated configuration.
+    pub plan: Plan,
+    /// The log.
+    pub log: PathBuf,
+    /// The output directory.
+    pub out: PathBuf,
+    /// The files the run reads.
+    pub inputs: Vec<PathBuf>,
+}
+
+/// One sensor's estimates (`summary.json`'s `calibration.sensors[]`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SensorCalibration {
+    /// The sensor's name (a lidar) or topic (the wheel odometry).
+    pub name: String,
+    /// Its kind.
+    pub kind: SensorKind,
+    /// The mount's x, metres (a lidar whose turns fix it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub x: Option<Interval>,
+    /// The mount's y, metres.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub y: Option<Interval>,
+    /// The mount's yaw, radians.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub yaw: Option<Interval>,
+    /// The clock offset to add to its stamps, seconds (a lidar: against the odometry).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_offset_s: Option<Interval>,
+    /// Odometry distance / true distance (the wheel odometry).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scale: Option<Interval>,
+    /// The residual RMS of the motion equations before, metres.
+    pub cost_before: f64,
+    /// … and after.
+    pub cost_after: f64,
+    /// Robot steps used (and of them, turning ones).
+    pub steps: [u64; 2],
+}
+
+/// What `calibrate` found: `summary.json`'s `calibration`.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Calibration {
+    /// The estimates.
+    pub sensors: Vec<SensorCalibration>,
+    /// What this log cannot determine, or this version does not estimate, and why.
+    pub undetermined: Vec<String>,
+}
+
+/// What the run wrote and found.
+pub struct CalibrateRun {
+    /// The summary (`summary.json`, with `calibration`).
+    pub summary: crate::outputs::Summary,
+    /// The calibration.
+    pub calibration: Calibration,
+}
+
+impl CalibrateJob {
+    /// `fusemap calibrate [--config C] --out DIR LOG`.
+    pub fn plan(config: Option<&Path>, log: &Path, out: &Path) -> Result<Self, JobError> {
+        let plan = plan_of(config)?;
+        let inputs = config.map(Path::to_path_buf).into_iter().chain([log.to_path_buf()]).collect();
+        Ok(Self { plan, log: log.to_path_buf(), out: out.to_path_buf(), inputs })
+    }
+
+    /// Estimates, maps with the configuration as given, and writes the set: the map's
+    /// files, `calibration.toml` and `summary.json` with its `calibration`.
+    pub fn run(self, progress: &mut dyn FnMut(Progress)) -> Result<CalibrateRun, JobError> {
+        let started = Instant::now();
+        let (plan, input) = (&self.plan, self.log.display().to_string());
+        let outputs = prepare(&self.out, &self.inputs)?;
+        let named = |error: PipelineError| match error {
+            PipelineError::Read(e) => JobError::File(e),
+            error => JobError::Run { input: input.clone(), error },
+        };
+        progress(Progress::Phase { name: "reading", total: 0 });
+        let inv = Inventory::read_with(&self.log, &plan.limits).map_err(JobError::File)?;
+        progress(Progress::Done);
+        let (bound, raw, track_s) = crate::run::prepare_track(plan, &inv).map_err(named)?;
+        let (chosen, track_s) = crate::run::correct(plan, &inv, &bound, raw, track_s, progress).map_err(named)?;
+        let (estimate, mut undetermined) = lidar_against_odometry(plan, &inv, &bound, &chosen).map_err(named)?;
+        let run =
+            crate::map_with_track(plan, &inv, &bound, chosen, track_s, Default::default(), progress).map_err(named)?;
+        let mount = run.report.lidars.first().map(|l| (l.name.clone(), l.topic.clone(), l.extrinsics.base_from_sensor));
+        let configured_offset = run.report.lidars.first().map_or(0.0, |l| l.time_offset_s);
+        let mut calibration = Calibration::default();
+        if let (Some(mut estimate), Some((name, topic, configured))) = (estimate, mount) {
+            // The search's offset is relative to the configured one.
+            estimate.clock = estimate.clock.map(|c| Interval {
+                value: c.value + configured_offset,
+                low: c.low + configured_offset,
+                high: c.high + configured_offset,
+            });
+            calibration.sensors = sensors_of(&estimate, &name, &configured, &mut undetermined);
+            let text = calibration_toml(&input, &estimate, &name, &topic, &configured);
+            let path = outputs.staged(CALIBRATION_TOML);
+            fusemap_io::atomic::write_atomic(&path, |w| std::io::Write::write_all(w, text.as_bytes()))?;
+        }
+        undetermined.push("the camera's mount and clock offset: not estimated by this version".into());
+        calibration.undetermined = undetermined;
+        let mut notes = run.notes;
+        notes.extend(calibration.undetermined.iter().map(|u| format!("calibration: {u}")));
+        let record = RunRecord {
+            source_kind: &run.format.to_string(),
+            source: &input,
+            started,
+            notes,
+            log: Some(serde_json::to_value(&run.report)?),
+            trajectory: Some(&run.trajectory),
+            validation: None,
+            calibration: Some(serde_json::to_value(&calibration)?),
+        };
+        let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
+        let summary = finish(&run.engine, outputs, &export, record)?;
+        Ok(CalibrateRun { summary, calibration })
+    }
+}
+
+/// The hand–eye estimate of the first lidar against the wheel odometry, with the odometry
+/// topic; `None` and why when the log cannot give it.
+type Estimated = Option<Estimate>;
+
+fn lidar_against_odometry(
+    plan: &Plan,
+    inv: &Inventory,
+    bound: &Bound,
+    chosen: &ChosenTrack,
+) -> Result<(Estimated, Vec<String>), PipelineError> {
+    let why = |s: &str| Ok((None, vec![format!("the lidar's mount and the odometry's scale: {s}")]));
+    let Some(odom) = bound.first(SensorKind::WheelOdometry) else {
+        return why(
+            "the log has no wheel-odometry topic to compare the lidar's motion with (the odometry on CARMEN scan \
+             lines is not compared yet)",
+        );
+    };
+    let Some(slam) = &chosen.slam else {
+        return why("SLAM did not run (it needs raw poses: odometry, the estimator or TF under `odom`)");
+    };
+    let odometry = crate::track::odometry_track(inv, &plan.log, odom)?;
+    let Track::Timed(track) = &odometry.track else { return why("the odometry is not a timed track") };
+    let steps_at = |offset_ns: i64, step_m: f64, step_rad: f64| {
+        let pairs: Vec<(Pose2, Pose2)> = slam
+            .scan_poses
+            .iter()
+            .filter_map(|(t, p)| {
+                let at = Stamp(t.0.saturating_add(offset_ns));
+                track.pose_at(at, SyncMode::Interpolate).ok().map(|o| (o, *p))
+            })
+            .collect();
+        steps_of(&pairs, step_m, step_rad)
+    };
+    let offset = clock_offset(&|dt| steps_at(dt, STEP_M, STEP_RAD));
+    let fit_at = |dt: f64| lidar_odometry(&steps_at(crate::offset_ns(dt), STEP_M, STEP_RAD), MAX_LEVER_INTERVAL_M);
+    let Some(mut e) = fit_at(offset.map_or(0.0, |o| o.value)) else {
+        return why("fewer than 10 steps of the robot are seen by both SLAM and the odometry");
+    };
+    // The mount depends on the clock offset (a turn seen late looks like a lever arm): its
+    // intervals take in the fits at both ends of the offset's interval.
+    for end in offset.iter().flat_map(|o| [o.low, o.high]) {
+        if let Some(other) = fit_at(end) {
+            widen(&mut e, &other);
+        }
+    }
+    Ok((Some(Estimate { motion: e, odometry: odom.topic.clone(), clock: offset }), Vec::new()))
+}
+
+/// Widens `e`'s intervals to take in `other`'s.
+fn widen(e: &mut LidarOdometry, other: &LidarOdometry) {
+    let hull = |a: &mut Interval, b: &Interval| {
+        a.low = a.low.min(b.low);
+        a.high = a.high.max(b.high);
+    };
+    hull(&mut e.yaw, &other.yaw);
+    hull(&mut e.scale, &other.scale);
+    match (&mut e.lever, &other.lever) {
+        (Some(a), Some(b)) => {
+            hull(&mut a[0], &b[0]);
+            hull(&mut a[1], &b[1]);
+        }
+        (lever, None) => *lever = None,
+        _ => {}
+    }
+}
+
+/// The search of the lidar's clock offset against the odometry: ±`CLOCK_SEARCH_S` in
+/// steps of `CLOCK_STEP_S`, then a parabola through the best and its neighbours.
+const CLOCK_SEARCH_S: f64 = 0.1;
+const CLOCK_STEP_S: f64 = 0.005;
+
+/// The correction of the lidar's clock offset against the odometry's, seconds (added to
+/// its stamps, beyond the configured `time_offset_s`): the offset at which the two tracks'
+/// turns line up best ([`turn_agreement`]), with the interval the cost's curvature gives;
+/// `None` when the cost has no interior minimum in the search.
+fn clock_offset(steps_at: &dyn Fn(i64) -> Vec<MotionStep>) -> Option<Interval> {
+    let n = (CLOCK_SEARCH_S / CLOCK_STEP_S).round() as i64;
+    let costs: Vec<(f64, f64, usize)> = (-n..=n)
+        .filter_map(|k| {
+            let dt = k as f64 * CLOCK_STEP_S;
+            turn_agreement(&steps_at(crate::offset_ns(dt))).map(|(_, c, m)| (dt, c, m))
+        })
+        .collect();
+    let best = (1..costs.len().saturating_sub(1)).min_by(|&a, &b| costs[a].1.total_cmp(&costs[b].1))?;
+    let ((x0, y0, _), (_, y1, m), (_, y2, _)) = (costs[best - 1], costs[best], costs[best + 1]);
+    let h = CLOCK_STEP_S;
+    let a = (y0 - 2.0 * y1 + y2) / (2.0 * h * h);
+    if a.is_nan() || a <= 0.0 {
+        return None;
+    }
+    let vertex = x0 + h - (y2 - y0) / (4.0 * a * h);
+    // Σ r² ≈ a (δ − δ₀)² + min: var(δ) = σ² / a with σ² = min / (m − 2).
+    let sigma2 = y1 / (m.saturating_sub(2).max(1)) as f64;
+    Some(Interval::of(vertex, (sigma2 / a).sqrt()))
+}
+
+/// What the lidar–odometry comparison gave.
+struct Estimate {
+    motion: LidarOdometry,
+    odometry: String,
+    clock: Option<Interval>,
+}
+
+/// The true mount `Δ ∘ M′` from the configured one and `Δ` (yaw, x, y), with intervals.
+fn corrected(e: &LidarOdometry, m: &Mount3) -> (Interval, Option<[Interval; 2]>) {
+    let phi = e.yaw.value;
+    let yaw = Interval { value: m.yaw + phi, low: m.yaw + e.yaw.low, high: m.yaw + e.yaw.high };
+    let lever = e.lever.map(|[dx, dy]| {
+        let (rx, ry) = (phi.cos() * m.x - phi.sin() * m.y, phi.sin() * m.x + phi.cos() * m.y);
+        let shift = |i: Interval, by: f64| Interval { value: i.value + by, low: i.low + by, high: i.high + by };
+        [shift(dx, rx), shift(dy, ry)]
+    });
+    (yaw, lever)
+}
+
+fn sensors_of(
+    est: &Estimate,
+    lidar: &str,
+    configured: &Mount3,
+    undetermined: &mut Vec<String>,
+) -> Vec<SensorCalibration> {
+    let (e, odometry) = (&est.motion, &est.odometry);
+    let (yaw, lever) = corrected(e, configured);
+    if est.clock.is_none() {
+        undetermined.push(format!(
+            "`{lidar}`'s clock offset against the odometry: the fit's cost has no minimum within ±{CLOCK_SEARCH_S} s"
+        ));
+    }
+    if lever.is_none() {
+        undetermined.push(format!(
+            "`{lidar}`'s x and y: the log's turns do not fix them (a straight drive never shows a lever arm)"
+        ));
+    }
+    let base = SensorCalibration {
+        name: lidar.to_string(),
+        kind: SensorKind::Lidar,
+        x: lever.map(|l| l[0]),
+        y: lever.map(|l| l[1]),
+        yaw: Some(yaw),
+        time_offset_s: est.clock,
+        scale: None,
+        cost_before: e.cost_before_m,
+        cost_after: e.cost_after_m,
+        steps: [e.steps, e.turning_steps],
+    };
+    let wheels = SensorCalibration {
+        name: odometry.to_string(),
+        kind: SensorKind::WheelOdometry,
+        x: None,
+        y: None,
+        yaw: None,
+        time_offset_s: None,
+        scale: Some(e.scale),
+        ..base.clone()
+    };
+    vec![base, wheels]
+}
+
+/// `calibration.toml`: the lidar's `[[sensor]]` table with the corrected mount, ready to
+/// paste, and the odometry's scale as a comment (fusemap has no key for it: the
+/// estimator learns it).
+fn calibration_toml(log: &str, est: &Estimate, name: &str, topic: &str, m: &Mount3) -> String {
+    let (e, odometry) = (&est.motion, &est.odometry);
+    let (yaw, lever) = corrected(e, m);
+    let mut s = String::new();
+    let q = |v: &str| serde_json::to_string(v).unwrap_or_default();
+    let _ = writeln!(s, "# fusemap calibrate on {log}");
+    let _ = writeln!(
+        s,
+        "# The lidar's mount from its motion (SLAM) against the wheel odometry's, {} steps ({} turning);\n\
+         # residual RMS {:.4} m before, {:.4} m after. 95 % intervals:",
+        e.steps, e.turning_steps, e.cost_before_m, e.cost_after_m
+    );
+    let _ = writeln!(s, "#   yaw {:.5} rad ({:.5} .. {:.5})", yaw.value, yaw.low, yaw.high);
+    match lever {
+        Some([x, y]) => {
+            let _ = writeln!(
+                s,
+                "#   x {:.4} m ({:.4} .. {:.4}), y {:.4} m ({:.4} .. {:.4})",
+                x.value, x.low, x.high, y.value, y.low, y.high
+            );
+        }
+        None => {
+            let _ = writeln!(s, "#   x, y: not determined by this log (too few turns); kept as configured");
+        }
+    }
+    if let Some(c) = est.clock {
+        let _ = writeln!(s, "#   time_offset_s {:.4} s ({:.4} .. {:.4}), against the odometry", c.value, c.low, c.high);
+    }
+    let _ = writeln!(s, "[[sensor]]\nkind = \"lidar\"\nname = {}\ntopic = {}", q(name), q(topic));
+    if let Some(c) = est.clock {
+        let _ = writeln!(s, "time_offset_s = {}", c.value);
+    }
+    let (x, y) = lever.map_or((m.x, m.y), |[x, y]| (x.value, y.value));
+    let _ = writeln!(s, "\n[sensor.base_from_sensor]");
+    for (k, v) in [("x", x), ("y", y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", yaw.value)] {
+        let _ = writeln!(s, "{k} = {v}");
+    }
+    let _ = writeln!(
+        s,
+        "\n# The wheel odometry {}: it reports {:.4} × the distance driven (95 %: {:.4} .. {:.4}).\n\
+         # fusemap has no key for it: the estimator learns the scale (estimator.odometry_scale_prior_sigma).",
+        q(odometry),
+        e.scale.value,
+        e.scale.low,
+        e.scale.high
+    );
+    s
+}

