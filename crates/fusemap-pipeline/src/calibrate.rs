@@ -130,7 +130,7 @@ impl CalibrateJob {
                 high: c.high + configured_offset,
             });
             calibration.sensors = sensors_of(&estimate, &name, &configured, &mut undetermined);
-            let text = calibration_toml(&input, &estimate, &name, &topic, &configured);
+            let text = calibration_toml(&input, &estimate, &name, &topic, &configured, configured_offset);
             let path = outputs.staged(CALIBRATION_TOML);
             fusemap_io::atomic::write_atomic(&path, |w| std::io::Write::write_all(w, text.as_bytes()))?;
         }
@@ -176,19 +176,22 @@ fn lidar_against_odometry(
     };
     let odometry = crate::track::odometry_track(inv, &plan.log, odom)?;
     let Track::Timed(track) = &odometry.track else { return why("the odometry is not a timed track") };
-    let steps_at = |offset_ns: i64, step_m: f64, step_rad: f64| {
+    // The steps with the odometry read `offset_ns` later, the SLAM poses of `skip` left out.
+    let steps_at = |offset_ns: i64, skip: std::ops::Range<usize>| {
         let pairs: Vec<(Pose2, Pose2)> = slam
             .scan_poses
             .iter()
-            .filter_map(|(t, p)| {
+            .enumerate()
+            .filter(|(i, _)| !skip.contains(i))
+            .filter_map(|(_, (t, p))| {
                 let at = Stamp(t.0.saturating_add(offset_ns));
                 track.pose_at(at, SyncMode::Interpolate).ok().map(|o| (o, *p))
             })
             .collect();
-        steps_of(&pairs, step_m, step_rad)
+        steps_of(&pairs, STEP_M, STEP_RAD)
     };
-    let offset = clock_offset(&|dt| steps_at(dt, STEP_M, STEP_RAD));
-    let fit_at = |dt: f64| lidar_odometry(&steps_at(crate::offset_ns(dt), STEP_M, STEP_RAD), MAX_LEVER_INTERVAL_M);
+    let offset = clock_offset(&steps_at, slam.scan_poses.len());
+    let fit_at = |dt: f64| lidar_odometry(&steps_at(crate::offset_ns(dt), 0..0), MAX_LEVER_INTERVAL_M);
     let Some(mut e) = fit_at(offset.map_or(0.0, |o| o.value)) else {
         return why("fewer than 10 steps of the robot are seen by both SLAM and the odometry");
     };
@@ -222,22 +225,60 @@ fn widen(e: &mut LidarOdometry, other: &LidarOdometry) {
 
 /// The search of the lidar's clock offset against the odometry: ±`CLOCK_SEARCH_S` in
 /// steps of `CLOCK_STEP_S`, then a parabola through the best and its neighbours.
-const CLOCK_SEARCH_S: f64 = 0.1;
+const CLOCK_SEARCH_S: f64 = 0.2;
 const CLOCK_STEP_S: f64 = 0.005;
 
 /// The correction of the lidar's clock offset against the odometry's, seconds (added to
 /// its stamps, beyond the configured `time_offset_s`): the offset at which the two tracks'
 /// turns line up best ([`turn_agreement`]), with the interval the cost's curvature gives;
 /// `None` when the cost has no interior minimum in the search.
-fn clock_offset(steps_at: &dyn Fn(i64) -> Vec<MotionStep>) -> Option<Interval> {
-    let n = (CLOCK_SEARCH_S / CLOCK_STEP_S).round() as i64;
-    let costs: Vec<(f64, f64, usize)> = (-n..=n)
+fn clock_offset(steps_at: &dyn Fn(i64, std::ops::Range<usize>) -> Vec<MotionStep>, poses: usize) -> Option<Interval> {
+    let search = |centre: f64| (centre - CLOCK_SEARCH_S, centre + CLOCK_SEARCH_S);
+    let (best, curvature_sigma) = clock_minimum(&|dt| steps_at(dt, 0..0), search(0.0))?;
+    // The curvature treats every step as independent; neighbouring steps share their errors,
+    // so the interval is also the delete-a-block jackknife's, whichever is wider. Each
+    // reduced search stays near the whole log's minimum (the jackknife measures how that
+    // minimum moves, not which of two far minima a reduced log prefers); one whose
+    // minimum leaves that neighbourhood counts at its edge.
+    let k = CLOCK_JACKKNIFE_BLOCKS;
+    let block = poses.div_ceil(k);
+    let near = (best - CLOCK_JACKKNIFE_REACH_S, best + CLOCK_JACKKNIFE_REACH_S);
+    let reduced: Vec<f64> = (0..k)
+        .map(|b| {
+            clock_minimum(&|dt| steps_at(dt, b * block..(b + 1) * block), near)
+                .map_or(near.1, |m| m.0.clamp(near.0, near.1))
+        })
+        .collect();
+    let sigma = if reduced.len() == k {
+        let mean = reduced.iter().sum::<f64>() / k as f64;
+        let ss: f64 = reduced.iter().map(|v| (v - mean).powi(2)).sum();
+        curvature_sigma.max(((k - 1) as f64 / k as f64 * ss).sqrt())
+    } else {
+        return None;
+    };
+    Some(Interval::of(best, sigma))
+}
+
+/// Blocks of SLAM poses left out in turn for the clock's jackknife.
+const CLOCK_JACKKNIFE_BLOCKS: usize = 10;
+/// How far from the whole log's minimum a reduced search looks, seconds.
+const CLOCK_JACKKNIFE_REACH_S: f64 = 0.05;
+
+/// The least turn-agreement cost over the search (the parabola's vertex through the best
+/// grid offset and its neighbours), with the curvature's standard error; `None` when the
+/// minimum is at the search's edge or the cost is flat there.
+fn clock_minimum(steps_at: &dyn Fn(i64) -> Vec<MotionStep>, (from, to): (f64, f64)) -> Option<(f64, f64)> {
+    let n = ((to - from) / CLOCK_STEP_S).round() as i64;
+    let costs: Vec<(f64, f64, usize)> = (0..=n)
         .filter_map(|k| {
-            let dt = k as f64 * CLOCK_STEP_S;
+            let dt = from + k as f64 * CLOCK_STEP_S;
             turn_agreement(&steps_at(crate::offset_ns(dt))).map(|(_, c, m)| (dt, c, m))
         })
         .collect();
-    let best = (1..costs.len().saturating_sub(1)).min_by(|&a, &b| costs[a].1.total_cmp(&costs[b].1))?;
+    let best = (0..costs.len()).min_by(|&a, &b| costs[a].1.total_cmp(&costs[b].1))?;
+    if best == 0 || best + 1 >= costs.len() {
+        return None;
+    }
     let ((x0, y0, _), (_, y1, m), (_, y2, _)) = (costs[best - 1], costs[best], costs[best + 1]);
     let h = CLOCK_STEP_S;
     let a = (y0 - 2.0 * y1 + y2) / (2.0 * h * h);
@@ -247,7 +288,7 @@ fn clock_offset(steps_at: &dyn Fn(i64) -> Vec<MotionStep>) -> Option<Interval> {
     let vertex = x0 + h - (y2 - y0) / (4.0 * a * h);
     // Σ r² ≈ a (δ − δ₀)² + min: var(δ) = σ² / a with σ² = min / (m − 2).
     let sigma2 = y1 / (m.saturating_sub(2).max(1)) as f64;
-    Some(Interval::of(vertex, (sigma2 / a).sqrt()))
+    Some((vertex, (sigma2 / a).sqrt()))
 }
 
 /// What the lidar–odometry comparison gave.
@@ -315,12 +356,13 @@ fn sensors_of(
 /// `calibration.toml`: the lidar's `[[sensor]]` table with the corrected mount, ready to
 /// paste, and the odometry's scale as a comment (fusemap has no key for it: the
 /// estimator learns it).
-fn calibration_toml(log: &str, est: &Estimate, name: &str, topic: &str, m: &Mount3) -> String {
+fn calibration_toml(log: &str, est: &Estimate, name: &str, topic: &str, m: &Mount3, configured_offset: f64) -> String {
     let (e, odometry) = (&est.motion, &est.odometry);
     let (yaw, lever) = corrected(e, m);
     let mut s = String::new();
     let q = |v: &str| serde_json::to_string(v).unwrap_or_default();
     let _ = writeln!(s, "# fusemap calibrate on {log}");
+    let _ = writeln!(s, "# A value whose interval holds the configured one is left as configured.");
     let _ = writeln!(
         s,
         "# The lidar's mount from its motion (SLAM) against the wheel odometry's, {} steps ({} turning);\n\
@@ -344,12 +386,15 @@ fn calibration_toml(log: &str, est: &Estimate, name: &str, topic: &str, m: &Moun
         let _ = writeln!(s, "#   time_offset_s {:.4} s ({:.4} .. {:.4}), against the odometry", c.value, c.low, c.high);
     }
     let _ = writeln!(s, "[[sensor]]\nkind = \"lidar\"\nname = {}\ntopic = {}", q(name), q(topic));
+    // No change smaller than its interval is claimed: a configured value inside the
+    // estimate's interval stays.
+    let claim = |i: Interval, configured: f64| if i.contains(configured) { configured } else { i.value };
     if let Some(c) = est.clock {
-        let _ = writeln!(s, "time_offset_s = {}", c.value);
+        let _ = writeln!(s, "time_offset_s = {}", claim(c, configured_offset));
     }
-    let (x, y) = lever.map_or((m.x, m.y), |[x, y]| (x.value, y.value));
+    let (x, y) = lever.map_or((m.x, m.y), |[x, y]| (claim(x, m.x), claim(y, m.y)));
     let _ = writeln!(s, "\n[sensor.base_from_sensor]");
-    for (k, v) in [("x", x), ("y", y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", yaw.value)] {
+    for (k, v) in [("x", x), ("y", y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", claim(yaw, m.yaw))] {
         let _ = writeln!(s, "{k} = {v}");
     }
     let _ = writeln!(
