@@ -16,7 +16,10 @@ limit, and is checked for:
 * inputs untouched: every file of the case's directory outside `out/` has the size and
   modification time it had before, and no file appeared beside them (no SQLite -wal or
   -shm);
-* for `doctor`: it fails where `map` fails on the log, and succeeds where `map` maps.
+* for `doctor`: it fails where `map` fails on the log, and succeeds where `map` maps;
+* for `validate` and `calibrate`, run on every log case of `map` with the same config:
+  no crash, no change to the inputs, a refusal wherever `map` refuses, and one `error: `
+  line whenever they refuse.
 
 Prints one line per failed check and a summary (cases, runs, the largest peak RSS and
 the longest run); exits 1 when any check failed.
@@ -247,7 +250,37 @@ def check_case_in(fusemap: str, d: Path, c: dict) -> tuple[list[str], list[Run]]
             problems.append(f"doctor fails on a log that map maps: {dr.stderr.strip()[-300:]}")
         elif c["doctor"] == "any" and (dr.status == 0) != (r.status == 0):
             problems.append(f"doctor exits {dr.status} but map exits {r.status}")
+    problems += check_validate_and_calibrate(fusemap, c, d, args, r, runs)
     return problems, runs
+
+
+def check_validate_and_calibrate(fusemap: str, c: dict, d: Path, args: list[str], r: Run, runs: list[Run]) -> list[str]:
+    """A log case of `map` also runs `validate` and `calibrate` on the same log and
+    config (into out/validate, out/calibrate): neither may crash; each refuses a log that
+    `map` refuses; where `map` maps, each runs or refuses with one `error: ` line (a log too
+    short to hold a period out is refused, with the reason)."""
+    if args[:1] != ["map"] or "--world" in args or "--crop" in args or c.get("setup") or "--out" not in args:
+        return []
+    if c["name"].startswith("output/"):
+        return []  # the case is about map's output directory, which these do not share
+    problems = []
+    for cmd in ("validate", "calibrate"):
+        xargs = [cmd, *args[1:]]
+        xargs[xargs.index("--out") + 1] = str(d / "out" / cmd)
+        before = snapshot(d)
+        x = run([fusemap, *xargs], d)
+        runs.append(x)
+        if snapshot(d) != before:
+            problems.append(f"{cmd}: inputs changed")
+        why = crashed(x)
+        errors = [line for line in x.stderr.splitlines() if line.startswith("error: ")]
+        if why:
+            problems.append(f"{cmd}: {why}: {x.stderr.strip()[-300:]}")
+        elif r.status != 0 and x.status == 0:
+            problems.append(f"{cmd} exits 0 on a log that map refuses")
+        elif x.status != 0 and len(errors) != 1:
+            problems.append(f"{cmd}: expected one `error: ` line, got: {x.stderr.strip()[-300:]}")
+    return problems
 
 
 def main() -> int:
