@@ -67,8 +67,8 @@ enum Command {
         log: PathBuf,
     },
     /// Estimate from the log what §4.3 tells a user to check by hand: the lidar's mount
-    /// (yaw, x, y) and the wheel odometry's scale, from the lidar's motion (SLAM) against
-    /// the wheels', with 95 % intervals; parameters the log cannot fix are named, not
+    /// (yaw, x, y), its clock offset and the wheel odometry's scale, from the lidar's
+    /// motion (SLAM) against the wheels', with 95 % intervals; parameters the log cannot fix are named, not
     /// invented. Writes DIR/calibration.toml (the `[[sensor]]` table to paste), the map and
     /// summary.json's `calibration`.
     Calibrate {

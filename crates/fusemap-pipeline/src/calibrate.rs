@@ -5,9 +5,10 @@
 //! This version estimates the lidar's planar mount (yaw, x, y) and the wheel odometry's
 //! scale from the two tracks of one robot: SLAM's, which follows the lidar through its
 //! configured mount, and the wheels' ([`fusemap_core::calibration::lidar_odometry`],
-//! after Censi et al. 2013). It needs SLAM on a timed track and a wheel-odometry topic;
-//! without them it says so. The camera's mount and clock offset and the lidar's clock
-//! offset are not estimated yet, and the report says that too.
+//! after Censi et al. 2013), and the lidar's clock offset against the odometry from when
+//! their turns line up ([`fusemap_core::calibration::turn_agreement`]). It needs SLAM on
+//! a timed track and a wheel-odometry topic; without them it says so. The camera's mount
+//! and clock offset are not estimated yet, and the report says that too.
 
 use crate::job::{plan_of, JobError};
 use crate::outputs::{finish, prepare, ExportOptions, RunRecord};
@@ -176,10 +177,18 @@ fn lidar_against_odometry(
     };
     let odometry = crate::track::odometry_track(inv, &plan.log, odom)?;
     let Track::Timed(track) = &odometry.track else { return why("the odometry is not a timed track") };
-    // The steps with the odometry read `offset_ns` later, the SLAM poses of `skip` left out.
+    // The SLAM poses the odometry covers at every offset of the search, so that each offset
+    // compares the same steps.
+    let reach = crate::offset_ns(CLOCK_SEARCH_S);
+    let covered = |t: Stamp| {
+        [t.0.saturating_sub(reach), t.0.saturating_add(reach)]
+            .iter()
+            .all(|&s| track.pose_at(Stamp(s), SyncMode::Interpolate).is_ok())
+    };
+    let poses: Vec<(Stamp, Pose2)> = slam.scan_poses.iter().copied().filter(|(t, _)| covered(*t)).collect();
+    // The steps with the odometry read `offset_ns` later, the poses of `skip` left out.
     let steps_at = |offset_ns: i64, skip: std::ops::Range<usize>| {
-        let pairs: Vec<(Pose2, Pose2)> = slam
-            .scan_poses
+        let pairs: Vec<(Pose2, Pose2)> = poses
             .iter()
             .enumerate()
             .filter(|(i, _)| !skip.contains(i))
@@ -190,7 +199,7 @@ fn lidar_against_odometry(
             .collect();
         steps_of(&pairs, STEP_M, STEP_RAD)
     };
-    let offset = clock_offset(&steps_at, slam.scan_poses.len());
+    let offset = clock_offset(&steps_at, poses.len());
     let fit_at = |dt: f64| lidar_odometry(&steps_at(crate::offset_ns(dt), 0..0), MAX_LEVER_INTERVAL_M);
     let Some(mut e) = fit_at(offset.map_or(0.0, |o| o.value)) else {
         return why("fewer than 10 steps of the robot are seen by both SLAM and the odometry");
@@ -230,23 +239,23 @@ const CLOCK_STEP_S: f64 = 0.005;
 
 /// The correction of the lidar's clock offset against the odometry's, seconds (added to
 /// its stamps, beyond the configured `time_offset_s`): the offset at which the two tracks'
-/// turns line up best ([`turn_agreement`]), with the interval the cost's curvature gives;
-/// `None` when the cost has no interior minimum in the search.
+/// turns line up best ([`turn_agreement`], over the same steps at every offset),
+/// with the wider of the intervals the cost's curvature and a delete-a-block jackknife
+/// give; `None` when the cost has no interior minimum in the search.
 fn clock_offset(steps_at: &dyn Fn(i64, std::ops::Range<usize>) -> Vec<MotionStep>, poses: usize) -> Option<Interval> {
     let search = |centre: f64| (centre - CLOCK_SEARCH_S, centre + CLOCK_SEARCH_S);
-    let (best, curvature_sigma) = clock_minimum(&|dt| steps_at(dt, 0..0), search(0.0))?;
+    let (best, curvature_sigma) = clock_minimum(&|dt| steps_at(dt, 0..0), search(0.0)).ok()?;
     // The curvature treats every step as independent; neighbouring steps share their errors,
     // so the interval is also the delete-a-block jackknife's, whichever is wider. Each
     // reduced search stays near the whole log's minimum (the jackknife measures how that
     // minimum moves, not which of two far minima a reduced log prefers); one whose
     // minimum leaves that neighbourhood counts at its edge.
     let k = CLOCK_JACKKNIFE_BLOCKS;
-    let block = poses.div_ceil(k);
     let near = (best - CLOCK_JACKKNIFE_REACH_S, best + CLOCK_JACKKNIFE_REACH_S);
     let reduced: Vec<f64> = (0..k)
-        .map(|b| {
-            clock_minimum(&|dt| steps_at(dt, b * block..(b + 1) * block), near)
-                .map_or(near.1, |m| m.0.clamp(near.0, near.1))
+        .map(|b| match clock_minimum(&|dt| steps_at(dt, b * poses / k..(b + 1) * poses / k), near) {
+            Ok((m, _)) => m.clamp(near.0, near.1),
+            Err(edge) => edge.unwrap_or(best),
         })
         .collect();
     let sigma = if reduced.len() == k {
@@ -265,30 +274,31 @@ const CLOCK_JACKKNIFE_BLOCKS: usize = 10;
 const CLOCK_JACKKNIFE_REACH_S: f64 = 0.05;
 
 /// The least turn-agreement cost over the search (the parabola's vertex through the best
-/// grid offset and its neighbours), with the curvature's standard error; `None` when the
-/// minimum is at the search's edge or the cost is flat there.
-fn clock_minimum(steps_at: &dyn Fn(i64) -> Vec<MotionStep>, (from, to): (f64, f64)) -> Option<(f64, f64)> {
+/// grid offset and its neighbours), with the curvature's standard error. `Err(Some(edge))`
+/// when the least cost is at an edge of the search, `Err(None)` when a grid offset has no
+/// cost or the cost is flat at its least.
+fn clock_minimum(steps_at: &dyn Fn(i64) -> Vec<MotionStep>, (from, to): (f64, f64)) -> Result<(f64, f64), Option<f64>> {
     let n = ((to - from) / CLOCK_STEP_S).round() as i64;
-    let costs: Vec<(f64, f64, usize)> = (0..=n)
-        .filter_map(|k| {
-            let dt = from + k as f64 * CLOCK_STEP_S;
-            turn_agreement(&steps_at(crate::offset_ns(dt))).map(|(_, c, m)| (dt, c, m))
-        })
-        .collect();
-    let best = (0..costs.len()).min_by(|&a, &b| costs[a].1.total_cmp(&costs[b].1))?;
+    let mut costs = Vec::new();
+    for k in 0..=n {
+        let dt = from + k as f64 * CLOCK_STEP_S;
+        let (_, c, m) = turn_agreement(&steps_at(crate::offset_ns(dt))).ok_or(None)?;
+        costs.push((dt, c, m));
+    }
+    let best = (0..costs.len()).min_by(|&a, &b| costs[a].1.total_cmp(&costs[b].1)).ok_or(None)?;
     if best == 0 || best + 1 >= costs.len() {
-        return None;
+        return Err(Some(costs[best].0));
     }
     let ((x0, y0, _), (_, y1, m), (_, y2, _)) = (costs[best - 1], costs[best], costs[best + 1]);
     let h = CLOCK_STEP_S;
     let a = (y0 - 2.0 * y1 + y2) / (2.0 * h * h);
     if a.is_nan() || a <= 0.0 {
-        return None;
+        return Err(None);
     }
     let vertex = x0 + h - (y2 - y0) / (4.0 * a * h);
     // Σ r² ≈ a (δ − δ₀)² + min: var(δ) = σ² / a with σ² = min / (m − 2).
     let sigma2 = y1 / (m.saturating_sub(2).max(1)) as f64;
-    Some((vertex, (sigma2 / a).sqrt()))
+    Ok((vertex, (sigma2 / a).sqrt()))
 }
 
 /// What the lidar–odometry comparison gave.
@@ -302,9 +312,13 @@ struct Estimate {
 fn corrected(e: &LidarOdometry, m: &Mount3) -> (Interval, Option<[Interval; 2]>) {
     let phi = e.yaw.value;
     let yaw = Interval { value: m.yaw + phi, low: m.yaw + e.yaw.low, high: m.yaw + e.yaw.high };
+    // x, y = Δ's translation + R_φ (the configured translation): the yaw's uncertainty
+    // moves the second term by up to |t_M′| times its half-width.
+    let swing = m.x.hypot(m.y) * e.yaw.half_width();
     let lever = e.lever.map(|[dx, dy]| {
         let (rx, ry) = (phi.cos() * m.x - phi.sin() * m.y, phi.sin() * m.x + phi.cos() * m.y);
-        let shift = |i: Interval, by: f64| Interval { value: i.value + by, low: i.low + by, high: i.high + by };
+        let shift =
+            |i: Interval, by: f64| Interval { value: i.value + by, low: i.low + by - swing, high: i.high + by + swing };
         [shift(dx, rx), shift(dy, ry)]
     });
     (yaw, lever)

@@ -133,7 +133,7 @@ fn write_map_files(
         Some(l) => {
             let with = fusemap_io::npz::NpzLayers { semantic: Some(&l.semantic), dynamic: Some(&l.dynamic) };
             fusemap_io::npz::write_map_npz_with(&files.npz, &raster, &with)?;
-            fusemap_io::semantic::write_semantic(&files.semantic, &l.semantic)?;
+            fusemap_io::semantic::write_semantic(&files.semantic, &l.picture())?;
             fusemap_io::semantic::write_dynamic_png(&files.dynamic, &l.dynamic)?;
         }
         None => fusemap_io::npz::write_map_npz(&files.npz, &raster)?,
@@ -185,8 +185,7 @@ fn write_comparison(
     }
     if let Some(l) = fused_semantic {
         let rgb = l
-            .semantic
-            .best
+            .shown
             .iter()
             .map(|&b| if b >= 0 { l.semantic.classes[b as usize].color } else { fusemap_io::semantic::UNKNOWN_COLOR })
             .collect();

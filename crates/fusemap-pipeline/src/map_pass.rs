@@ -144,8 +144,11 @@ pub fn map_with_track(
     let mut streams = Streams::open(&input, &mut engine, &mut notes)?;
 
     let t_map = Instant::now();
-    let hold_from = maps.holdout_share.map(|share| streams.holdout_key(&input, share));
-    let placed = streams.run(&input, &mut engine, mode, hold_from, progress)?;
+    let hold_from = maps.holdout_share.and_then(|share| streams.holdout_key(&input, share));
+    // On poses of the scan lines the keys of scans count them; only scans start the
+    // held-out period there (the images of such a log, if any, carry stamps).
+    let scans_only = matches!(chosen.track, Track::ScanLine(_));
+    let placed = streams.run(&input, &mut engine, mode, hold_from.map(|k| (k, scans_only)), progress)?;
     let map_s = t_map.elapsed().as_secs_f64();
     let trajectory = match &chosen.track {
         Track::ScanLine(_) => placed,
@@ -327,7 +330,7 @@ impl Streams {
         input: &Inputs,
         engine: &mut Engine,
         mode: SyncMode,
-        hold_from: Option<i64>,
+        hold_from: Option<(i64, bool)>,
         progress: &mut dyn FnMut(Progress),
     ) -> Result<Vec<(Stamp, Pose2)>, PipelineError> {
         let inv = input.inv;
@@ -356,14 +359,14 @@ impl Streams {
                 progress(Progress::Advance(1));
             }
             while let Some((s, key, msg)) = self.merge.pop_ready() {
-                hold_out_from(inserter.engine, hold_from, key);
+                hold_out_from(inserter.engine, hold_from, key, &msg);
                 release(&mut inserter, &mut self.lidars, &mut self.cameras, s, Stamp(key), msg)?;
                 progress(Progress::Advance(1));
             }
             Ok(())
         })?;
         while let Some((s, key, msg)) = self.merge.pop_final() {
-            hold_out_from(inserter.engine, hold_from, key);
+            hold_out_from(inserter.engine, hold_from, key, &msg);
             release(&mut inserter, &mut self.lidars, &mut self.cameras, s, Stamp(key), msg)?;
             progress(Progress::Advance(1));
         }
@@ -374,29 +377,27 @@ impl Streams {
         Ok(std::mem::take(&mut inserter.placed))
     }
 
-    /// The merge key from which the later `share` of the log is held out: by the stamps'
-    /// span (with each sensor's clock offset) on a timed track, by the scan count on poses
-    /// of the scan lines (their keys count the scans).
-    fn holdout_key(&self, input: &Inputs, share: f64) -> i64 {
+    /// The merge key from which the later `share` of the log is held out: the
+    /// `(1 − share)` quantile of the observations' keys (their stamps with each sensor's
+    /// clock offset) on a timed track, so that a stray stamp years off moves it by one
+    /// observation, not by years; by the scan count on poses of the scan lines (their keys
+    /// count the scans). `None` when the log has nothing to split.
+    fn holdout_key(&self, input: &Inputs, share: f64) -> Option<i64> {
         let inv = input.inv;
         if matches!(input.track, Track::ScanLine(_)) {
             let n: u64 = self.lidars.iter().map(|l| l.report.scans_read).sum();
-            return ((1.0 - share) * n as f64).floor() as i64 + 1;
+            return Some(((1.0 - share) * n as f64).floor() as i64 + 1);
         }
         let lidar = self.lidars.iter().map(|l| (&inv.scans[&l.report.topic].stamps, l.offset_ns));
         let camera =
             self.cameras.iter().filter_map(|c| inv.images.get(&c.report.topic).map(|i| (&i.stamps, c.offset_ns)));
-        let (mut lo, mut hi) = (i64::MAX, i64::MIN);
-        for (stamps, offset) in lidar.chain(camera) {
-            for s in stamps {
-                let k = s.0.saturating_add(offset);
-                (lo, hi) = (lo.min(k), hi.max(k));
-            }
-        }
-        if lo > hi {
-            return i64::MAX;
-        }
-        lo.saturating_add(((1.0 - share) * (hi as f64 - lo as f64)) as i64)
+        let mut keys: Vec<i64> = lidar
+            .chain(camera)
+            .flat_map(|(stamps, offset)| stamps.iter().map(move |s| s.0.saturating_add(offset)))
+            .collect();
+        keys.sort_unstable();
+        let at = ((1.0 - share) * keys.len() as f64).floor() as usize;
+        keys.get(at.min(keys.len().saturating_sub(1))).copied()
     }
 
     /// The merge stream of a message and its merge key (its stamp with the sensor's time
@@ -434,9 +435,11 @@ impl Streams {
     }
 }
 
-/// Holds the rest of the pass out of the maps once the merge reaches `hold_from`.
-fn hold_out_from(engine: &mut Engine, hold_from: Option<i64>, key: i64) {
-    if hold_from.is_some_and(|h| key >= h) {
+/// Holds the rest of the pass out of the maps once the merge reaches `hold_from`'s key
+/// (with its flag set, only a scan's key counts).
+fn hold_out_from(engine: &mut Engine, hold_from: Option<(i64, bool)>, key: i64, msg: &RangeMessage) {
+    let counts = |scans_only: bool| !scans_only || matches!(msg, RangeMessage::Scan(_));
+    if hold_from.is_some_and(|(h, scans_only)| key >= h && counts(scans_only)) {
         engine.hold_out();
     }
 }

@@ -6,7 +6,7 @@
 //! M3 (every sensor), each placed with the same track; the later `validate.holdout_share`
 //! of the log is held out of all three, and its lidar returns and camera obstacle pixels
 //! are counted per cell instead ([`fusemap_core::fusion::HeldOut`]). Each sensor's hit
-//! rate on each map and each map's mean entropy over the cells they share give the
+//! rate on each map and each map's mean entropy over the cells any of them observed give the
 //! verdict ([`fusemap_core::metrics::judge`]).
 //!
 //! Pose sensors (odometry, IMU, GNSS) place every map's evidence and are in every map: to
@@ -221,7 +221,7 @@ fn validate(
             (true, _) => not_built.push(format!("{name}: {}", missing(&role))),
             (false, None) => not_built.push(format!(
                 "{name}: its sensors observed nothing before the held-out period (the log is shorter than the \
-                 training period, or they are silent until late)"
+                 training period, its stamps do not advance, or its sensors are silent until late)"
             )),
             (false, Some(b)) => built.push((name, role, used, m.grid(), b)),
         }

@@ -1,4 +1,4 @@
-//! `fusemap calibrate`: the lidar's mount and the wheel odometry's scale estimated from the
+//! `fusemap calibrate`: the lidar's mount and clock offset and the wheel odometry's scale estimated from the
 //! log, with 95 % intervals, and what it cannot determine. The job is the library's
 //! ([`fusemap_pipeline::calibrate`]); this prints its table.
 
@@ -35,6 +35,7 @@ pub fn table(c: &Calibration) -> String {
             ("y", &e.y, "m", 1.0, 4),
             ("yaw", &e.yaw, "°", 180.0 / std::f64::consts::PI, 3),
             ("scale", &e.scale, "×", 1.0, 4),
+            ("time_offset_s", &e.time_offset_s, "s", 1.0, 4),
         ] {
             if let Some(i) = v {
                 let _ = writeln!(s, "calibrated    {name} {k} {}", show(i, unit, f, d));

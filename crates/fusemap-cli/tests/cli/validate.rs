@@ -79,3 +79,23 @@ fn calibrate_names_what_a_log_cannot_determine() {
     assert!(!out.join("calibration.toml").exists(), "nothing estimated, nothing to paste");
     assert!(out.join("map.npz").is_file());
 }
+
+/// A config kept in the output directory under a name the set owns is an input: the run
+/// refuses instead of removing it at its commit.
+#[test]
+fn a_config_named_like_an_output_is_never_removed() {
+    let dir = temp_dir("calibration-toml-input");
+    let lines: Vec<String> = (0..30).map(corridor).collect();
+    let log = write_file(&dir, "corridor.log", lines.join("\n") + "\n");
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let config = write_file(&out, "calibration.toml", "[map]\n");
+    for cmd in ["map", "validate", "calibrate"] {
+        let o =
+            run(&[cmd, "--config", config.to_str().unwrap(), "--out", out.to_str().unwrap(), log.to_str().unwrap()]);
+        assert!(!o.status.success(), "{cmd}");
+        let e = crate::util::one_line_error(&o);
+        assert!(e.contains("calibration.toml"), "{cmd}: {e}");
+        assert_eq!(std::fs::read_to_string(&config).unwrap(), "[map]\n", "{cmd}");
+    }
+}

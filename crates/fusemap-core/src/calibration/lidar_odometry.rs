@@ -179,10 +179,10 @@ fn model_sigmas(u: &[f64; 4], cov: &[[f64; 4]; 4]) -> [f64; 4] {
 /// reduced fit could not give.
 fn jackknife_sigmas(steps: &[MotionStep]) -> [Option<f64>; 4] {
     let k = JACKKNIFE_BLOCKS;
-    let block = steps.len().div_ceil(k);
+    let n = steps.len();
     let mut estimates = Vec::new();
     for b in 0..k {
-        let (lo, hi) = ((b * block).min(steps.len()), ((b + 1) * block).min(steps.len()));
+        let (lo, hi) = (b * n / k, (b + 1) * n / k);
         let kept: Vec<MotionStep> = steps[..lo].iter().chain(&steps[hi..]).copied().collect();
         if let Some((u, _)) = fit(&kept) {
             estimates.push(parameters(&u));
@@ -256,17 +256,19 @@ pub fn turn_agreement(steps: &[MotionStep]) -> Option<(f64, f64, usize)> {
     Some((kappa, cost, steps.len()))
 }
 
-/// Cuts two tracks sampled at the same instants into steps: from each step's start, the
-/// first sample at least `step_m` away or `step_rad` turned along the odometry.
+/// Cuts two tracks sampled at the same instants, `(odometry, lidar)`, into steps: from
+/// each step's start, the first sample at least `step_m` away or `step_rad` turned along
+/// the lidar's track. The cuts depend on the lidar's poses alone, so the odometry read at
+/// shifted instants (a clock-offset search) gives the same steps.
 pub fn steps_of(pairs: &[(Pose2, Pose2)], step_m: f64, step_rad: f64) -> Vec<MotionStep> {
     let mut out = Vec::new();
     let mut a = 0;
     for j in 1..pairs.len() {
-        let odometry = pairs[a].0.inverse() * pairs[j].0;
-        if odometry.x.hypot(odometry.y) < step_m && odometry.theta.abs() < step_rad {
+        let lidar = pairs[a].1.inverse() * pairs[j].1;
+        if lidar.x.hypot(lidar.y) < step_m && lidar.theta.abs() < step_rad {
             continue;
         }
-        out.push(MotionStep { odometry, lidar: pairs[a].1.inverse() * pairs[j].1 });
+        out.push(MotionStep { odometry: pairs[a].0.inverse() * pairs[j].0, lidar });
         a = j;
     }
     out

@@ -4,8 +4,9 @@
 //! rate on each map (built from the earlier part alone) can be read.
 //!
 //! An endpoint is what a sensor claims is an obstacle: a lidar beam's return (a hit, not
-//! a max-range pass), a camera pixel of a static class in the obstacle band. Dynamic
-//! classes and floor pixels claim no static obstacle and are not counted.
+//! a max-range pass), a camera pixel in the obstacle band of a class that is obstacle
+//! evidence. Dynamic classes, floor-like classes and floor pixels claim no static
+//! obstacle and are not counted.
 //!
 //! Counting per cell instead of keeping the points bounds the memory by the cells the
 //! later period sees, not by its length; the hit rate is the same, since a map's verdict
@@ -45,18 +46,23 @@ impl HeldOut {
         let cells = self.counts.entry(data.sensor).or_default();
         for r in data.rays.iter().filter(|r| r.hit) {
             if let Some(c) = geometry.cell_of(r.end) {
-                *cells.entry(c).or_insert(0) += 1;
+                let n = cells.entry(c).or_insert(0);
+                *n = n.saturating_add(1);
             }
         }
         *self.observations.entry(data.sensor).or_insert(0) += 1;
     }
 
-    /// Counts a camera frame's obstacle-band pixels of static classes.
+    /// Counts a camera frame's obstacle-band pixels of the classes that are obstacle
+    /// evidence (static, not ignored, `p_occupied` above one half: those the camera's
+    /// occupancy update makes occupied, see `CameraModel::occupancy_evidence`).
     pub fn add_camera(&mut self, obs: &CameraObservation, classes: &ClassTable, geometry: &GridGeometry) {
         let cells = self.counts.entry(obs.sensor).or_default();
-        for p in obs.points.iter().filter(|p| p.band == Band::Obstacle && !classes.get(p.class).dynamic) {
+        let obstacle = |k: u8| classes.try_get(k).is_some_and(|c| !c.dynamic && !c.ignore && c.p_occupied > 0.5);
+        for p in obs.points.iter().filter(|p| p.band == Band::Obstacle && obstacle(p.class)) {
             if let Some(c) = geometry.cell_of(p.end) {
-                *cells.entry(c).or_insert(0) += 1;
+                let n = cells.entry(c).or_insert(0);
+                *n = n.saturating_add(1);
             }
         }
         *self.observations.entry(obs.sensor).or_insert(0) += 1;

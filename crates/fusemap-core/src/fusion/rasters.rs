@@ -3,7 +3,7 @@
 //! layer's probability at a given time.
 
 use super::camera::cell_semantics;
-use crate::grid::{logodds::probability, CellBox, CellIndex, CellRaster, FusionGrid};
+use crate::grid::{logodds::probability, CellBox, CellIndex, CellRaster, FusionGrid, Ternary};
 use crate::sensor::camera::ClassTable;
 use crate::time::Stamp;
 
@@ -56,6 +56,43 @@ pub fn semantic_cells(grid: &FusionGrid, area: CellBox, classes: &ClassTable) ->
         }
     }
     SemanticCells { best, prob, probs, classes: k }
+}
+
+/// The least probability of its most likely class for a cell's class to be shown.
+pub const MIN_SHOWN_CLASS_PROBABILITY: f32 = 0.5;
+
+/// The most likely class of each cell of `cells` as a picture shows it (`semantic.png`),
+/// -1 where it is hidden: a class is shown only where it is confident (its probability at
+/// least [`MIN_SHOWN_CLASS_PROBABILITY`]) and agrees with the occupancy layer — an
+/// obstacle class (`p_occupied` above one half) on a cell the occupancy does not hold
+/// free, a floor-like class on one it does not hold occupied. The camera's labels land a
+/// cell or two off an edge and its depth smears them along the ray; without the mask, the
+/// floor in front of a glass fence showed as glass (most of 11,084 "glass" cells of the
+/// production line, against 401 true ones, were free, with a median class probability of
+/// 0.24).
+pub fn shown_classes(grid: &FusionGrid, cells: &SemanticCells, classes: &ClassTable) -> Vec<i16> {
+    let b = &cells.best;
+    b.cells
+        .iter()
+        .enumerate()
+        .map(|(i, &best)| {
+            if best < 0 || cells.prob[i] < MIN_SHOWN_CLASS_PROBABILITY {
+                return -1;
+            }
+            let cell = CellIndex::new(b.first_cell.x + (i % b.width) as i64, b.first_cell.y + (i / b.width) as i64);
+            let obstacle = classes.get(best as u8).p_occupied > 0.5;
+            let agrees = match grid.ternary(cell) {
+                Ternary::Free => !obstacle,
+                Ternary::Occupied => obstacle,
+                Ternary::Unknown => true,
+            };
+            if agrees {
+                best
+            } else {
+                -1
+            }
+        })
+        .collect()
 }
 
 /// The dynamic layer's probability over `area` at `now` (its evidence decayed with

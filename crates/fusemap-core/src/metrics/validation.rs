@@ -7,7 +7,8 @@
 //!   track, and its hit rate is the share that land on the map's obstacle cells. A map of
 //!   every sensor (M3) that a sensor's later observations hit less often than a map built
 //!   without some of the sensors (M1, M2) disagrees with that sensor: evidence was put in
-//!   the wrong place, which a mount or a clock does, not the fusion rule.
+//!   the wrong place, which a mount or a clock does, not the fusion rule. (A point hits
+//!   a map when it lands within one cell of an obstacle cell.)
 //! * **§5.1, entropy.** Otherwise fusion helps when M3's mean entropy is below the best
 //!   single-sensor map's by at least `min_gain_nats` (the document's rule of thumb: 0.05
 //!   nats indoors at 0.05 m with prior 0.5; entropy depends on the resolution, so the
@@ -21,8 +22,8 @@
 //! of travel with theirs, which a wrong lidar yaw turns by the error. So:
 //! * a lidar whose motion disagrees with the pose sensors by more than `mount_yaw_deg`
 //!   (and three standard errors) is the suspect;
-//! * else, the sensor whose later observations lose the most hit rate from its own map
-//!   (built from it alone) to M3, as a share of its own-map rate.
+//! * else, the sensor whose later observations lose the most hit rate from the map of its
+//!   own kind (M1 for a lidar, M2 for a camera) to M3, as a share of that rate.
 
 use super::MotionAgreement;
 use crate::config::Thresholds;
@@ -63,7 +64,8 @@ pub struct MapFigures {
     pub role: MapRole,
     /// The sensors whose observations built it.
     pub sensors: Vec<String>,
-    /// Mean binary entropy over the cells every map of the validation shares, nats.
+    /// Mean binary entropy over the cells any map of the validation observed (unknown
+    /// ones at the prior), nats.
     pub mean_entropy_nats: f64,
     /// Each held-out sensor's hit rate on it.
     pub hit_rates: Vec<SensorHits>,
@@ -190,7 +192,7 @@ pub fn judge(maps: &[MapFigures], motion: &[(String, MotionAgreement)], t: &Thre
             Verdict::FusionHelps,
             format!(
                 "fusion helps: the fused map's mean entropy is {g:.3} nats below the best single-sensor map's \
-                 (at least {:.2} asked), and every sensor's later observations agree with it",
+                 (at least {:.2} asked), and every sensor with enough later points agrees with it",
                 t.min_gain_nats
             ),
         ),
@@ -198,7 +200,7 @@ pub fn judge(maps: &[MapFigures], motion: &[(String, MotionAgreement)], t: &Thre
             Verdict::NoGain,
             format!(
                 "no clear gain: the fused map's mean entropy is {g:.3} nats below the best single-sensor map's, \
-                 under the {:.2} asked; the sensors agree with it, so check what each adds before adding more \
+                 under the {:.2} asked; the sensors with enough later points agree with it, so check what each adds before adding more \
                  (§4.3)",
                 t.min_gain_nats
             ),

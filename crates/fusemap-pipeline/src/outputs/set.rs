@@ -109,8 +109,13 @@ impl Outputs {
 /// Checks that no output would overwrite one of `inputs`, creates `dir`, takes its lock
 /// (a second run into it is refused while this one lives) and opens the set.
 pub fn prepare(dir: &Path, inputs: &[PathBuf]) -> Result<Outputs, OutputError> {
+    // Every name the set may write or remove at its commit, not only the map's files: a
+    // config passed as `--config out/calibration.toml` must survive a run into `out`.
     for f in OutputFiles::in_dir(dir).all() {
         ensure_not_input(f, inputs)?;
+    }
+    for name in OutputFiles::NAMES {
+        ensure_not_input(&dir.join(name), inputs)?;
     }
     let set = OutputSet::begin(dir).map_err(|source| OutputError::Directory { dir: dir.to_path_buf(), source })?;
     Ok(Outputs { files: OutputFiles::in_dir(set.staging()), set, owned: Vec::new() })

@@ -7,7 +7,7 @@ use super::set::{OutputFiles, Outputs};
 use super::summary::{CellsUpdated, MapInfo, Summary};
 use super::view::{view_of, ExportOptions, ExportRoom, MapView};
 use super::OutputError;
-use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells};
+use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells, shown_classes};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::grid::{CellBox, CellIndex, CellRaster, DynamicParams, FusionGrid, Raster};
@@ -44,6 +44,8 @@ pub struct RunRecord<'a> {
 pub struct Layers {
     /// The semantic layer.
     pub semantic: SemanticRaster,
+    /// Its most likely class per cell as the picture shows it (-1: hidden).
+    pub shown: Vec<i16>,
     /// The dynamic layer's probability at the run's last stamp.
     pub dynamic: CellRaster<f32>,
 }
@@ -69,6 +71,7 @@ pub fn layers_of(engine: &Engine, grid: &FusionGrid, raster: &Raster) -> Option<
         ),
     };
     let cells = semantic_cells(grid, area, classes);
+    let shown = shown_classes(grid, &cells, classes);
     let semantic = SemanticRaster {
         width: cells.best.width,
         height: cells.best.height,
@@ -81,7 +84,25 @@ pub fn layers_of(engine: &Engine, grid: &FusionGrid, raster: &Raster) -> Option<
     };
     let half_life = engine.dynamic_params().map_or(DynamicParams::default().half_life_s, |p| p.half_life_s);
     let dynamic = dynamic_cells(grid, area, engine.last_stamp().unwrap_or_default(), half_life);
-    Some(Layers { semantic, dynamic })
+    Some(Layers { semantic, shown, dynamic })
+}
+
+impl Layers {
+    /// The semantic layer as `semantic.png` shows it: each cell's class only where
+    /// [`shown_classes`] shows it (`map.npz` keeps the whole layer).
+    pub fn picture(&self) -> SemanticRaster {
+        let s = &self.semantic;
+        SemanticRaster {
+            width: s.width,
+            height: s.height,
+            resolution: s.resolution,
+            origin: s.origin,
+            classes: s.classes.clone(),
+            best: self.shown.clone(),
+            prob: s.prob.clone(),
+            probs: Vec::new(),
+        }
+    }
 }
 
 /// Writes the map files of `view` and the trajectory (when there is one) into the set,
@@ -107,7 +128,7 @@ pub fn write(
             Some(l) => {
                 let with = NpzLayers { semantic: Some(&l.semantic), dynamic: Some(&l.dynamic) };
                 fusemap_io::npz::write_map_npz_with(&files.npz, r, &with)?;
-                fusemap_io::semantic::write_semantic(&files.semantic, &l.semantic)?;
+                fusemap_io::semantic::write_semantic(&files.semantic, &l.picture())?;
                 fusemap_io::semantic::write_dynamic_png(&files.dynamic, &l.dynamic)?;
             }
             None => fusemap_io::npz::write_map_npz(&files.npz, r)?,

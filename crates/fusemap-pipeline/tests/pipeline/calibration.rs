@@ -76,10 +76,11 @@ fn finds_a_lidar_clock_running_late() {
 }
 
 /// The figure, not met: every interval contains the truth. Measured (2026-12-06):
-/// with the right mount, x 0.2425 m (0.2392 .. 0.2464) and yaw −0.050° (−0.090 .. −0.012)
-/// miss (0.25, 0°) by 0.3 mm and 0.012°; with the wrong one, y −0.0055 m (−0.0097 ..
-/// −0.0015) misses 0 by 1.5 mm. The estimates are within 1 cm and 0.2°; their intervals
-/// are too narrow by a bias of a few millimetres the fit does not model.
+/// with the right mount, x 0.2429 m (0.2393 .. 0.2473) misses 0.25 by 0.3 mm and yaw
+/// −0.048° (−0.086 .. −0.006) misses 0° by 0.006°; with the wrong one, y −0.0057 m
+/// (−0.0099 .. −0.0021) misses 0 by 2 mm and yaw 0.043° (0.007 .. 0.089) misses 0° by
+/// 0.007°. The estimates are within 1 cm and 0.2°; the intervals are too narrow by a bias
+/// of a few millimetres the fit does not model.
 #[test]
 #[ignore = "not met: some intervals miss the truth by millimetres (see the doc comment)"]
 fn every_interval_contains_the_true_mount() {
