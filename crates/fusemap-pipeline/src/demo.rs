@@ -205,12 +205,16 @@ pub fn scores_table(scores: &[MapScore], plan: &Plan) -> String {
     use std::fmt::Write;
     let mut t = String::new();
     t.push_str("scores against the simulator's ground truth (1-cell tolerance):\n");
-    t.push_str("  map      F1 occ  glass  backlit  pillar free  machine free  person  classes  wall  glass  pillar\n");
+    t.push_str(
+        "  map      F1 occ  glass  backlit  pillar free  machine free  person  classes  wall  glass  pillar  \
+         shown glass (precision)\n",
+    );
     for s in scores {
         let acc = |n: &str| s.semantic_of(&plan.classes, n).map_or("   -".to_string(), |a| format!("{a:.2}"));
+        let glass = s.class_precision.get("glass").and_then(|p| Some(format!("{} ({:.2})", p.shown, p.precision?)));
         let _ = writeln!(
             t,
-            "  {:<7}  {:>6.3}  {:>5.2}  {:>7}  {:>11.3}  {:>12.3}  {:>6}  {:>7}  {:>4}  {:>5}  {:>6}",
+            "  {:<7}  {:>6.3}  {:>5.2}  {:>7}  {:>11.3}  {:>12.3}  {:>6}  {:>7}  {:>4}  {:>5}  {:>6}  {}",
             s.name,
             s.occupied.f1,
             s.glass_occupied_share,
@@ -222,6 +226,7 @@ pub fn scores_table(scores: &[MapScore], plan: &Plan) -> String {
             acc("wall"),
             acc("glass"),
             acc("pillar"),
+            glass.unwrap_or_else(|| "-".into()),
         );
     }
     t

@@ -10,7 +10,7 @@
 
 use crate::PipelineError;
 use fusemap_core::config::Plan;
-use fusemap_core::fusion::rasters::semantic_cells;
+use fusemap_core::fusion::rasters::{semantic_cells, shown_classes};
 use fusemap_core::fusion::{MapSet, SensorSelection};
 use fusemap_core::geometry::Point2;
 use fusemap_core::grid::{CellBox, CellIndex, FusionGrid, Ternary};
@@ -20,7 +20,7 @@ use fusemap_core::sensor::camera::ClassTable;
 use fusemap_core::time::Stamp;
 use fusemap_sim::{TruthRaster, TruthSemantic};
 use serde::Serialize;
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 
 /// The mapping configuration of the production line (`configs/production_line.toml`, a
@@ -83,6 +83,23 @@ pub struct MapScore {
     /// Cells along the person's walk the map holds as occupied, away from any true
     /// obstacle.
     pub person_static_cells: usize,
+    /// Per class name, of the cells the semantic picture shows as that class
+    /// ([`shown_classes`]), how many there are and the share that truly are it (within one
+    /// cell for an obstacle class, in the cell itself for a floor-like one; unlabelled
+    /// truth is floor). Accuracy asks whether true obstacles carry the right class;
+    /// precision asks whether what the picture shows is there.
+    pub class_precision: BTreeMap<String, ClassPrecision>,
+}
+
+/// One class's precision in the semantic picture.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct ClassPrecision {
+    /// Cells shown as the class.
+    pub shown: usize,
+    /// Of them, those that truly are it.
+    pub correct: usize,
+    /// `correct / shown`; `None` when none is shown.
+    pub precision: Option<f64>,
 }
 
 impl MapScore {
@@ -141,7 +158,34 @@ pub fn score(name: &str, grid: &FusionGrid, classes: &ClassTable, truth: &Truth)
         pillar_body_free_share: free_share(&truth.semantic.pillar_body_cells),
         machine_body_free_share: free_share(&truth.semantic.machine_body_cells),
         person_static_cells,
+        class_precision: class_precision(grid, classes, truth),
     }
+}
+
+/// [`MapScore::class_precision`] of `grid`.
+fn class_precision(grid: &FusionGrid, classes: &ClassTable, truth: &Truth) -> BTreeMap<String, ClassPrecision> {
+    let mut out: BTreeMap<String, ClassPrecision> = BTreeMap::new();
+    let Some(b) = grid.known_box() else { return out };
+    let cells = semantic_cells(grid, b, classes);
+    let shown = shown_classes(grid, &cells, classes);
+    let floor = classes.index_by_name("floor").map(|i| classes.get(i).id);
+    let true_id = |c: CellIndex| match truth.semantic.class_at(c) {
+        0 => floor,
+        k => Some(u16::from(k)),
+    };
+    let w = cells.best.width;
+    for (i, &k) in shown.iter().enumerate().filter(|(_, &k)| k >= 0) {
+        let c = CellIndex::new(cells.best.first_cell.x + (i % w) as i64, cells.best.first_cell.y + (i / w) as i64);
+        let spec = classes.get(k as u8);
+        let reach = if spec.p_occupied > 0.5 { 1 } else { 0 };
+        let e = out.entry(spec.name.clone()).or_default();
+        e.shown += 1;
+        e.correct += usize::from(neighbours(c, reach).any(|n| true_id(n) == Some(spec.id)));
+    }
+    for e in out.values_mut() {
+        e.precision = (e.shown > 0).then(|| e.correct as f64 / e.shown as f64);
+    }
+    out
 }
 
 /// The class each occupied cell of the map holds (what the semantic scores compare with
