@@ -58,7 +58,11 @@ fn with_scan_poses(samples: Vec<(Stamp, Pose2)>, placed: Vec<(Stamp, Pose2)>) ->
 
 /// The cameras to map: the configured ones, else a default camera when the log carries
 /// the usual camera topics (and the camera kind is not disabled).
-fn planned_cameras(plan: &Plan, inv: &Inventory, notes: &mut Vec<String>) -> Result<Vec<PlannedCamera>, PipelineError> {
+pub(crate) fn planned_cameras(
+    plan: &Plan,
+    inv: &Inventory,
+    notes: &mut Vec<String>,
+) -> Result<Vec<PlannedCamera>, PipelineError> {
     if !plan.cameras.is_empty() || plan.disabled_kinds.contains(&SensorKind::Camera) {
         return Ok(plan.cameras.clone());
     }

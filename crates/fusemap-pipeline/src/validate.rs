@@ -67,7 +67,8 @@ pub struct HeldOutSensor {
 pub struct Validation {
     /// The share of the log held out.
     pub holdout_share: f64,
-    /// The maps built, M1, M2, M3 in that order (those the log allows).
+    /// The maps built, M1, M2, M3 in that order (those the log allows), then with more
+    /// than two sensors making the map, one map without each (`without NAME`).
     pub maps: Vec<MapFigures>,
     /// The maps that could not be built, each with why.
     pub not_built: Vec<String>,
@@ -142,12 +143,25 @@ pub struct ValidateRun {
 }
 
 /// The maps of the pass: M3 first (the primary, written as the run's map), then M1, M2.
-fn validation_maps(plan: &Plan) -> MapSet {
+fn validation_maps(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<MapSet, PipelineError> {
     let grid = || FusionGrid::new(plan.geometry, plan.occupancy);
-    MapSet::new("m3", SensorSelection::All, grid())
+    let mut maps = MapSet::new("m3", SensorSelection::All, grid())
         .with("m1", SensorSelection::Kinds(vec![SensorKind::Lidar]), grid())
-        .with("m2", SensorSelection::Kinds(vec![SensorKind::Camera]), grid())
+        .with("m2", SensorSelection::Kinds(vec![SensorKind::Camera]), grid());
+    // §4.3's leave-one-out maps, when more than two sensors make the map.
+    let cameras = crate::map_pass::planned_cameras(plan, inv, &mut Vec::new())?;
+    let names: Vec<String> =
+        bound.lidars.iter().map(|b| b.lidar.name.clone()).chain(cameras.into_iter().map(|c| c.name)).collect();
+    if names.len() > 2 {
+        for n in names {
+            maps.add(format!("{LEFT_OUT}{n}"), SensorSelection::without(vec![n]), grid());
+        }
+    }
+    Ok(maps)
 }
+
+/// The name of the map without sensor `x` is this followed by `x`.
+const LEFT_OUT: &str = "without ";
 
 impl ValidateJob {
     /// `fusemap validate [--config C] --out DIR LOG`.
@@ -174,7 +188,8 @@ impl ValidateJob {
         let raw_at_scans = raw_at_scans(&raw, &inv, &bound);
         let (chosen, track_s) = crate::run::correct(plan, &inv, &bound, raw, track_s, progress).map_err(named)?;
         let motion = lidar_motion(&bound, &chosen, &raw_at_scans);
-        let maps = PassMaps { set: Some(validation_maps(plan)), holdout_share: Some(plan.holdout_share) };
+        let set = validation_maps(plan, &inv, &bound).map_err(named)?;
+        let maps = PassMaps { set: Some(set), holdout_share: Some(plan.holdout_share) };
         let run = crate::map_with_track(plan, &inv, &bound, chosen, track_s, maps, progress).map_err(named)?;
         let (validation, rasters) = validate(&run.engine, plan, motion).map_err(named)?;
         write_validate_npz(&outputs.staged(VALIDATE_NPZ), &validation, &rasters, plan)?;
@@ -263,6 +278,7 @@ fn validate(
             hit_rates: hit_rates(&held, &all, grid),
         });
     }
+    figures.extend(left_out(engine, area, &shared, &held, &all));
     let entropy_cells = shared.iter().filter(|&&s| s).count() as u64;
     let held_out = all
         .iter()
@@ -306,6 +322,26 @@ fn validate(
     Ok((validation, rasters))
 }
 
+/// The figures of the leave-one-out maps, over the same cells as M1, M2 and M3 (M3 knows
+/// every cell they know).
+fn left_out(
+    engine: &Engine,
+    area: CellBox,
+    shared: &[bool],
+    held: &HeldOut,
+    all: &[(SensorId, String, SensorKind)],
+) -> Vec<MapFigures> {
+    let maps = engine.maps().iter().filter(|m| m.name().starts_with(LEFT_OUT));
+    maps.map(|m| MapFigures {
+        name: m.name().to_string(),
+        role: MapRole::LeftOut,
+        sensors: all.iter().filter(|(id, _, kind)| m.sensors().includes(*id, *kind)).map(|s| s.1.clone()).collect(),
+        mean_entropy_nats: entropy_where(&m.grid().raster(area), shared).map_or(f64::NAN, |e| e.0),
+        hit_rates: hit_rates(held, all, m.grid()),
+    })
+    .collect()
+}
+
 /// Where the fusion gain comes from (see [`Validation::gain_split`]).
 #[derive(Clone, Debug, Serialize)]
 pub struct GainSplit {
@@ -329,7 +365,7 @@ pub struct GainSplit {
 fn gain_split(figures: &[MapFigures], rasters: &[Option<Raster>], shared: &[bool]) -> Option<GainSplit> {
     let best = figures
         .iter()
-        .filter(|m| m.role != MapRole::Fused)
+        .filter(|m| matches!(m.role, MapRole::Lidar | MapRole::Camera))
         .min_by(|a, b| a.mean_entropy_nats.total_cmp(&b.mean_entropy_nats))?;
     let slot = match best.role {
         MapRole::Lidar => 0,
@@ -367,7 +403,7 @@ fn missing(role: &MapRole) -> &'static str {
             "no camera is mapped (the log has none, or its streams are unusable: see the notes), so the camera's \
              map and its hit rates are left out"
         }
-        MapRole::Fused => "no sensor is mapped",
+        MapRole::Fused | MapRole::LeftOut => "no sensor is mapped",
     }
 }
 

@@ -281,7 +281,9 @@ impl Engine {
     /// Registers a sensor with its model and returns its id.
     pub fn add_sensor(&mut self, name: impl Into<String>, model: SensorModel) -> SensorId {
         let id = SensorId(self.sensors.len() as u16);
-        self.sensors.push(SensorSlot::new(name.into(), model));
+        let name = name.into();
+        self.maps.register(id, &name);
+        self.sensors.push(SensorSlot::new(name, model));
         self.apply_budget();
         id
     }

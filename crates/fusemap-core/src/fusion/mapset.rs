@@ -21,6 +21,15 @@ pub enum SensorSelection {
     Kinds(Vec<SensorKind>),
     /// Exactly these sensors.
     Sensors(Vec<SensorId>),
+    /// Every sensor but those named (a lidar's name also leaves out the sensors of its
+    /// other frames, `name@frame`): §4.3's leave-one-out maps, chosen before the sensors
+    /// have ids. `ids` is filled as the engine registers the named sensors.
+    Without {
+        /// The sensors left out, by name.
+        names: Vec<String>,
+        /// Their ids, once registered.
+        ids: Vec<SensorId>,
+    },
 }
 
 impl SensorSelection {
@@ -31,6 +40,22 @@ impl SensorSelection {
             SensorSelection::All => true,
             SensorSelection::Kinds(k) => k.contains(&kind),
             SensorSelection::Sensors(s) => s.contains(&sensor),
+            SensorSelection::Without { ids, .. } => !ids.contains(&sensor),
+        }
+    }
+
+    /// Every sensor but those named `names` (see [`SensorSelection::Without`]).
+    pub fn without(names: Vec<String>) -> Self {
+        SensorSelection::Without { names, ids: Vec::new() }
+    }
+
+    /// Notes that the sensor `name` was registered as `sensor`.
+    fn register(&mut self, sensor: SensorId, name: &str) {
+        if let SensorSelection::Without { names, ids } = self {
+            let named = |n: &String| name == n || name.strip_prefix(n.as_str()).is_some_and(|r| r.starts_with('@'));
+            if names.iter().any(named) {
+                ids.push(sensor);
+            }
         }
     }
 }
@@ -154,6 +179,13 @@ impl MapSet {
     }
 
     /// All maps, primary first, writable.
+    /// Notes in every map's selection that the sensor `name` was registered as `sensor`.
+    pub(super) fn register(&mut self, sensor: SensorId, name: &str) {
+        for m in self.entries_mut() {
+            m.sensors.register(sensor, name);
+        }
+    }
+
     pub(super) fn entries_mut(&mut self) -> impl Iterator<Item = &mut MapEntry> {
         std::iter::once(&mut self.primary).chain(&mut self.others)
     }
@@ -215,6 +247,23 @@ impl MapSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_leave_one_out_selection_learns_its_ids_by_name() {
+        let grid = || FusionGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
+        let mut maps = MapSet::new("all", SensorSelection::All, grid()).with(
+            "without laser",
+            SensorSelection::without(vec!["laser".into()]),
+            grid(),
+        );
+        for (i, name) in ["laser", "laser@rear", "laser2", "camera"].iter().enumerate() {
+            maps.register(SensorId(i as u16), name);
+        }
+        let m = maps.by_name("without laser").unwrap().sensors();
+        let taken: Vec<bool> = (0..4).map(|i| m.includes(SensorId(i), SensorKind::Lidar)).collect();
+        assert_eq!(taken, [false, false, true, true]);
+        assert!(maps.primary().sensors().includes(SensorId(0), SensorKind::Lidar));
+    }
     use crate::fusion::{Engine, SensorModel};
     use crate::geometry::{PlanarMount, Pose2};
     use crate::grid::{GridGeometry, OccupancyParams, TileKey, TILE_CELLS};

@@ -41,6 +41,9 @@ pub enum MapRole {
     Camera,
     /// M3: every sensor.
     Fused,
+    /// Every sensor but one (§4.3's leave-one-out, built when more than two sensors make
+    /// the map); reported, not judged.
+    LeftOut,
 }
 
 /// One sensor's held-out observations against one map.
@@ -110,6 +113,7 @@ fn rate_on(maps: &[MapFigures], role: &MapRole, sensor: &str, min_endpoints: u64
 
 /// The map built from a sensor's kind alone.
 fn own_role(kind: SensorKind) -> MapRole {
+    // (A map without one sensor is never a sensor's own.)
     match kind {
         SensorKind::Lidar => MapRole::Lidar,
         SensorKind::Camera => MapRole::Camera,
@@ -138,7 +142,8 @@ pub fn judge(maps: &[MapFigures], motion: &[(String, MotionAgreement)], t: &Thre
             sentence: "no fused map was built: nothing to judge".into(),
         };
     };
-    let singles: Vec<&MapFigures> = maps.iter().filter(|m| m.role != MapRole::Fused).collect();
+    let singles: Vec<&MapFigures> =
+        maps.iter().filter(|m| matches!(m.role, MapRole::Lidar | MapRole::Camera)).collect();
     let mut drops = Vec::new();
     for h in &fused.hit_rates {
         let own = rate_on(maps, &own_role(h.kind), &h.sensor, t.min_endpoints);
