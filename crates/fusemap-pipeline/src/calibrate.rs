@@ -10,7 +10,7 @@
 //! a timed track and a wheel-odometry topic; without them it says so. The camera's mount
 //! and clock offset are not estimated yet, and the report says that too.
 
-use crate::job::{plan_of, JobError};
+use crate::job::{JobError, LogJob};
 use crate::outputs::{finish, prepare, ExportOptions, RunRecord};
 use crate::recording::Inventory;
 use crate::sensors::Bound;
@@ -22,7 +22,7 @@ use fusemap_core::geometry::{Mount3, Pose2};
 use fusemap_core::time::{Stamp, SyncMode};
 use serde::Serialize;
 use std::fmt::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// The file of ready-to-paste `[[sensor]]` tables.
@@ -37,14 +37,8 @@ const MAX_LEVER_INTERVAL_M: f64 = 0.05;
 
 /// A calibration, planned.
 pub struct CalibrateJob {
-    /// The validated configuration.
-    pub plan: Plan,
-    /// The log.
-    pub log: PathBuf,
-    /// The output directory.
-    pub out: PathBuf,
-    /// The files the run reads.
-    pub inputs: Vec<PathBuf>,
+    /// The configuration, the log and the output directory.
+    pub job: LogJob,
 }
 
 /// One sensor's estimates (`summary.json`'s `calibration.sensors[]`).
@@ -97,24 +91,18 @@ pub struct CalibrateRun {
 impl CalibrateJob {
     /// `fusemap calibrate [--config C] --out DIR LOG`.
     pub fn plan(config: Option<&Path>, log: &Path, out: &Path) -> Result<Self, JobError> {
-        let plan = plan_of(config)?;
-        let inputs = config.map(Path::to_path_buf).into_iter().chain([log.to_path_buf()]).collect();
-        Ok(Self { plan, log: log.to_path_buf(), out: out.to_path_buf(), inputs })
+        Ok(Self { job: LogJob::plan(config, log, out)? })
     }
 
     /// Estimates, maps with the configuration as given, and writes the set: the map's
     /// files, `calibration.toml` and `summary.json` with its `calibration`.
     pub fn run(self, progress: &mut dyn FnMut(Progress)) -> Result<CalibrateRun, JobError> {
         let started = Instant::now();
-        let (plan, input) = (&self.plan, self.log.display().to_string());
-        let outputs = prepare(&self.out, &self.inputs)?;
-        let named = |error: PipelineError| match error {
-            PipelineError::Read(e) => JobError::File(e),
-            error => JobError::Run { input: input.clone(), error },
-        };
-        progress(Progress::Phase { name: "reading", total: 0 });
-        let inv = Inventory::read_with(&self.log, &plan.limits).map_err(JobError::File)?;
-        progress(Progress::Done);
+        let job = &self.job;
+        let (plan, input) = (&job.plan, job.log.display().to_string());
+        let outputs = prepare(&job.out, &job.inputs)?;
+        let named = |e| job.named(e);
+        let inv = job.read(progress)?;
         let (bound, raw, track_s) = crate::run::prepare_track(plan, &inv).map_err(named)?;
         let (chosen, track_s) = crate::run::correct(plan, &inv, &bound, raw, track_s, progress).map_err(named)?;
         let (estimate, mut undetermined) = lidar_against_odometry(plan, &inv, &bound, &chosen).map_err(named)?;

@@ -77,6 +77,45 @@ pub fn plan_of_or(config: Option<&Path>, default: impl FnOnce() -> Result<Plan, 
     }
 }
 
+/// A command over one log (`validate`, `calibrate`), planned: the configuration read and
+/// checked, the log and the output directory, and the files no output may replace.
+pub struct LogJob {
+    /// The validated configuration.
+    pub plan: Plan,
+    /// The log.
+    pub log: PathBuf,
+    /// The output directory.
+    pub out: PathBuf,
+    /// The files the run reads (the configuration, the log).
+    pub inputs: Vec<PathBuf>,
+}
+
+impl LogJob {
+    /// `fusemap CMD [--config C] --out DIR LOG`.
+    pub fn plan(config: Option<&Path>, log: &Path, out: &Path) -> Result<Self, JobError> {
+        let plan = plan_of(config)?;
+        let inputs = config.map(Path::to_path_buf).into_iter().chain([log.to_path_buf()]).collect();
+        Ok(Self { plan, log: log.to_path_buf(), out: out.to_path_buf(), inputs })
+    }
+
+    /// A pipeline error as the job reports it: a reader's names its file already, the
+    /// others get the log's name.
+    pub(crate) fn named(&self, error: PipelineError) -> JobError {
+        match error {
+            PipelineError::Read(e) => JobError::File(e),
+            error => JobError::Run { input: self.log.display().to_string(), error },
+        }
+    }
+
+    /// The first pass over the log.
+    pub(crate) fn read(&self, progress: &mut dyn FnMut(Progress)) -> Result<crate::recording::Inventory, JobError> {
+        progress(Progress::Phase { name: "reading", total: 0 });
+        let inv = crate::recording::Inventory::read_with(&self.log, &self.plan.limits).map_err(JobError::File)?;
+        progress(Progress::Done);
+        Ok(inv)
+    }
+}
+
 /// What a map run maps.
 pub enum MapSource {
     /// A robot log (CARMEN, ROS 1 bag, MCAP, rosbag2 directory), recognised by its content.

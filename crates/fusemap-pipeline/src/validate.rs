@@ -12,7 +12,7 @@
 //! Pose sensors (odometry, IMU, GNSS) place every map's evidence and are in every map: to
 //! leave one out would need a second track, which this pass does not build.
 
-use crate::job::{plan_of, JobError};
+use crate::job::{JobError, LogJob};
 use crate::outputs::{finish, prepare, ExportOptions, RunRecord, Summary};
 use crate::recording::Inventory;
 use crate::sensors::Bound;
@@ -31,7 +31,7 @@ use fusemap_core::metrics::{
 use fusemap_core::time::{Stamp, SyncMode};
 use fusemap_io::npz::{NpyArray, NpyData};
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// The validation file's name in the output directory.
@@ -39,14 +39,8 @@ pub const VALIDATE_NPZ: &str = "fusion_validate.npz";
 
 /// A validation, planned.
 pub struct ValidateJob {
-    /// The validated configuration (its `[validate]` table).
-    pub plan: Plan,
-    /// The log.
-    pub log: PathBuf,
-    /// The output directory.
-    pub out: PathBuf,
-    /// The files the run reads: no output may replace one.
-    pub inputs: Vec<PathBuf>,
+    /// The configuration, the log and the output directory.
+    pub job: LogJob,
 }
 
 /// One held-out sensor.
@@ -166,24 +160,18 @@ const LEFT_OUT: &str = "without ";
 impl ValidateJob {
     /// `fusemap validate [--config C] --out DIR LOG`.
     pub fn plan(config: Option<&Path>, log: &Path, out: &Path) -> Result<Self, JobError> {
-        let plan = plan_of(config)?;
-        let inputs = config.map(Path::to_path_buf).into_iter().chain([log.to_path_buf()]).collect();
-        Ok(Self { plan, log: log.to_path_buf(), out: out.to_path_buf(), inputs })
+        Ok(Self { job: LogJob::plan(config, log, out)? })
     }
 
     /// Maps, validates and writes the set: the fused map's files, `fusion_validate.npz`
     /// and `summary.json` with its `validation`.
     pub fn run(self, progress: &mut dyn FnMut(Progress)) -> Result<ValidateRun, JobError> {
         let started = Instant::now();
-        let (plan, input) = (&self.plan, self.log.display().to_string());
-        let outputs = prepare(&self.out, &self.inputs)?;
-        let named = |error: PipelineError| match error {
-            PipelineError::Read(e) => JobError::File(e),
-            error => JobError::Run { input: input.clone(), error },
-        };
-        progress(Progress::Phase { name: "reading", total: 0 });
-        let inv = crate::recording::Inventory::read_with(&self.log, &plan.limits).map_err(JobError::File)?;
-        progress(Progress::Done);
+        let job = &self.job;
+        let (plan, input) = (&job.plan, job.log.display().to_string());
+        let outputs = prepare(&job.out, &job.inputs)?;
+        let named = |e| job.named(e);
+        let inv = job.read(progress)?;
         let (bound, raw, track_s) = crate::run::prepare_track(plan, &inv).map_err(named)?;
         let raw_at_scans = raw_at_scans(&raw, &inv, &bound);
         let (chosen, track_s) = crate::run::correct(plan, &inv, &bound, raw, track_s, progress).map_err(named)?;
