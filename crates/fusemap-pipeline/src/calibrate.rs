@@ -63,6 +63,9 @@ pub struct SensorCalibration {
     /// Odometry distance / true distance (the wheel odometry).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub scale: Option<Interval>,
+    /// The true wheel base as a multiple of the one the odometry assumes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wheel_base: Option<Interval>,
     /// The residual RMS of the motion equations before, metres.
     pub cost_before: f64,
     /// … and after.
@@ -338,6 +341,7 @@ fn sensors_of(
         yaw: Some(yaw),
         time_offset_s: est.clock,
         scale: None,
+        wheel_base: None,
         cost_before: e.cost_before_m,
         cost_after: e.cost_after_m,
         steps: [e.steps, e.turning_steps],
@@ -350,6 +354,7 @@ fn sensors_of(
         yaw: None,
         time_offset_s: None,
         scale: Some(e.scale),
+        wheel_base: e.wheel_base,
         ..base.clone()
     };
     vec![base, wheels]
@@ -408,5 +413,12 @@ fn calibration_toml(log: &str, est: &Estimate, name: &str, topic: &str, m: &Moun
         e.scale.low,
         e.scale.high
     );
+    if let Some(b) = e.wheel_base {
+        let _ = writeln!(
+            s,
+            "# Its true wheel base is {:.4} × the one it assumes (95 %: {:.4} .. {:.4}).",
+            b.value, b.low, b.high
+        );
+    }
     s
 }

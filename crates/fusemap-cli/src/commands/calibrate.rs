@@ -36,6 +36,7 @@ pub fn table(c: &Calibration) -> String {
             ("yaw", &e.yaw, "°", 180.0 / std::f64::consts::PI, 3),
             ("scale", &e.scale, "×", 1.0, 4),
             ("time_offset_s", &e.time_offset_s, "s", 1.0, 4),
+            ("wheel_base", &e.wheel_base, "× assumed", 1.0, 4),
         ] {
             if let Some(i) = v {
                 let _ = writeln!(s, "calibrated    {name} {k} {}", show(i, unit, f, d));

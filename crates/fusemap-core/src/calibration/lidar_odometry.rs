@@ -39,6 +39,11 @@ pub struct LidarOdometry {
     pub lever: Option<[Interval; 2]>,
     /// Odometry distance / true distance.
     pub scale: Interval,
+    /// The wheel base the odometry should assume, as a multiple of the one it does: with
+    /// both wheels' distances scaled by ρ and the base wrong, its turns are scaled by
+    /// κ = ρ · true base / assumed base, so this is κ / ρ (κ from [`turn_agreement`] over
+    /// the steps that turn). `None` with fewer than 10 turning steps.
+    pub wheel_base: Option<Interval>,
     /// Residual RMS of the step equations with no correction (Δ = identity, ρ = 1), metres.
     pub cost_before_m: f64,
     /// … and with the estimate.
@@ -230,9 +235,36 @@ pub fn lidar_odometry(steps: &[MotionStep], max_lever_interval_m: f64) -> Option
         yaw: Interval::of(normalize_angle(p[0]), sigma[0]),
         lever: determined.then_some(lever),
         scale: Interval::of(p[1], sigma[1]),
+        wheel_base: wheel_base(steps, p[1], sigma[1]),
         cost_before_m: rms(&[1.0, 0.0, 0.0, 0.0]),
         cost_after_m: rms(&u),
     })
+}
+
+/// Steps turning more than this count for the wheel base, radians.
+const TURNING_RAD: f64 = 0.087;
+
+/// [`LidarOdometry::wheel_base`]: κ over the turning steps, its standard error by a
+/// delete-a-block jackknife, divided by the scale ρ (its error added in quadrature).
+fn wheel_base(steps: &[MotionStep], rho: f64, sigma_rho: f64) -> Option<Interval> {
+    let turning: Vec<MotionStep> = steps.iter().copied().filter(|s| s.lidar.theta.abs() > TURNING_RAD).collect();
+    let (kappa, _, n) = turn_agreement(&turning)?;
+    let k = JACKKNIFE_BLOCKS;
+    let reduced: Vec<f64> = (0..k)
+        .filter_map(|b| {
+            let kept: Vec<MotionStep> =
+                turning[..b * n / k].iter().chain(&turning[(b + 1) * n / k..]).copied().collect();
+            turn_agreement(&kept).map(|t| t.0)
+        })
+        .collect();
+    if reduced.len() < k {
+        return None;
+    }
+    let mean = reduced.iter().sum::<f64>() / k as f64;
+    let sigma_kappa = ((k - 1) as f64 / k as f64 * reduced.iter().map(|v| (v - mean).powi(2)).sum::<f64>()).sqrt();
+    let ratio = kappa / rho;
+    let sigma = ratio * ((sigma_kappa / kappa).powi(2) + (sigma_rho / rho).powi(2)).sqrt();
+    Some(Interval::of(ratio, sigma))
 }
 
 /// How the odometry's turning agrees with SLAM's: `κ`, the least-squares ratio of the
@@ -314,6 +346,9 @@ mod tests {
             let lever = c.lever.unwrap();
             prop_assert!((lever[0].value - x).abs() < 1e-6 && (lever[1].value - y).abs() < 1e-6, "{c:?}");
             prop_assert!(c.cost_after_m <= c.cost_before_m);
+            // Turns untouched while distances scale: the odometry assumes a base `scale`
+            // times too large for its wheels: the true base is 1 / scale of the one assumed.
+            prop_assert!((c.wheel_base.unwrap().value - 1.0 / scale).abs() < 1e-6, "{c:?}");
         }
     }
 

@@ -1,6 +1,6 @@
 //! `fusemap calibrate` on the production line with its ground truth: the lidar's mount
-//! (5 cm and 2° off in the configuration) and the wheel odometry's scale (the simulator's
-//! 3 % error) from the lidar's motion against the wheels', and the lidar's clock offset
+//! (5 cm and 2° off in the configuration), the wheel odometry's scale (the simulator's
+//! 3 % error) and wheel base (right) from the lidar's motion against the wheels', and the lidar's clock offset
 //! (a bag whose lidar stamps run 40 ms late).
 
 use crate::validation::{bag, config};
@@ -51,6 +51,9 @@ fn finds_the_lidar_mount_and_the_odometry_scale() {
     let truth = Scenario::default().odometry.scale_error;
     assert!((scale.value / truth - 1.0).abs() < 0.003, "{scale:?} against {truth}");
     assert!(scale.contains(truth), "{scale:?} against {truth}");
+    // The simulator's wheels are where the odometry assumes them.
+    let base = get(&c, "wheel_odometry", |s| s.wheel_base);
+    assert!(base.contains(1.0) && (base.value - 1.0).abs() < 0.005, "{base:?}");
     // Nothing was left late: the lidar's clock agrees with the odometry's.
     let clock = get(&c, "lidar", |s| s.time_offset_s);
     assert!(clock.contains(0.0), "{clock:?}");
