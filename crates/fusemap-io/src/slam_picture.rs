@@ -108,7 +108,9 @@ pub fn write_pose_graph_png(
         if finite(&w[0]) && finite(&w[1]) {
             let (a, b) = (to_px(w[0]), to_px(w[1]));
             canvas.line(a, b, TRAJECTORY, 1.0);
-            canvas.line((a.0 + 1, a.1), (b.0 + 1, b.1), TRAJECTORY, 1.0);
+            // The second pixel across the segment: below a flat one, beside a steep one.
+            let (dx, dy) = if (b.0 - a.0).abs() > (b.1 - a.1).abs() { (0, 1) } else { (1, 0) };
+            canvas.line((a.0 + dx, a.1 + dy), (b.0 + dx, b.1 + dy), TRAJECTORY, 1.0);
         }
     }
     write_atomic(path, |w| {

@@ -3,7 +3,7 @@
 //! where the log cannot fix it.
 //!
 //! This version estimates the lidar's planar mount (yaw, x, y) and the wheel odometry's
-//! scale from the two tracks of one robot: SLAM's, which follows the lidar through its
+//! scale and wheel base from the two tracks of one robot: SLAM's, which follows the lidar through its
 //! configured mount, and the wheels' ([`fusemap_core::calibration::lidar_odometry`],
 //! after Censi et al. 2013), and the lidar's clock offset against the odometry from when
 //! their turns line up ([`fusemap_core::calibration::turn_agreement`]). It needs SLAM on

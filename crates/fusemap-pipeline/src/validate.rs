@@ -1,5 +1,7 @@
 //! `fusemap validate`, planned and run: the design document's validation (§5) for any
-//! sensor set, in one pass over the log.
+//! sensor set, in one pass over the log. (With more than two sensors making the map, the
+//! same pass also builds one map without each, §4.3: reported, not judged; they share
+//! `[limits]`' budget with M1, M2 and M3.)
 //!
 //! The pose track is built as `map` builds it (the estimator, SLAM). One mapping pass
 //! then feeds three maps from the log's earlier part: M1 (the lidars), M2 (the cameras) and
@@ -136,7 +138,8 @@ pub struct ValidateRun {
     pub validation: Validation,
 }
 
-/// The maps of the pass: M3 first (the primary, written as the run's map), then M1, M2.
+/// The maps of the pass: M3 first (the primary, written as the run's map), then M1, M2,
+/// then the leave-one-out maps.
 fn validation_maps(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<MapSet, PipelineError> {
     let grid = || FusionGrid::new(plan.geometry, plan.occupancy);
     let mut maps = MapSet::new("m3", SensorSelection::All, grid())
@@ -319,7 +322,10 @@ fn left_out(
     held: &HeldOut,
     all: &[(SensorId, String, SensorKind)],
 ) -> Vec<MapFigures> {
-    let maps = engine.maps().iter().filter(|m| m.name().starts_with(LEFT_OUT));
+    // A sensor the pass did not map (a camera left out with a note) never got an id: its
+    // map is M3 again, and not reported.
+    let unmapped = |m: &&fusemap_core::fusion::MapEntry| matches!(m.sensors(), SensorSelection::Without { ids, .. } if ids.is_empty());
+    let maps = engine.maps().iter().filter(|m| m.name().starts_with(LEFT_OUT)).filter(|m| !unmapped(m));
     maps.map(|m| MapFigures {
         name: m.name().to_string(),
         role: MapRole::LeftOut,

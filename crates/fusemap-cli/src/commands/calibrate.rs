@@ -1,4 +1,4 @@
-//! `fusemap calibrate`: the lidar's mount and clock offset and the wheel odometry's scale estimated from the
+//! `fusemap calibrate`: the lidar's mount and clock offset and the wheel odometry's scale and wheel base estimated from the
 //! log, with 95 % intervals, and what it cannot determine. The job is the library's
 //! ([`fusemap_pipeline::calibrate`]); this prints its table.
 

@@ -42,7 +42,8 @@ pub struct LidarOdometry {
     /// The wheel base the odometry should assume, as a multiple of the one it does: with
     /// both wheels' distances scaled by ρ and the base wrong, its turns are scaled by
     /// κ = ρ · true base / assumed base, so this is κ / ρ (κ from [`turn_agreement`] over
-    /// the steps that turn). `None` with fewer than 10 turning steps.
+    /// the steps that turn). `None` with fewer than 12 turning steps (each jackknife subset
+    /// needs 10), or when the odometry does not turn the way SLAM does.
     pub wheel_base: Option<Interval>,
     /// Residual RMS of the step equations with no correction (Δ = identity, ρ = 1), metres.
     pub cost_before_m: f64,
@@ -262,9 +263,12 @@ fn wheel_base(steps: &[MotionStep], rho: f64, sigma_rho: f64) -> Option<Interval
     }
     let mean = reduced.iter().sum::<f64>() / k as f64;
     let sigma_kappa = ((k - 1) as f64 / k as f64 * reduced.iter().map(|v| (v - mean).powi(2)).sum::<f64>()).sqrt();
+    if !(rho > 0.0 && kappa > 0.0) {
+        return None; // no turning the odometry agrees with in sign: nothing to scale
+    }
     let ratio = kappa / rho;
-    let sigma = ratio * ((sigma_kappa / kappa).powi(2) + (sigma_rho / rho).powi(2)).sqrt();
-    Some(Interval::of(ratio, sigma))
+    let sigma = ((sigma_kappa / rho).powi(2) + (kappa * sigma_rho / (rho * rho)).powi(2)).sqrt();
+    ratio.is_finite().then(|| Interval::of(ratio, sigma))
 }
 
 /// How the odometry's turning agrees with SLAM's: `κ`, the least-squares ratio of the

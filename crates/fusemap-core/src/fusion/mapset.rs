@@ -178,7 +178,6 @@ impl MapSet {
         &mut self.primary
     }
 
-    /// All maps, primary first, writable.
     /// Notes in every map's selection that the sensor `name` was registered as `sensor`.
     pub(super) fn register(&mut self, sensor: SensorId, name: &str) {
         for m in self.entries_mut() {
@@ -186,6 +185,7 @@ impl MapSet {
         }
     }
 
+    /// All maps, primary first, writable.
     pub(super) fn entries_mut(&mut self) -> impl Iterator<Item = &mut MapEntry> {
         std::iter::once(&mut self.primary).chain(&mut self.others)
     }
