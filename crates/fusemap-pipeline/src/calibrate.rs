@@ -16,7 +16,9 @@ use crate::recording::Inventory;
 use crate::sensors::Bound;
 use crate::track::{ChosenTrack, Track};
 use crate::{PipelineError, Progress};
-use fusemap_core::calibration::{lidar_odometry, steps_of, turn_agreement, Interval, LidarOdometry, MotionStep};
+use fusemap_core::calibration::{
+    jackknife_sigma, lidar_odometry, steps_of, turn_agreement, Interval, LidarOdometry, MotionStep,
+};
 use fusemap_core::config::{Plan, SensorKind};
 use fusemap_core::geometry::{Mount3, Pose2};
 use fusemap_core::time::{Stamp, SyncMode};
@@ -249,13 +251,7 @@ fn clock_offset(steps_at: &dyn Fn(i64, std::ops::Range<usize>) -> Vec<MotionStep
             Err(edge) => edge.unwrap_or(best),
         })
         .collect();
-    let sigma = if reduced.len() == k {
-        let mean = reduced.iter().sum::<f64>() / k as f64;
-        let ss: f64 = reduced.iter().map(|v| (v - mean).powi(2)).sum();
-        curvature_sigma.max(((k - 1) as f64 / k as f64 * ss).sqrt())
-    } else {
-        return None;
-    };
+    let sigma = curvature_sigma.max(jackknife_sigma(&reduced, false));
     Some(Interval::of(best, sigma))
 }
 

@@ -12,7 +12,7 @@
 //! step that moves; the lever arm `t_Δ` only from steps that turn (`R_A − I` vanishes on a
 //! straight drive), and is reported as undetermined when the turns do not fix it.
 
-use super::Interval;
+use super::{jackknife_sigma, Interval};
 use crate::geometry::{normalize_angle, Pose2};
 use serde::Serialize;
 
@@ -113,13 +113,10 @@ fn residual(r: &([f64; 4], f64), u: &[f64; 4]) -> f64 {
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
+    if v.is_empty() {
         0.0
-    } else if n % 2 == 1 {
-        v[n / 2]
     } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
+        crate::metrics::median_of_sorted(&v)
     }
 }
 
@@ -194,23 +191,10 @@ fn jackknife_sigmas(steps: &[MotionStep]) -> [Option<f64>; 4] {
             estimates.push(parameters(&u));
         }
     }
-    let n = estimates.len();
     std::array::from_fn(|i| {
-        if n < k {
-            return None;
-        }
-        let mean = estimates.iter().map(|e| e[i]).sum::<f64>() / n as f64;
-        let ss: f64 = estimates.iter().map(|e| (normalize_if_angle(i, e[i] - mean)).powi(2)).sum();
-        Some(((n - 1) as f64 / n as f64 * ss).sqrt())
+        let of: Vec<f64> = estimates.iter().map(|e| e[i]).collect();
+        (of.len() == k).then(|| jackknife_sigma(&of, i == 0))
     })
-}
-
-fn normalize_if_angle(i: usize, d: f64) -> f64 {
-    if i == 0 {
-        normalize_angle(d)
-    } else {
-        d
-    }
 }
 
 /// Estimates the correction from `steps` (see the module docs); `None` with fewer than 10
@@ -261,8 +245,7 @@ fn wheel_base(steps: &[MotionStep], rho: f64, sigma_rho: f64) -> Option<Interval
     if reduced.len() < k {
         return None;
     }
-    let mean = reduced.iter().sum::<f64>() / k as f64;
-    let sigma_kappa = ((k - 1) as f64 / k as f64 * reduced.iter().map(|v| (v - mean).powi(2)).sum::<f64>()).sqrt();
+    let sigma_kappa = jackknife_sigma(&reduced, false);
     if !(rho > 0.0 && kappa > 0.0) {
         return None; // no turning the odometry agrees with in sign: nothing to scale
     }

@@ -6,7 +6,22 @@ mod lidar_odometry;
 
 pub use lidar_odometry::{lidar_odometry, steps_of, turn_agreement, LidarOdometry, MotionStep};
 
+use crate::geometry::normalize_angle;
 use serde::Serialize;
+
+/// The delete-a-group jackknife's standard error of an estimate from its `n` estimates
+/// with one group left out each: `√((n − 1)/n · Σ (θᵢ − θ̄)²)`; deviations of an angle
+/// (`angle`) wrapped to (−π, π]. 0 without estimates.
+pub fn jackknife_sigma(estimates: &[f64], angle: bool) -> f64 {
+    let n = estimates.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let mean = estimates.iter().sum::<f64>() / n as f64;
+    let wrap = |d: f64| if angle { normalize_angle(d) } else { d };
+    let ss: f64 = estimates.iter().map(|e| wrap(e - mean).powi(2)).sum();
+    ((n - 1) as f64 / n as f64 * ss).sqrt()
+}
 
 /// An estimated parameter: its value and a 95 % interval.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -10,6 +10,7 @@ mod trajectory;
 mod validation;
 
 pub use entropy::{binary_entropy, entropy_where, map_entropy, sparse_entropy, EntropyReport};
+pub(crate) use motion_agreement::median_of_sorted;
 pub use motion_agreement::{motion_agreement, MotionAgreement};
 pub use relations::{
     at_relation_stamps, parse_relations, relation_errors, score_relations, score_trajectory, Relation,

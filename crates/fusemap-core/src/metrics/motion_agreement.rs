@@ -62,7 +62,8 @@ pub fn motion_agreement(pairs: &[(Pose2, Pose2)], step_m: f64, max_turn_rad: f64
     })
 }
 
-fn median_of_sorted(v: &[f64]) -> f64 {
+/// The median of a sorted, non-empty slice.
+pub(crate) fn median_of_sorted(v: &[f64]) -> f64 {
     let n = v.len();
     if n % 2 == 1 {
         v[n / 2]
