@@ -12,12 +12,13 @@ use crate::recording::Inventory;
 use crate::sync::Skipped;
 use crate::track::Track;
 use crate::PipelineError;
+use fusemap_core::calibration::CameraSample;
 use fusemap_core::config::{ExtrinsicsSource, LogConfig, PlannedCamera};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::fusion::{Engine, EngineError};
-use fusemap_core::geometry::Pose3;
+use fusemap_core::geometry::{Point2, Pose2, Pose3};
 use fusemap_core::measurement::{ObservationId, SensorId};
-use fusemap_core::sensor::camera::{CameraModel, ClassTable, Pinhole, PixelCounts};
+use fusemap_core::sensor::camera::{Band, CameraModel, ClassTable, Pinhole, PixelCounts};
 use fusemap_core::time::{Stamp, SyncMode};
 use fusemap_io::log::{image_over_limit, ImageMessage};
 use serde::Serialize;
@@ -89,7 +90,20 @@ pub(crate) struct MappedCamera {
     pending_label: Option<(Stamp, ImageMessage)>,
     pending_depth: Option<(Stamp, ImageMessage)>,
     pub(crate) report: CameraReport,
+    /// Every placed frame's obstacle points in the base frame, when a calibration asked.
+    pub(crate) samples: Option<Vec<CameraSample>>,
 }
+
+/// A calibration keeps obstacle points at least this far inside the obstacle band, metres:
+/// nearer its edges depth noise decides the band (a wall's foot measured long falls into
+/// the floor band and is dropped, one measured short stays), so the points kept there lie
+/// nearer the camera than the wall, and would read as a clock running late while the
+/// robot drives at a wall.
+const BAND_MARGIN_M: f64 = 0.3;
+
+/// The most obstacle points a calibration keeps of one frame (evenly spread over the
+/// frame's points): enough to trace the walls it sees, and a bounded memory per frame.
+const SAMPLE_POINTS: usize = 400;
 
 /// A camera as the log lets it be built.
 pub(crate) enum BuiltCamera {
@@ -231,6 +245,7 @@ impl MappedCamera {
             pending_label: None,
             pending_depth: None,
             report,
+            samples: None,
         }
     }
 
@@ -276,6 +291,27 @@ impl MappedCamera {
         None
     }
 
+    /// Keeps the frame just projected as a calibration's sample: its obstacle points
+    /// ([`ClassTable::is_static_obstacle`](fusemap_core::sensor::camera::ClassTable::is_static_obstacle),
+    /// obstacle band) back in the base frame, at most [`SAMPLE_POINTS`] of them.
+    fn sample(&mut self, engine: &Engine, stamp: Stamp, pose: Pose2) {
+        let (Some(samples), Some(model)) = (&mut self.samples, engine.camera_model(self.id)) else { return };
+        let classes = model.classes();
+        let (low, high) =
+            (model.params().floor_band_m + BAND_MARGIN_M, model.params().obstacle_max_z_m - BAND_MARGIN_M);
+        let to_base = pose.inverse();
+        let obstacle: Vec<Point2> = engine
+            .last_camera_frame()
+            .points
+            .iter()
+            .filter(|p| p.band == Band::Obstacle && classes.is_static_obstacle(p.class))
+            .filter(|p| (low..=high).contains(&(p.height as f64)))
+            .map(|p| to_base.transform_point(p.end))
+            .collect();
+        let step = obstacle.len().div_ceil(SAMPLE_POINTS).max(1);
+        samples.push(CameraSample { stamp, points: obstacle.into_iter().step_by(step).collect() });
+    }
+
     /// Counts images left unpaired at the end of the log.
     pub(crate) fn finish(&mut self) {
         self.report.labels_unpaired += self.pending_label.take().is_some() as u64;
@@ -316,6 +352,7 @@ impl MappedCamera {
         match engine.insert_camera_frame(self.id, Some(id), frame.release, &labels, &depths, pose) {
             Ok(_) => {
                 self.report.frames_used += 1;
+                self.sample(engine, stamp, pose);
                 Ok(())
             }
             // Another sensor's observation was applied after this frame's stamp (a clock

@@ -10,6 +10,7 @@ use crate::recording::{line_key, LineKey, RangeMessage};
 use crate::report::LidarReport;
 use crate::track::{LinePoses, Track};
 use crate::PipelineError;
+use fusemap_core::calibration::SurfaceHits;
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::measurement::{ObservationId, SensorId};
@@ -116,6 +117,8 @@ pub(crate) struct Inserter<'a> {
     /// The next observation id: one per scan released by the merge, so that every insert
     /// is named (evidence of one instant from several sensors will share one).
     pub(crate) next_id: u64,
+    /// The lidars' returns per cell, when a calibration asked (see [`SurfaceHits`]).
+    pub(crate) surface: Option<SurfaceHits>,
 }
 
 impl Inserter<'_> {
@@ -185,6 +188,9 @@ impl Inserter<'_> {
                     })?;
                 } else {
                     self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;
+                }
+                if let Some(s) = &mut self.surface {
+                    s.add(self.engine.last_range_data(), self.engine.maps().primary().grid().geometry());
                 }
                 self.placed.push((t, pose));
                 self.last = Some(t);

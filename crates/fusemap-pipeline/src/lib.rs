@@ -42,6 +42,7 @@ mod lidar_frames;
 mod map_pass;
 pub mod merge;
 pub mod outputs;
+mod pass_notes;
 pub mod pose_sensors_report;
 pub mod progress;
 pub mod recording;

@@ -9,6 +9,7 @@ use crate::extrinsics::frame_tree;
 use crate::insert::{release, Inserter, Mapped};
 use crate::lidar_frames::{lidar_setup, other_frames};
 use crate::merge::{OrderedMerge, Pushed};
+use crate::pass_notes::lidar_notes;
 use crate::progress::Progress;
 use crate::recording::{for_each_range_message, Inventory, RangeMessage};
 use crate::report::{LidarReport, LogReport};
@@ -16,7 +17,8 @@ use crate::sensors::Bound;
 use crate::sync::{limits, offset_ns, sync_mode, Skipped};
 use crate::track::{count_reordered, ChosenTrack, Track};
 use crate::PipelineError;
-use fusemap_core::config::{default_camera, LogConfig, Plan, PlannedCamera, SensorKind};
+use fusemap_core::calibration::{CameraSample, SurfaceHits};
+use fusemap_core::config::{default_camera, Plan, PlannedCamera, SensorKind};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::fusion::{Correlation, Engine, MapSet};
 use fusemap_core::geometry::Pose2;
@@ -41,6 +43,13 @@ pub struct MapRun {
     pub trajectory: Vec<(Stamp, Pose2)>,
     /// Facts a user should know.
     pub notes: Vec<String>,
+    /// The track the pass placed the scans with.
+    pub track: Track,
+    /// Each camera's frames as a calibration reads them (by name), when
+    /// [`PassMaps::camera_samples`] asked.
+    pub camera_samples: Vec<(String, Vec<CameraSample>)>,
+    /// The lidars' returns per cell, kept with the camera samples.
+    pub lidar_surface: Option<SurfaceHits>,
 }
 
 /// A timed track's samples with the pose every scan was placed with, by stamp (a sample
@@ -99,6 +108,9 @@ struct Streams {
     planned: Vec<PlannedCamera>,
 }
 
+/// The pose every scan was placed with, and the lidars' returns per cell if kept.
+type Placed = (Vec<(Stamp, Pose2)>, Option<SurfaceHits>);
+
 /// The maps a pass builds, and whether the log's later part is held out of them.
 #[derive(Default)]
 pub struct PassMaps {
@@ -110,11 +122,14 @@ pub struct PassMaps {
     /// are counted instead ([`Engine::held_out`]), §5.2's later period. By time span on a
     /// timed track; by scan count on poses of the scan lines, whose stamps may be broken.
     pub holdout_share: Option<f64>,
+    /// Keep every placed camera frame's obstacle points in the base frame
+    /// ([`MapRun::camera_samples`]): what the camera's calibration scores.
+    pub camera_samples: bool,
 }
 
 impl From<MapSet> for PassMaps {
     fn from(set: MapSet) -> Self {
-        Self { set: Some(set), holdout_share: None }
+        Self { set: Some(set), holdout_share: None, camera_samples: false }
     }
 }
 
@@ -146,13 +161,17 @@ pub fn map_with_track(
     notes.extend(tree_notes);
     let input = Inputs { plan, inv, bound, track: &chosen.track, tree: &tree };
     let mut streams = Streams::open(&input, &mut engine, &mut notes)?;
+    if maps.camera_samples {
+        streams.cameras.iter_mut().for_each(|c| c.samples = Some(Vec::new()));
+    }
 
     let t_map = Instant::now();
     let hold_from = maps.holdout_share.and_then(|share| streams.holdout_key(&input, share));
     // On poses of the scan lines the keys of scans count them; only scans start the
     // held-out period there (the images of such a log, if any, carry stamps).
     let scans_only = matches!(chosen.track, Track::ScanLine(_));
-    let placed = streams.run(&input, &mut engine, mode, hold_from.map(|k| (k, scans_only)), progress)?;
+    let hold_from = hold_from.map(|k| (k, scans_only));
+    let (placed, lidar_surface) = streams.run(&input, &mut engine, mode, hold_from, maps.camera_samples, progress)?;
     let map_s = t_map.elapsed().as_secs_f64();
     let trajectory = match &chosen.track {
         Track::ScanLine(_) => placed,
@@ -165,12 +184,23 @@ pub fn map_with_track(
     }
     notes.extend(inv.malformed_note());
     camera_notes(&engine, &mut streams, &mut notes);
+    let camera_samples =
+        streams.cameras.iter_mut().filter_map(|c| Some((c.report.name.clone(), c.samples.take()?))).collect();
     let mut report = log_report(&input, &chosen, streams, mode, skipped, &tree);
     (report.track_s, report.map_s) = (track_s, map_s);
     report.correlated_merged = engine.stats().correlated_merged;
     report.slam = slam_summary.map(|s| *s);
     notes.extend(chosen.notes.iter().cloned());
-    Ok(MapRun { engine, format: inv.format, report, trajectory, notes })
+    Ok(MapRun {
+        engine,
+        format: inv.format,
+        report,
+        trajectory,
+        notes,
+        track: chosen.track,
+        camera_samples,
+        lidar_surface,
+    })
 }
 
 /// Opens the pass's streams as [`map_with_track`] does (each lidar's model and mount, each
@@ -335,8 +365,9 @@ impl Streams {
         engine: &mut Engine,
         mode: SyncMode,
         hold_from: Option<(i64, bool)>,
+        sample: bool,
         progress: &mut dyn FnMut(Progress),
-    ) -> Result<Vec<(Stamp, Pose2)>, PipelineError> {
+    ) -> Result<Placed, PipelineError> {
         let inv = input.inv;
         let topics: Vec<String> = input.bound.lidars.iter().map(|b| b.topic.clone()).collect();
         let image_topics: Vec<String> =
@@ -354,6 +385,7 @@ impl Streams {
             placed: Vec::new(),
             lines_seen: Default::default(),
             next_id: 0,
+            surface: sample.then(SurfaceHits::default),
         };
         let mut seq = 0i64;
         for_each_range_message(&inv.path, &inv.limits, &topics, &image_topics, |msg| {
@@ -378,7 +410,7 @@ impl Streams {
             c.finish();
         }
         progress(Progress::Done);
-        Ok(std::mem::take(&mut inserter.placed))
+        Ok((std::mem::take(&mut inserter.placed), inserter.surface.take()))
     }
 
     /// The merge key from which the later `share` of the log is held out: the
@@ -446,78 +478,6 @@ fn hold_out_from(engine: &mut Engine, hold_from: Option<(i64, bool)>, key: i64, 
     if hold_from.is_some_and(|(h, scans_only)| key >= h && counts(scans_only)) {
         engine.hold_out();
     }
-}
-
-/// A lidar's contradictory stamps: all scans at one stamp, or scans sharing the stamp of
-/// the scan before them with other ranges (a repeat, same ranges, has its own note).
-fn stamp_notes(r: &crate::report::LidarReport, notes: &mut Vec<String>) {
-    let (n, shared) = (r.timing.count, r.timing.duplicates);
-    if n > 2 && shared + 1 == n {
-        notes.push(format!(
-            "every one of the {n} scans of `{}` carries the same header stamp: where the scans carry no pose of \
-             their own, each is placed at the pose of that one instant",
-            r.topic
-        ));
-    } else if shared > r.scans_skipped.repeated {
-        notes.push(format!(
-            "{} scans of `{}` carry the stamp of the scan before them but other ranges (two scans at one \
-             instant: a second lidar on the topic, or a driver's stamping fault); both are placed at that \
-             instant's pose",
-            shared - r.scans_skipped.repeated,
-            r.topic
-        ));
-    }
-}
-
-/// The lidars' notes (stamps going backwards, refused, repeated, late and unposed scans);
-/// the skipped scans of all of them.
-fn lidar_notes(lidars: &[Mapped], cfg: &LogConfig, notes: &mut Vec<String>) -> Skipped {
-    let mut skipped = Skipped::default();
-    for l in lidars {
-        let r = &l.report;
-        skipped.add(&r.scans_skipped);
-        if r.timing.regressions > 0 {
-            let order = if r.scans_reordered > 0 {
-                format!(": {} scans mapped in stamp order", r.scans_reordered)
-            } else {
-                String::new()
-            };
-            notes.push(format!("`{}` stamps go backwards {} times{order}", r.topic, r.timing.regressions));
-        }
-        stamp_notes(r, notes);
-        if r.scans_skipped.bad_angles > 0 {
-            notes.push(format!(
-                "{} scans of `{}` refused: their beam angles cannot be placed (first: {})",
-                r.scans_skipped.bad_angles,
-                r.topic,
-                l.bad_angles_example.as_deref().unwrap_or("?")
-            ));
-        }
-        if r.scans_skipped.repeated > 0 {
-            notes.push(format!(
-                "{} scans of `{}` repeat the scan before them (same stamp, same ranges): each was inserted once",
-                r.scans_skipped.repeated, r.topic
-            ));
-        }
-        if r.scans_skipped.frozen > 0 {
-            notes.push(format!(
-                "{} scans of `{}` are frozen: the ranges of the scan before, bit for bit, while the pose track moved (a driver republishing its last reading); they were not mapped",
-                r.scans_skipped.frozen, r.topic
-            ));
-        }
-        if r.scans_skipped.late > 0 {
-            notes.push(format!(
-                "{} scans of `{}` arrived more than log.reorder_window_s = {} s behind the others and were dropped",
-                r.scans_skipped.late, r.topic, cfg.reorder_window_s
-            ));
-        }
-    }
-    let read: u64 = lidars.iter().map(|l| l.report.scans_read).sum();
-    let without_pose = skipped.total() - skipped.bad_angles - skipped.repeated - skipped.frozen;
-    if without_pose > 0 {
-        notes.push(format!("{without_pose} of {read} scans skipped without a pose"));
-    }
-    skipped
 }
 
 /// The cameras' pixel counts from the engine, and a note for a camera that mapped no

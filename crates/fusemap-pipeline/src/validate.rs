@@ -180,7 +180,7 @@ impl ValidateJob {
         let (chosen, track_s) = crate::run::correct(plan, &inv, &bound, raw, track_s, progress).map_err(named)?;
         let motion = lidar_motion(&bound, &chosen, &raw_at_scans);
         let set = validation_maps(plan, &inv, &bound).map_err(named)?;
-        let maps = PassMaps { set: Some(set), holdout_share: Some(plan.holdout_share) };
+        let maps = PassMaps { set: Some(set), holdout_share: Some(plan.holdout_share), camera_samples: false };
         let run = crate::map_with_track(plan, &inv, &bound, chosen, track_s, maps, progress).map_err(named)?;
         let (validation, rasters) = validate(&run.engine, plan, motion).map_err(named)?;
         write_validate_npz(&outputs.staged(VALIDATE_NPZ), &validation, &rasters, plan)?;

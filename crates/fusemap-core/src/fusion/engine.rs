@@ -412,6 +412,17 @@ impl Engine {
         Ok(total)
     }
 
+    /// The last lidar observation turned into rays (inserted or held out), map frame.
+    pub fn last_range_data(&self) -> &RangeData {
+        &self.scratch
+    }
+
+    /// The last camera frame projected (by [`Engine::insert_camera_frame`], inserted or
+    /// held out), map frame: what a calibration reads back of the pass.
+    pub fn last_camera_frame(&self) -> &CameraObservation {
+        &self.camera_scratch
+    }
+
     /// The kind of a registered sensor.
     pub fn sensor_kind(&self, sensor: SensorId) -> Option<SensorKind> {
         self.sensors.get(sensor.0 as usize).map(|s| s.model.kind())

@@ -54,12 +54,10 @@ impl HeldOut {
     }
 
     /// Counts a camera frame's obstacle-band pixels of the classes that are obstacle
-    /// evidence (static, not ignored, `p_occupied` above one half: those the camera's
-    /// occupancy update makes occupied, see `CameraModel::occupancy_evidence`).
+    /// evidence ([`ClassTable::is_static_obstacle`]).
     pub fn add_camera(&mut self, obs: &CameraObservation, classes: &ClassTable, geometry: &GridGeometry) {
         let cells = self.counts.entry(obs.sensor).or_default();
-        let obstacle = |k: u8| classes.try_get(k).is_some_and(|c| !c.dynamic && !c.ignore && c.p_occupied > 0.5);
-        for p in obs.points.iter().filter(|p| p.band == Band::Obstacle && obstacle(p.class)) {
+        for p in obs.points.iter().filter(|p| p.band == Band::Obstacle && classes.is_static_obstacle(p.class)) {
             if let Some(c) = geometry.cell_of(p.end) {
                 let n = cells.entry(c).or_insert(0);
                 *n = n.saturating_add(1);

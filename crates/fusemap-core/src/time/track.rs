@@ -14,7 +14,7 @@ use crate::geometry::Pose2;
 pub type Covariance3 = [[f64; 3]; 3];
 
 /// `map_from_base` at any stamp of a track's span.
-pub trait PoseTrack {
+pub trait PoseTrack: Send + Sync {
     /// The pose at `t` under `mode` (sources that are not sampled buffers may ignore the
     /// nearest-neighbour mode and always interpolate).
     fn pose_at(&self, t: Stamp, mode: SyncMode) -> Result<Pose2, NoPose>;

@@ -1,7 +1,8 @@
 //! `fusemap calibrate` on the production line with its ground truth: the lidar's mount
 //! (5 cm and 2° off in the configuration), the wheel odometry's scale (the simulator's
 //! 3 % error) and wheel base (right) from the lidar's motion against the wheels', and the lidar's clock offset
-//! (a bag whose lidar stamps run 40 ms late).
+//! (a bag whose lidar stamps run 40 ms late), and the camera's clock offset and mount yaw
+//! against the lidar's map.
 
 use crate::validation::{bag, config};
 use fusemap_core::calibration::Interval;
@@ -76,6 +77,60 @@ fn finds_a_lidar_clock_running_late() {
     let (late, on_time) = (get(&c, "lidar", |s| s.time_offset_s), get(&on_time, "lidar", |s| s.time_offset_s));
     assert!(late.contains(-0.04) && on_time.contains(0.0), "{late:?} {on_time:?}");
     assert!((late.value - on_time.value + 0.04).abs() < 0.005, "{late:?} {on_time:?}");
+}
+
+/// A bag whose camera stamps run 40 ms late, simulated once per test binary.
+fn late_camera_bag() -> &'static Path {
+    static BAG: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    BAG.get_or_init(|| {
+        let mut scenario = Scenario::default();
+        scenario.camera.time_offset_s = 0.04;
+        let rec = simulate(&scenario).expect("the scenario simulates");
+        let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), "calibration-late-camera-bag");
+        let late = dir.join("bag");
+        fusemap_sim::bag::write_bag(&rec, &late, true).expect("the bag is written");
+        late
+    })
+}
+
+#[test]
+fn finds_a_camera_clock_running_late() {
+    let late = calibrate("camera-late", late_camera_bag(), &config((0.25, 0.0), 0.0));
+    let on_time = calibrate("camera-on-time", bag(), &config((0.25, 0.0), 0.0));
+    let (late, on_time) = (get(&late, "camera", |s| s.time_offset_s), get(&on_time, "camera", |s| s.time_offset_s));
+    // The two bags share every noise draw: the difference is the search's response to a
+    // clock 40 ms late, −0.040 s ± 0.005 s.
+    assert!((late.value - on_time.value + 0.04).abs() < 0.005, "{late:?} {on_time:?}");
+}
+
+#[test]
+fn finds_a_turned_camera_mount() {
+    let c = calibrate("camera-yaw", bag(), &config((0.25, 0.0), 5.0));
+    let yaw = get(&c, "camera", |s| s.yaw);
+    let truth = (-90f64).to_radians();
+    assert!((yaw.value - truth).abs() < 0.2f64.to_radians(), "{yaw:?}");
+    let camera = c.sensors.iter().find(|s| s.name == "camera").unwrap();
+    assert!(camera.cost_after < 0.5 * camera.cost_before, "{camera:?}");
+    assert!(!camera.clock_curve.is_empty() && !camera.yaw_curve.is_empty());
+}
+
+/// The figure for the camera, not met: its clock found within 5 ms of the truth,
+/// each interval holding it. Measured (2026-12-06): 40 ms late, −0.0270 s (−0.0318 ..
+/// −0.0223); on time, +0.0130 s (0.0082 .. 0.0177). The response is right (−0.0400 s), the
+/// level is 13 ms late on both: the camera's wall points sit about 2 cm nearer the robot
+/// than the lidar's walls (shifting them 2 cm ahead moves the minimum to +0.004 s), which
+/// reads as a late clock while the robot drives at a wall. Neither the cells behind the
+/// walls' faces (now left out), the walls' cell centres (now the lidar returns' mean), the
+/// depth cut-off (8 m: +0.008 s) nor the obstacle band's edges (points within 0.3 m of them
+/// left out) explain it; the mount yaw is 0.06° off with it.
+#[test]
+#[ignore = "not met: the camera's clock comes out 13 ms late on both bags (see the doc comment)"]
+fn the_camera_clock_within_five_milliseconds() {
+    let late = calibrate("camera-late-abs", late_camera_bag(), &config((0.25, 0.0), 0.0));
+    let on_time = calibrate("camera-on-time-abs", bag(), &config((0.25, 0.0), 0.0));
+    let (late, on_time) = (get(&late, "camera", |s| s.time_offset_s), get(&on_time, "camera", |s| s.time_offset_s));
+    assert!((late.value + 0.04).abs() < 0.005 && late.contains(-0.04), "{late:?}");
+    assert!(on_time.value.abs() < 0.005 && on_time.contains(0.0), "{on_time:?}");
 }
 
 /// The figure, not met: every interval contains the truth. Measured (2026-12-06):

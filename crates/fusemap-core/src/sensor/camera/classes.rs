@@ -155,6 +155,13 @@ impl ClassTable {
         self.classes.get(idx as usize)
     }
 
+    /// Whether a point of class `idx` in the obstacle band claims a static obstacle: a
+    /// class that is not dynamic, not ignored and more likely occupied than not (those the
+    /// camera's occupancy update makes occupied, see `CameraModel::occupancy_evidence`).
+    pub fn is_static_obstacle(&self, idx: u8) -> bool {
+        self.try_get(idx).is_some_and(|c| !c.dynamic && !c.ignore && c.p_occupied > 0.5)
+    }
+
     /// The classes in index order.
     pub fn iter(&self) -> std::slice::Iter<'_, ClassSpec> {
         self.classes.iter()

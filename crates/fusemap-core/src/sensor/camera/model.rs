@@ -219,7 +219,13 @@ impl CameraModel {
                 let bx = t[0] + d * (a[0] + r[0]);
                 let by = t[1] + d * (a[1] + r[1]);
                 c.used += 1;
-                out.points.push(CameraPoint { end: to_map(bx, by), class, weight: self.point_weight(d), band });
+                out.points.push(CameraPoint {
+                    end: to_map(bx, by),
+                    class,
+                    weight: self.point_weight(d),
+                    band,
+                    height: z as f32,
+                });
             }
         }
         counts.add(&c);

@@ -28,6 +28,10 @@ pub struct CameraPoint {
     pub weight: f32,
     /// Its height band.
     pub band: Band,
+    /// Its height above the floor (base-frame `z`), metres: how far inside its band it
+    /// lies, which a calibration needs (near a band's edge, depth noise decides the band,
+    /// so the points kept there are biased towards the camera).
+    pub height: f32,
 }
 
 /// One camera frame's evidence, map frame.

@@ -327,6 +327,7 @@ fn evidence_rule_geometry_signs_class_strengths() {
         class: t.index_by_name(name).unwrap(),
         weight: 0.8,
         band,
+        height: 0.5,
     };
     let close = |a: Option<(f64, f32)>, b: (f64, f32)| a.is_some_and(|a| a.0 == b.0 && (a.1 - b.1).abs() < 1e-6);
     // Floor band: free whatever the label; a floor label at its own strength.

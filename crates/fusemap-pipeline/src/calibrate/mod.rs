@@ -7,20 +7,25 @@
 //! configured mount, and the wheels' ([`fusemap_core::calibration::lidar_odometry`],
 //! after Censi et al. 2013), and the lidar's clock offset against the odometry from when
 //! their turns line up ([`fusemap_core::calibration::turn_agreement`]). It needs SLAM on
-//! a timed track and a wheel-odometry topic; without them it says so. The camera's mount
-//! and clock offset are not estimated yet, and the report says that too.
+//! a timed track and a wheel-odometry topic; without them it says so. Each camera's clock
+//! offset and mount yaw come from its wall points scored on the lidars' map of the same
+//! pass (`calibrate/camera.rs`, [`fusemap_core::calibration::camera_against_map`]); its pitch and height are not estimated, and the report says so.
+
+mod camera;
 
 use crate::job::{JobError, LogJob};
 use crate::outputs::{finish, prepare, ExportOptions, RunRecord};
 use crate::recording::Inventory;
 use crate::sensors::Bound;
 use crate::track::{ChosenTrack, Track};
-use crate::{PipelineError, Progress};
+use crate::{PassMaps, PipelineError, Progress};
 use fusemap_core::calibration::{
     jackknife_sigma, lidar_odometry, steps_of, turn_agreement, Interval, LidarOdometry, MotionStep,
 };
 use fusemap_core::config::{Plan, SensorKind};
+use fusemap_core::fusion::{MapSet, SensorSelection};
 use fusemap_core::geometry::{Mount3, Pose2};
+use fusemap_core::grid::FusionGrid;
 use fusemap_core::time::{Stamp, SyncMode};
 use serde::Serialize;
 use std::fmt::Write;
@@ -72,8 +77,14 @@ pub struct SensorCalibration {
     pub cost_before: f64,
     /// … and after.
     pub cost_after: f64,
-    /// Robot steps used (and of them, turning ones).
+    /// Robot steps used (and of them, turning ones); a camera: frames and points scored.
     pub steps: [u64; 2],
+    /// The cost over the clock offsets searched, `[offset_s, cost]` (a camera).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub clock_curve: Vec<[f64; 2]>,
+    /// The cost over the mount yaws searched, `[yaw, cost]` (a camera).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub yaw_curve: Vec<[f64; 2]>,
 }
 
 /// What `calibrate` found: `summary.json`'s `calibration`.
@@ -111,11 +122,18 @@ impl CalibrateJob {
         let (bound, raw, track_s) = crate::run::prepare_track(plan, &inv).map_err(named)?;
         let (chosen, track_s) = crate::run::correct(plan, &inv, &bound, raw, track_s, progress).map_err(named)?;
         let (estimate, mut undetermined) = lidar_against_odometry(plan, &inv, &bound, &chosen).map_err(named)?;
-        let run =
-            crate::map_with_track(plan, &inv, &bound, chosen, track_s, Default::default(), progress).map_err(named)?;
+        let grid = || FusionGrid::new(plan.geometry, plan.occupancy);
+        let set = MapSet::new("all", SensorSelection::All, grid()).with(
+            camera::LIDAR_MAP,
+            SensorSelection::Kinds(vec![fusemap_core::measurement::SensorKind::Lidar]),
+            grid(),
+        );
+        let maps = PassMaps { set: Some(set), holdout_share: None, camera_samples: true };
+        let run = crate::map_with_track(plan, &inv, &bound, chosen, track_s, maps, progress).map_err(named)?;
         let mount = run.report.lidars.first().map(|l| (l.name.clone(), l.topic.clone(), l.extrinsics.base_from_sensor));
         let configured_offset = run.report.lidars.first().map_or(0.0, |l| l.time_offset_s);
         let mut calibration = Calibration::default();
+        let mut text = format!("# fusemap calibrate on {input}\n# A value whose interval holds the configured one is left as configured.\n");
         if let (Some(mut estimate), Some((name, topic, configured))) = (estimate, mount) {
             // The search's offset is relative to the configured one.
             estimate.clock = estimate.clock.map(|c| Interval {
@@ -124,11 +142,16 @@ impl CalibrateJob {
                 high: c.high + configured_offset,
             });
             calibration.sensors = sensors_of(&estimate, &name, &configured, &mut undetermined);
-            let text = calibration_toml(&input, &estimate, &name, &topic, &configured, configured_offset);
+            text.push_str(&calibration_toml(&estimate, &name, &topic, &configured, configured_offset));
+        }
+        for c in camera::cameras_against_lidar(&run, &mut undetermined) {
+            calibration.sensors.push(c.entry());
+            c.toml(&mut text);
+        }
+        if !calibration.sensors.is_empty() {
             let path = outputs.staged(CALIBRATION_TOML);
             fusemap_io::atomic::write_atomic(&path, |w| std::io::Write::write_all(w, text.as_bytes()))?;
         }
-        undetermined.push("the camera's mount and clock offset: not estimated by this version".into());
         calibration.undetermined = undetermined;
         let mut notes = run.notes;
         notes.extend(calibration.undetermined.iter().map(|u| format!("calibration: {u}")));
@@ -288,6 +311,16 @@ fn clock_minimum(steps_at: &dyn Fn(i64) -> Vec<MotionStep>, (from, to): (f64, f6
     Ok((vertex, (sigma2 / a).sqrt()))
 }
 
+/// No change smaller than its interval is claimed: a configured value inside the
+/// estimate's interval stays.
+fn claim(i: Interval, configured: f64) -> f64 {
+    if i.contains(configured) {
+        configured
+    } else {
+        i.value
+    }
+}
+
 /// What the lidar–odometry comparison gave.
 struct Estimate {
     motion: LidarOdometry,
@@ -341,6 +374,8 @@ fn sensors_of(
         cost_before: e.cost_before_m,
         cost_after: e.cost_after_m,
         steps: [e.steps, e.turning_steps],
+        clock_curve: Vec::new(),
+        yaw_curve: Vec::new(),
     };
     let wheels = SensorCalibration {
         name: odometry.to_string(),
@@ -359,13 +394,11 @@ fn sensors_of(
 /// `calibration.toml`: the lidar's `[[sensor]]` table with the corrected mount, ready to
 /// paste, and the odometry's scale as a comment (fusemap has no key for it: the
 /// estimator learns it).
-fn calibration_toml(log: &str, est: &Estimate, name: &str, topic: &str, m: &Mount3, configured_offset: f64) -> String {
+fn calibration_toml(est: &Estimate, name: &str, topic: &str, m: &Mount3, configured_offset: f64) -> String {
     let (e, odometry) = (&est.motion, &est.odometry);
     let (yaw, lever) = corrected(e, m);
     let mut s = String::new();
     let q = |v: &str| serde_json::to_string(v).unwrap_or_default();
-    let _ = writeln!(s, "# fusemap calibrate on {log}");
-    let _ = writeln!(s, "# A value whose interval holds the configured one is left as configured.");
     let _ = writeln!(
         s,
         "# The lidar's mount from its motion (SLAM) against the wheel odometry's, {} steps ({} turning);\n\
@@ -389,9 +422,6 @@ fn calibration_toml(log: &str, est: &Estimate, name: &str, topic: &str, m: &Moun
         let _ = writeln!(s, "#   time_offset_s {:.4} s ({:.4} .. {:.4}), against the odometry", c.value, c.low, c.high);
     }
     let _ = writeln!(s, "[[sensor]]\nkind = \"lidar\"\nname = {}\ntopic = {}", q(name), q(topic));
-    // No change smaller than its interval is claimed: a configured value inside the
-    // estimate's interval stays.
-    let claim = |i: Interval, configured: f64| if i.contains(configured) { configured } else { i.value };
     if let Some(c) = est.clock {
         let _ = writeln!(s, "time_offset_s = {}", claim(c, configured_offset));
     }

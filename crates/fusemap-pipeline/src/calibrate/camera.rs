@@ -1,0 +1,161 @@
+//! The cameras' clock offsets and mount yaws against the lidar: each camera's frames, as
+//! the mapping pass placed them, scored on the lidar-only map of the same pass
+//! ([`fusemap_core::calibration::camera_against_map`]).
+//!
+//! The camera's pitch and height above the floor are not estimated: they change which
+//! pixels fall in the obstacle band, not only where, and need the floor's own points; the
+//! report says so.
+
+use super::{claim, SensorCalibration};
+use crate::map_pass::MapRun;
+use crate::track::Track;
+use fusemap_core::calibration::{camera_against_map, CameraLidarFit, CameraSearch, DistanceField, Interval};
+use fusemap_core::config::SensorKind;
+use fusemap_core::fusion::OBSTACLE_PROBABILITY;
+use fusemap_core::geometry::{Mount3, Point2};
+use fusemap_core::grid::logodds::logit;
+use fusemap_core::time::SyncMode;
+use std::fmt::Write;
+
+/// The name of the lidar-only map of the calibration's pass.
+pub(super) const LIDAR_MAP: &str = "lidars";
+/// Distances beyond this cost the same: farther than any clock or mount error this
+/// search corrects moves a wall point, and near enough that a shelf the lidar cannot see
+/// does not pull the estimate. Metres.
+const FIELD_REACH_M: f64 = 0.3;
+
+/// One camera's estimate.
+pub(super) struct CameraEstimate {
+    name: String,
+    report: crate::camera::CameraReport,
+    fit: CameraLidarFit,
+}
+
+/// Each camera that made samples, scored on the lidar map; what could not be fitted, and
+/// why, in `undetermined`.
+pub(super) fn cameras_against_lidar(run: &MapRun, undetermined: &mut Vec<String>) -> Vec<CameraEstimate> {
+    let mut out = Vec::new();
+    for (name, samples) in &run.camera_samples {
+        let why = |s: String| format!("`{name}`'s clock offset and mount yaw: {s}");
+        let Some(report) = run.report.cameras.iter().find(|c| &c.name == name) else { continue };
+        let lidar_map = run.engine.maps().by_name(LIDAR_MAP).map(|m| m.grid());
+        let Some((grid, area)) = lidar_map.and_then(|g| g.known_box().map(|b| (g, b))) else {
+            undetermined.push(why("the lidars observed nothing to score the camera on".into()));
+            continue;
+        };
+        let threshold = logit(OBSTACLE_PROBABILITY) as f32;
+        let Some(field) =
+            DistanceField::new(&grid.raster(area), |l| l > threshold, run.lidar_surface.as_ref(), FIELD_REACH_M)
+        else {
+            undetermined.push(why("the lidars' map has no obstacle to score the camera on".into()));
+            continue;
+        };
+        let Track::Timed(track) = &run.track else {
+            undetermined.push(why("the poses are on the scan lines, not a timed track".into()));
+            continue;
+        };
+        let pose_at = |t| track.pose_at(t, SyncMode::Interpolate).ok();
+        let mount = report.extrinsics.base_from_sensor;
+        let centre = Point2::new(mount.x, mount.y);
+        match camera_against_map(samples, centre, &pose_at, &field, &CameraSearch::default()) {
+            Ok(fit) => {
+                if fit.clock.is_none() {
+                    undetermined.push(why(
+                        "the clock offset: its cost is flat or least at the edge of ±0.3 s (a robot that never turns \
+                         while the camera sees the lidar's walls does not fix it)"
+                            .into(),
+                    ));
+                }
+                if fit.yaw.is_none() {
+                    undetermined.push(why("the mount yaw: its cost is flat or least at the edge of ±8°".into()));
+                }
+                out.push(CameraEstimate { name: name.clone(), report: report.clone(), fit });
+            }
+            Err(e) => undetermined.push(why(e)),
+        }
+    }
+    if !out.is_empty() {
+        undetermined.push(
+            "the cameras' pitch and height above the floor: not estimated by this version (they decide which pixels \
+             are obstacles, and need the floor's points)"
+                .into(),
+        );
+    }
+    out
+}
+
+/// A correction added to a configured value.
+fn shifted(i: Interval, by: f64) -> Interval {
+    Interval { value: i.value + by, low: i.low + by, high: i.high + by }
+}
+
+impl CameraEstimate {
+    /// The configured mount.
+    fn mount(&self) -> Mount3 {
+        self.report.extrinsics.base_from_sensor
+    }
+
+    /// `summary.json`'s entry.
+    pub(super) fn entry(&self) -> SensorCalibration {
+        let f = &self.fit;
+        SensorCalibration {
+            name: self.name.clone(),
+            kind: SensorKind::Camera,
+            x: None,
+            y: None,
+            yaw: f.yaw.map(|y| shifted(y, self.mount().yaw)),
+            time_offset_s: f.clock.map(|c| shifted(c, self.report.time_offset_s)),
+            scale: None,
+            wheel_base: None,
+            cost_before: f.cost_before_m,
+            cost_after: f.cost_after_m,
+            steps: [f.frames as u64, f.points as u64],
+            clock_curve: f.clock_curve.iter().map(|[x, c]| [x + self.report.time_offset_s, *c]).collect(),
+            yaw_curve: f.yaw_curve.iter().map(|[x, c]| [x + self.mount().yaw, *c]).collect(),
+        }
+    }
+
+    /// Its `[[sensor]]` table for `calibration.toml`.
+    pub(super) fn toml(&self, s: &mut String) {
+        let (f, r, m) = (&self.fit, &self.report, self.mount());
+        let q = |v: &str| serde_json::to_string(v).unwrap_or_default();
+        let _ = writeln!(
+            s,
+            "\n# The camera's obstacle points on the lidars' map, {} frames, {} points; root mean\n\
+             # truncated squared distance {:.4} m before, {:.4} m after. 95 % intervals:",
+            f.frames, f.points, f.cost_before_m, f.cost_after_m
+        );
+        let e = self.entry();
+        match e.time_offset_s {
+            Some(c) => {
+                let _ = writeln!(
+                    s,
+                    "#   time_offset_s {:.4} s ({:.4} .. {:.4}), against the lidar",
+                    c.value, c.low, c.high
+                );
+            }
+            None => {
+                let _ = writeln!(s, "#   time_offset_s: not determined by this log; kept as configured");
+            }
+        }
+        if let Some(y) = e.yaw {
+            let _ = writeln!(s, "#   yaw {:.5} rad ({:.5} .. {:.5})", y.value, y.low, y.high);
+        }
+        let _ = writeln!(s, "#   pitch, height (z): not estimated; kept as configured");
+        let _ = writeln!(
+            s,
+            "[[sensor]]\nkind = \"camera\"\nname = {}\ntopic = {}\ndepth_topic = {}\ninfo_topic = {}",
+            q(&self.name),
+            q(&r.topic),
+            q(&r.depth_topic),
+            q(&r.info_topic)
+        );
+        let offset = e.time_offset_s.map_or(r.time_offset_s, |c| claim(c, r.time_offset_s));
+        let _ = writeln!(s, "time_offset_s = {offset}");
+        let yaw = e.yaw.map_or(m.yaw, |y| claim(y, m.yaw));
+        let _ = writeln!(s, "\n[sensor.base_from_sensor]");
+        for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", yaw)] {
+            let _ = writeln!(s, "{k} = {v}");
+        }
+    }
+}
