@@ -16,9 +16,12 @@ use fusemap_core::grid::{LogOddsTable, Raster};
 use std::io;
 use std::path::Path;
 
-const TRAJECTORY: [u8; 3] = [30, 90, 230];
-const LOOP_CLOSURE: [u8; 3] = [230, 30, 30];
-const FIX: [u8; 3] = [20, 150, 50];
+/// The trajectory's colour.
+pub const TRAJECTORY: [u8; 3] = [30, 90, 230];
+/// The loop closures' colour (blended over the map).
+pub const LOOP_CLOSURE: [u8; 3] = [230, 30, 30];
+/// The GNSS fix priors' colour (blended over the map).
+pub const FIX: [u8; 3] = [20, 150, 50];
 /// The opacity of the closures and the fixes over the map.
 const OVERLAY_ALPHA: f32 = 0.35;
 

@@ -176,7 +176,10 @@ fn demo_writes_every_output_and_prints_its_summary() {
     let (out, o) = demo("demo-outputs");
     // The lock a run takes on its directory stays (empty): removing it could let two runs
     // hold two locks.
-    assert_eq!(file_names(&out), [".fusemap.lock", "map.npz", "map.pgm", "map.png", "map.yaml", "summary.json"]);
+    assert_eq!(
+        file_names(&out),
+        [".fusemap.lock", "map.npz", "map.pgm", "map.png", "map.yaml", "report.html", "summary.json"]
+    );
     for name in file_names(&out).into_iter().filter(|n| n != ".fusemap.lock") {
         assert!(!(name.starts_with('.') && name.contains(".tmp")), "temp file left: {name}");
         assert!(std::fs::metadata(out.join(&name)).unwrap().len() > 0, "{name} is empty");

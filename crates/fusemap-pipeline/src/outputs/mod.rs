@@ -4,15 +4,19 @@
 //! validation and calibration runs to come) goes through [`finish`], so the files and
 //! `summary.json`'s schema are the same whichever command made them.
 
+mod report_page;
+mod report_tables;
 pub mod set;
 pub mod summary;
+mod svg_plot;
 pub mod view;
 pub mod write;
 
+pub use report_page::SECTIONS as REPORT_SECTIONS;
 pub use set::{prepare, OutputFiles, Outputs};
 pub use summary::Summary;
 pub use view::{crop_area, parse_crop, view_of, Crop, ExportOptions, ExportRoom, MapView};
-pub use write::{finish, layers_of, Layers, RunRecord};
+pub use write::{finish, layers_of, Layers, RunRecord, REPORT_HTML};
 
 use std::path::PathBuf;
 

@@ -50,7 +50,7 @@ impl OutputFiles {
 
     /// The file names of a run's set, for removing an earlier run's files this run does
     /// not write.
-    pub const NAMES: [&'static str; 12] = [
+    pub const NAMES: [&'static str; 13] = [
         "map.npz",
         "map.yaml",
         "map.pgm",
@@ -63,6 +63,7 @@ impl OutputFiles {
         "slam.png",
         "fusion_validate.npz",
         "calibration.toml",
+        "report.html",
     ];
 
     pub(crate) fn all(&self) -> [&PathBuf; 10] {

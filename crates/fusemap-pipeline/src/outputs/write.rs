@@ -3,6 +3,7 @@
 //! `summary.json` goes last with each file's size and SHA-256. A failing run leaves the
 //! previous set as it was; no output is ever written over an input.
 
+use super::report_page::{self, Picture};
 use super::set::{OutputFiles, Outputs};
 use super::summary::{CellsUpdated, MapInfo, Summary};
 use super::view::{view_of, ExportOptions, ExportRoom, MapView};
@@ -139,6 +140,14 @@ pub fn write(
             fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, &trajectory, &closures, &fixes)?;
         }
     }
+    let value =
+        serde_json::to_value(&*summary).map_err(|e| fusemap_io::Error::io(&files.summary, std::io::Error::other(e)))?;
+    let width_m = summary.map.width as f64 * summary.map.resolution;
+    let crop = match view {
+        MapView::Dense(r) => observed_crop(r),
+        _ => [0.0, 1.0, 0.0, 1.0],
+    };
+    report_page::write_report(&set.staged(REPORT_HTML), &value, &pictures(&files, layers, width_m, crop))?;
     // Files of an earlier run that this run does not write are removed at the commit: a
     // run never leaves files beside its summary that look like its own.
     let summary_path = set.dir().join("summary.json");
@@ -148,6 +157,85 @@ pub fn write(
         serde_json::to_vec_pretty(&*summary).map_err(|e| fusemap_io::Error::io(&summary_path, std::io::Error::other(e)))
     })?;
     Ok(())
+}
+
+/// The share of observed cells left outside the report's pictures on each side: the
+/// stray rays of a few beams through a door or a window, which would otherwise set the
+/// picture's extent.
+const CROP_TAIL: f64 = 0.002;
+/// The margin around the observed area, as a share of its size.
+const CROP_MARGIN: f64 = 0.03;
+
+/// The part of `r`'s pictures the report shows, `[left, right, top, bottom]` as shares of
+/// the picture (top = the highest row): the columns and rows holding all but
+/// [`CROP_TAIL`] of the observed cells on each side, with a margin.
+fn observed_crop(r: &Raster) -> [f64; 4] {
+    let (mut cols, mut rows) = (vec![0u64; r.width], vec![0u64; r.height]);
+    for (i, _) in r.known.iter().enumerate().filter(|(_, k)| **k) {
+        cols[i % r.width] += 1;
+        rows[i / r.width] += 1;
+    }
+    let span = |counts: &[u64]| {
+        let total: u64 = counts.iter().sum();
+        let tail = (CROP_TAIL * total as f64) as u64;
+        let mut acc = 0u64;
+        let first = counts.iter().position(|&c| {
+            acc += c;
+            acc > tail
+        });
+        acc = 0;
+        let last = counts.iter().rposition(|&c| {
+            acc += c;
+            acc > tail
+        });
+        let (a, b) = (first.unwrap_or(0) as f64, last.map_or(counts.len(), |l| l + 1) as f64);
+        let pad = CROP_MARGIN * (b - a);
+        let n = counts.len().max(1) as f64;
+        (((a - pad) / n).max(0.0), ((b + pad) / n).min(1.0))
+    };
+    let (left, right) = span(&cols);
+    let (low, high) = span(&rows);
+    // Row 0 is the lowest y, drawn at the bottom.
+    [left, right, 1.0 - high, 1.0 - low]
+}
+
+/// The page beside every run's outputs.
+pub const REPORT_HTML: &str = "report.html";
+
+/// The run's pictures that were written, each with its legend, for the report.
+fn pictures(files: &OutputFiles, layers: Option<&Layers>, width_m: f64, crop: [f64; 4]) -> Vec<Picture> {
+    let grey = |v: u8| format!("rgb({v},{v},{v})");
+    let shades = || {
+        vec![
+            (grey(255), "free".to_string()),
+            (grey(0), "occupied".to_string()),
+            (grey(fusemap_io::picture::UNKNOWN_SHADE), "never observed".to_string()),
+        ]
+    };
+    let rgb = |c: [u8; 3]| format!("rgb({},{},{})", c[0], c[1], c[2]);
+    let mut slam = shades();
+    slam.extend([
+        (rgb(fusemap_io::slam_picture::TRAJECTORY), "trajectory".to_string()),
+        (rgb(fusemap_io::slam_picture::LOOP_CLOSURE), "loop closure (blended 35 %)".to_string()),
+        (rgb(fusemap_io::slam_picture::FIX), "GNSS fix prior".to_string()),
+    ]);
+    let classes =
+        layers.map_or(Vec::new(), |l| l.semantic.classes.iter().map(|c| (rgb(c.color), c.name.clone())).collect());
+    let dynamic = vec![
+        (grey(0), "a moving object".to_string()),
+        (grey(255), "none".to_string()),
+        (grey(fusemap_io::map_server::PIXEL_UNKNOWN), "never observed".to_string()),
+    ];
+    [
+        ("Occupancy (map.png)", &files.png, shades()),
+        ("SLAM: trajectory, loop closures, fixes (slam.png)", &files.slam, slam),
+        ("Semantic classes where the map is occupied (semantic.png)", &files.semantic_png, classes),
+        ("Dynamic layer (dynamic.png)", &files.dynamic, dynamic),
+    ]
+    .into_iter()
+    .filter(|(_, path, _)| path.is_file())
+    .map(|(title, path, legend)| Picture { title: title.to_string(), path: path.clone(), legend, width_m, crop })
+    .collect()
 }
 
 /// The trajectory of scan nodes, the loop closures (submap origin, node) and the GNSS fixes
@@ -303,7 +391,7 @@ mod tests {
         assert!(summary.entropy.is_some());
         let mut listed: Vec<&str> = summary.files.iter().map(|f| f.name.as_str()).collect();
         listed.sort_unstable();
-        assert_eq!(listed, ["map.npz", "map.pgm", "map.png", "map.yaml"]);
+        assert_eq!(listed, ["map.npz", "map.pgm", "map.png", "map.yaml", "report.html"]);
         for f in &summary.files {
             assert_eq!(std::fs::metadata(out.join(&f.name)).unwrap().len(), f.bytes, "{}", f.name);
         }

@@ -9,6 +9,7 @@ mod frames;
 mod hour_loop;
 mod implausible_pose_sensors;
 mod production_line;
+mod report;
 mod scan_angles;
 mod scan_frames;
 mod sensors;
