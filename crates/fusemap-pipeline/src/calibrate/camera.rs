@@ -29,6 +29,10 @@ pub(super) struct CameraEstimate {
     name: String,
     report: crate::camera::CameraReport,
     fit: CameraLidarFit,
+    /// The lidar's yaw correction written beside it: the pass placed the base through the
+    /// configured lidar mount, so the camera's fitted yaw is relative to a base turned by
+    /// the lidar's error, and turns back with it.
+    pub(super) base_turn: f64,
 }
 
 /// Each camera that made samples, scored on the lidar map; what could not be fitted, and
@@ -69,7 +73,7 @@ pub(super) fn cameras_against_lidar(run: &MapRun, undetermined: &mut Vec<String>
                 if fit.yaw.is_none() {
                     undetermined.push(why("the mount yaw: its cost is flat or least at the edge of ±8°".into()));
                 }
-                out.push(CameraEstimate { name: name.clone(), report: report.clone(), fit });
+                out.push(CameraEstimate { name: name.clone(), report: report.clone(), fit, base_turn: 0.0 });
             }
             Err(e) => undetermined.push(why(e)),
         }
@@ -103,7 +107,7 @@ impl CameraEstimate {
             kind: SensorKind::Camera,
             x: None,
             y: None,
-            yaw: f.yaw.map(|y| shifted(y, self.mount().yaw)),
+            yaw: f.yaw.map(|y| shifted(y, self.mount().yaw + self.base_turn)),
             time_offset_s: f.clock.map(|c| shifted(c, self.report.time_offset_s)),
             scale: None,
             wheel_base: None,
@@ -111,7 +115,7 @@ impl CameraEstimate {
             cost_after: f.cost_after_m,
             steps: [f.frames as u64, f.points as u64],
             clock_curve: f.clock_curve.iter().map(|[x, c]| [x + self.report.time_offset_s, *c]).collect(),
-            yaw_curve: f.yaw_curve.iter().map(|[x, c]| [x + self.mount().yaw, *c]).collect(),
+            yaw_curve: f.yaw_curve.iter().map(|[x, c]| [x + self.mount().yaw + self.base_turn, *c]).collect(),
         }
     }
 
@@ -140,6 +144,13 @@ impl CameraEstimate {
         }
         if let Some(y) = e.yaw {
             let _ = writeln!(s, "#   yaw {:.5} rad ({:.5} .. {:.5})", y.value, y.low, y.high);
+            if self.base_turn != 0.0 {
+                let _ = writeln!(
+                    s,
+                    "#   (with the lidar's yaw correction, {:.5} rad, which turns the base)",
+                    self.base_turn
+                );
+            }
         }
         let _ = writeln!(s, "#   pitch, height (z): not estimated; kept as configured");
         let _ = writeln!(

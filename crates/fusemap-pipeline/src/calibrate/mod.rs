@@ -133,6 +133,10 @@ impl CalibrateJob {
         let mount = run.report.lidars.first().map(|l| (l.name.clone(), l.topic.clone(), l.extrinsics.base_from_sensor));
         let configured_offset = run.report.lidars.first().map_or(0.0, |l| l.time_offset_s);
         let mut calibration = Calibration::default();
+        // The pass placed the base through the configured lidar mount, and the cameras were
+        // fitted to that base: a lidar yaw corrected by φ turns the base by φ, and each
+        // camera's mount with it.
+        let mut base_turn = 0.0;
         let mut text = format!("# fusemap calibrate on {input}\n# A value whose interval holds the configured one is left as configured.\n");
         if let (Some(mut estimate), Some((name, topic, configured))) = (estimate, mount) {
             // The search's offset is relative to the configured one.
@@ -143,8 +147,10 @@ impl CalibrateJob {
             });
             calibration.sensors = sensors_of(&estimate, &name, &configured, &mut undetermined);
             text.push_str(&calibration_toml(&estimate, &name, &topic, &configured, configured_offset));
+            base_turn = claim(corrected(&estimate.motion, &configured).0, configured.yaw) - configured.yaw;
         }
-        for c in camera::cameras_against_lidar(&run, &mut undetermined) {
+        for mut c in camera::cameras_against_lidar(&run, &mut undetermined) {
+            c.base_turn = base_turn;
             calibration.sensors.push(c.entry());
             c.toml(&mut text);
         }

@@ -4,11 +4,18 @@
 //! (a bag whose lidar stamps run 40 ms late), and the camera's clock offset and mount yaw
 //! against the lidar's map.
 
-use crate::validation::{bag, config};
+use crate::validation::{bag, config, validate};
 use fusemap_core::calibration::Interval;
+use fusemap_core::metrics::Verdict;
 use fusemap_pipeline::calibrate::{CalibrateJob, Calibration, CALIBRATION_TOML};
+use fusemap_pipeline::validate::Validation;
 use fusemap_sim::{simulate, Scenario};
 use std::path::Path;
+
+/// Where `calibrate(name, …)` wrote its set.
+fn out_dir(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("calibration-{name}")).join("out")
+}
 
 fn calibrate(name: &str, log: &Path, cfg: &str) -> Calibration {
     let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), &format!("calibration-{name}"));
@@ -112,6 +119,64 @@ fn finds_a_turned_camera_mount() {
     let camera = c.sensors.iter().find(|s| s.name == "camera").unwrap();
     assert!(camera.cost_after < 0.5 * camera.cost_before, "{camera:?}");
     assert!(!camera.clock_curve.is_empty() && !camera.yaw_curve.is_empty());
+}
+
+/// The fused map's F1 of occupied cells against the simulator's truth, mapped with `cfg`.
+fn fused_f1(cfg: &fusemap_core::config::Config, truth: &fusemap_sim::SimRecording) -> f64 {
+    use fusemap_pipeline::scenario::{score, three_maps, Truth};
+    let plan = cfg.clone().validate().unwrap();
+    let inv = fusemap_pipeline::recording::Inventory::read(bag()).unwrap();
+    let (bound, chosen, track_s) = fusemap_pipeline::run::prepare(&plan, &inv).unwrap();
+    let run =
+        fusemap_pipeline::map_with_track(&plan, &inv, &bound, chosen, track_s, three_maps(&plan).into(), &mut |_| {})
+            .unwrap();
+    let (occupancy, semantic) =
+        (truth.truth_occupancy(plan.geometry).unwrap(), truth.truth_semantic(plan.geometry).unwrap());
+    let t = Truth {
+        occupancy: &occupancy,
+        semantic: &semantic,
+        person: &truth.person_track,
+        person_radius_m: truth.person_radius_m,
+    };
+    score("fused", run.engine.maps().by_name("fused").unwrap().grid(), &plan.classes, &t).occupied.f1
+}
+
+/// The acceptance: after calibration the fused F1 is back within 0.01 of the
+/// right configuration's, and `validate` with the calibrated configuration is no worse.
+/// The lidar is configured 5 cm and 2° off; `calibration.toml`'s tables are pasted over
+/// the configuration's (mount and clock of each sensor it names).
+///
+/// On this bench the wrong mount does not lower the fused F1 (measured 2026-12-06: right
+/// 0.5031, wrong 0.5384, calibrated 0.5001; SLAM follows the lidar, so its map stays
+/// consistent and only the base's track moves), so the F1 half shows the calibrated
+/// configuration is no worse, not that it recovers; the validation half shows it: the
+/// wrong mount is named, the calibrated one is not. (This test found the cameras' yaw
+/// fitted to a base the wrong lidar mount had turned: pasted beside the corrected lidar,
+/// it had turned the camera by the lidar's 2°, and its hit rate on the lidars' map fell
+/// from 0.38 to 0.33; turned back with the lidar's correction it is 0.79.)
+#[test]
+fn the_calibrated_configuration_maps_as_well_as_the_right_one() {
+    let parse = |text: &str| fusemap_io::config_file::parse_config_str(text, Path::new("config.toml")).unwrap();
+    let (right, wrong) = (parse(&config((0.25, 0.0), 0.0)), parse(&config((0.30, 2.0), 0.0)));
+    calibrate("apply", bag(), &config((0.30, 2.0), 0.0));
+    let pasted = fusemap_io::config_file::load_config(&out_dir("apply").join(CALIBRATION_TOML)).unwrap();
+    let mut calibrated = wrong.clone();
+    for table in &pasted.sensor {
+        let s = calibrated.sensor.iter_mut().find(|s| s.name == table.name && s.kind == table.kind).unwrap();
+        s.base_from_sensor = table.base_from_sensor;
+        s.time_offset_s = table.time_offset_s;
+    }
+    let truth = simulate(&Scenario::default()).unwrap();
+    let (f_right, f_wrong, f_calibrated) =
+        (fused_f1(&right, &truth), fused_f1(&wrong, &truth), fused_f1(&calibrated, &truth));
+    eprintln!("fused F1: right {f_right:.4}, wrong {f_wrong:.4}, calibrated {f_calibrated:.4}");
+    assert!(f_calibrated > f_right - 0.01, "right {f_right}, wrong {f_wrong}, calibrated {f_calibrated}");
+    let text = toml::to_string(&calibrated).unwrap();
+    let (before, after) = (validate("before-calibration", &config((0.30, 2.0), 0.0)), validate("calibrated", &text));
+    assert_eq!(before.judgement.suspect.as_deref(), Some("laser"), "{}", before.judgement.sentence);
+    assert_ne!(after.judgement.verdict, Verdict::CheckSyncAndExtrinsics, "{}", after.judgement.sentence);
+    let turn = |v: &Validation| v.lidar_motion[0].agreement.median_deg.abs();
+    assert!(turn(&after) < 0.5 && turn(&after) < turn(&before), "{} {}", turn(&after), turn(&before));
 }
 
 /// The figure for the camera, not met: its clock found within 5 ms of the truth,

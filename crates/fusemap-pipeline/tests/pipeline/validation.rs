@@ -48,7 +48,7 @@ pub(crate) fn config(lidar: (f64, f64), camera_yaw_deg: f64) -> String {
     format!("{c}\n[log]\nextrinsics = \"config\"\n")
 }
 
-fn validate(name: &str, cfg: &str) -> Validation {
+pub(crate) fn validate(name: &str, cfg: &str) -> Validation {
     let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), &format!("validation-{name}"));
     let path = dir.join("config.toml");
     std::fs::write(&path, cfg).unwrap();
