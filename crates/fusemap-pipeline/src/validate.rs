@@ -175,14 +175,7 @@ impl ValidateJob {
         let outputs = prepare(&job.out, &job.inputs)?;
         let named = |e| job.named(e);
         let inv = job.read(progress)?;
-        let (bound, raw, track_s) = crate::run::prepare_track(plan, &inv).map_err(named)?;
-        let raw_at_scans = raw_at_scans(&raw, &inv, &bound);
-        let (chosen, track_s) = crate::run::correct(plan, &inv, &bound, raw, track_s, progress).map_err(named)?;
-        let motion = lidar_motion(&bound, &chosen, &raw_at_scans);
-        let set = validation_maps(plan, &inv, &bound).map_err(named)?;
-        let maps = PassMaps { set: Some(set), holdout_share: Some(plan.holdout_share), camera_samples: false };
-        let run = crate::map_with_track(plan, &inv, &bound, chosen, track_s, maps, progress).map_err(named)?;
-        let (validation, rasters) = validate(&run.engine, plan, motion).map_err(named)?;
+        let (run, validation, rasters) = validated(plan, &inv, progress).map_err(named)?;
         write_validate_npz(&outputs.staged(VALIDATE_NPZ), &validation, &rasters, plan)?;
         let mut notes = run.notes;
         notes.push(format!("validation: {}", validation.judgement.sentence));
@@ -200,6 +193,26 @@ impl ValidateJob {
         let summary = finish(&run.engine, outputs, &export, record)?;
         Ok(ValidateRun { summary, validation })
     }
+}
+
+/// The pass of `validate` over a log already read: the track as `map` builds it, then the
+/// maps of [`validation_maps`] from the earlier part and the held-out later part; the
+/// run, the validation and each map's raster. `calibrate` runs it again with the
+/// calibrated mounts.
+pub(crate) fn validated(
+    plan: &Plan,
+    inv: &Inventory,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(crate::MapRun, Validation, Vec<Option<Raster>>), PipelineError> {
+    let (bound, raw, track_s) = crate::run::prepare_track(plan, inv)?;
+    let raw_at_scans = raw_at_scans(&raw, inv, &bound);
+    let (chosen, track_s) = crate::run::correct(plan, inv, &bound, raw, track_s, progress)?;
+    let motion = lidar_motion(&bound, &chosen, &raw_at_scans);
+    let set = validation_maps(plan, inv, &bound)?;
+    let maps = PassMaps { set: Some(set), holdout_share: Some(plan.holdout_share), camera_samples: false };
+    let run = crate::map_with_track(plan, inv, &bound, chosen, track_s, maps, progress)?;
+    let (validation, rasters) = validate(&run.engine, plan, motion)?;
+    Ok((run, validation, rasters))
 }
 
 /// The sensors registered with the engine, by id.

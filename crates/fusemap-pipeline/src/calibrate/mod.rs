@@ -12,6 +12,9 @@
 //! pass (`calibrate/camera.rs`, [`fusemap_core::calibration::camera_against_map`]); its pitch and height are not estimated, and the report says so.
 
 mod camera;
+mod revalidate;
+
+pub use revalidate::{Figures, Revalidation};
 
 use crate::job::{JobError, LogJob};
 use crate::outputs::{finish, prepare, ExportOptions, RunRecord};
@@ -94,6 +97,9 @@ pub struct Calibration {
     pub sensors: Vec<SensorCalibration>,
     /// What this log cannot determine, or this version does not estimate, and why.
     pub undetermined: Vec<String>,
+    /// `validate` with the configuration as given and with the calibration applied.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub revalidation: Option<Revalidation>,
 }
 
 /// What the run wrote and found.
@@ -157,10 +163,15 @@ impl CalibrateJob {
         if !calibration.sensors.is_empty() {
             let path = outputs.staged(CALIBRATION_TOML);
             fusemap_io::atomic::write_atomic(&path, |w| std::io::Write::write_all(w, text.as_bytes()))?;
+            match revalidate::revalidate(plan, &inv, &text, progress).map_err(named)? {
+                Ok(r) => calibration.revalidation = Some(r),
+                Err(why) => undetermined.push(why),
+            }
         }
         calibration.undetermined = undetermined;
         let mut notes = run.notes;
         notes.extend(calibration.undetermined.iter().map(|u| format!("calibration: {u}")));
+        notes.extend(calibration.revalidation.iter().map(|r| format!("calibration: {}", r.sentence)));
         let record = RunRecord {
             source_kind: &run.format.to_string(),
             source: &input,

@@ -131,6 +131,9 @@ pub(crate) fn calibration(c: &Value) -> String {
         }
     }
     s.push_str("</table>");
+    if let Some(r) = c["revalidation"]["sentence"].as_str() {
+        let _ = write!(s, "<p class=\"verdict\">{}</p>", escape(r));
+    }
     s.push_str(&plots);
     let undetermined: Vec<String> = c["undetermined"]
         .as_array()

@@ -158,7 +158,13 @@ fn fused_f1(cfg: &fusemap_core::config::Config, truth: &fusemap_sim::SimRecordin
 fn the_calibrated_configuration_maps_as_well_as_the_right_one() {
     let parse = |text: &str| fusemap_io::config_file::parse_config_str(text, Path::new("config.toml")).unwrap();
     let (right, wrong) = (parse(&config((0.25, 0.0), 0.0)), parse(&config((0.30, 2.0), 0.0)));
-    calibrate("apply", bag(), &config((0.30, 2.0), 0.0));
+    let c = calibrate("apply", bag(), &config((0.30, 2.0), 0.0));
+    // calibrate's own re-validation: named before, not after, and not worse.
+    let r = c.revalidation.as_ref().expect("re-validated: the configuration's mounts count");
+    assert!(
+        r.before.suspect.as_deref() == Some("laser") && r.after.verdict != Verdict::CheckSyncAndExtrinsics && !r.worse,
+        "{r:?}"
+    );
     let pasted = fusemap_io::config_file::load_config(&out_dir("apply").join(CALIBRATION_TOML)).unwrap();
     let mut calibrated = wrong.clone();
     for table in &pasted.sensor {
