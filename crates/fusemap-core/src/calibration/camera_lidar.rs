@@ -4,7 +4,7 @@
 //! The criterion is the "scan-match residual against the other sensors' map":
 //! each obstacle point of each frame, placed with the pose track at its stamp plus a
 //! trial offset `δ` and rotated by a trial yaw `ε` about the camera, costs its squared
-//! distance to the nearest obstacle of the lidar-only map, truncated (a point on
+//! distance to the nearest wall face of the lidar-only map, truncated (a point on
 //! something the lidar cannot see costs the same wherever it lands), read between cell
 //! centres so the summed cost moves smoothly ([`DistanceField`]). A late clock places a
 //! turning robot's frames at the wrong heading: the walls smear, and the cost rises on
@@ -117,7 +117,12 @@ impl Scorer<'_> {
         let shift = (dt * 1e9).round() as i64;
         let mut sums = vec![0.0; BLOCKS];
         for (f, b) in &self.frames {
-            let Some(pose) = (self.pose_at)(Stamp(f.stamp.0.saturating_add(shift))) else { continue };
+            // A frame beyond the track at this offset costs as much as a point far from
+            // every wall: fewer terms must not make an offset look better.
+            let Some(pose) = (self.pose_at)(Stamp(f.stamp.0.saturating_add(shift))) else {
+                sums[*b] += f.points.len() as f64 * self.field.max_m().powi(2);
+                continue;
+            };
             let mut sum = 0.0;
             for p in &f.points {
                 let (dx, dy) = (p.x - self.centre.x, p.y - self.centre.y);
@@ -192,6 +197,13 @@ fn least(curve: &[(f64, Vec<f64>)]) -> f64 {
     curve.iter().min_by(|a, b| total(a).total_cmp(&total(b))).map_or(0.0, |c| c.0)
 }
 
+/// Whether a curve's least total cost lies inside its grid, not at an end.
+fn interior(curve: &[(f64, Vec<f64>)]) -> bool {
+    let total = |c: &(f64, Vec<f64>)| c.1.iter().sum::<f64>();
+    let best = (0..curve.len()).min_by(|&a, &b| total(&curve[a]).total_cmp(&total(&curve[b])));
+    best.is_some_and(|i| i > 0 && i + 1 < curve.len())
+}
+
 /// Whether a curve varies by less than [`FLAT`] of its level.
 fn flat(curve: &[(f64, Vec<f64>)]) -> bool {
     let totals: Vec<f64> = curve.iter().map(|c| c.1.iter().sum()).collect();
@@ -210,7 +222,8 @@ pub fn camera_against_map(
     field: &DistanceField,
     search: &CameraSearch,
 ) -> Result<CameraLidarFit, String> {
-    let reach = (search.clock_span_s * 1e9).round() as i64 + 1;
+    // The coarse grid, and the fine grids around a minimum at its edge.
+    let reach = ((search.clock_span_s + 1.5 * search.clock_step_s) * 1e9).round() as i64 + 1;
     let covered = |t: Stamp| [-reach, reach].iter().all(|&d| pose_at(Stamp(t.0.saturating_add(d))).is_some());
     let kept: Vec<&CameraSample> = samples.iter().filter(|f| !f.points.is_empty() && covered(f.stamp)).collect();
     let points: usize = kept.iter().map(|f| f.points.len()).sum();
@@ -228,9 +241,12 @@ pub fn camera_against_map(
     // those of a turning robot, and a wrong yaw searched for a clock reads as one.
     let coarse_yaw = scorer.curve(&grid(0.0, search.yaw_span_rad, search.yaw_step_rad), |e| (0.0, e));
     let yaw_fixed = !flat(&coarse_yaw);
+    // A least cost at a grid's edge lies outside the search: not fixed.
+    let yaw_fixed = yaw_fixed && interior(&coarse_yaw);
     let e0 = if yaw_fixed { least(&coarse_yaw) } else { 0.0 };
     let coarse_clock = scorer.curve(&grid(0.0, search.clock_span_s, search.clock_step_s), |d| (d, e0));
     let clock_fixed = !flat(&coarse_clock);
+    let clock_fixed = clock_fixed && interior(&coarse_clock);
     let d0 = if clock_fixed { least(&coarse_clock) } else { 0.0 };
     // The two trade off where the robot turns one way for long (a turn seen late looks
     // like a turned mount): fine searches in turn until neither moves by a fine step.

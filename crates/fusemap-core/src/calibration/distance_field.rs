@@ -62,7 +62,7 @@ pub struct DistanceField {
     /// World position of the centre of cell (row 0, column 0).
     first_centre: Point2,
     max_m: f64,
-    /// Per cell, the index of its nearest face cell (`u32::MAX`: none within reach).
+    /// Per cell, the index of its nearest face cell (`u32::MAX` only before a face exists).
     nearest: Vec<u32>,
     /// Per cell, its surface point (faces only; others unused).
     surface: Vec<Point2>,
@@ -136,6 +136,10 @@ impl DistanceField {
                     || (r > 0 && free(i - w))
                     || (r + 1 < h && free(i + w)))
         };
+        // Face indices are kept as u32 (a raster is bounded by `limits.export_cells`, 10⁸).
+        if w.checked_mul(h).is_none_or(|n| n >= u32::MAX as usize) {
+            return None;
+        }
         let faces: Vec<bool> = (0..w * h).map(face).collect();
         if !faces.contains(&true) {
             return None;

@@ -6,10 +6,10 @@
 //! pixels fall in the obstacle band, not only where, and need the floor's own points; the
 //! report says so.
 
-use super::{claim, SensorCalibration};
+use super::{claim, shifted, SensorCalibration};
 use crate::map_pass::MapRun;
 use crate::track::Track;
-use fusemap_core::calibration::{camera_against_map, CameraLidarFit, CameraSearch, DistanceField, Interval};
+use fusemap_core::calibration::{camera_against_map, CameraLidarFit, CameraSearch, DistanceField};
 use fusemap_core::config::SensorKind;
 use fusemap_core::fusion::OBSTACLE_PROBABILITY;
 use fusemap_core::geometry::{Mount3, Point2};
@@ -61,17 +61,21 @@ pub(super) fn cameras_against_lidar(run: &MapRun, undetermined: &mut Vec<String>
         let pose_at = |t| track.pose_at(t, SyncMode::Interpolate).ok();
         let mount = report.extrinsics.base_from_sensor;
         let centre = Point2::new(mount.x, mount.y);
-        match camera_against_map(samples, centre, &pose_at, &field, &CameraSearch::default()) {
+        let search = CameraSearch::default();
+        match camera_against_map(samples, centre, &pose_at, &field, &search) {
             Ok(fit) => {
                 if fit.clock.is_none() {
-                    undetermined.push(why(
-                        "the clock offset: its cost is flat or least at the edge of ±0.3 s (a robot that never turns \
-                         while the camera sees the lidar's walls does not fix it)"
-                            .into(),
-                    ));
+                    undetermined.push(why(format!(
+                        "the clock offset: its cost is flat or least at the edge of ±{} s (a robot that never turns \
+                         while the camera sees the lidar's walls does not fix it)",
+                        search.clock_span_s
+                    )));
                 }
                 if fit.yaw.is_none() {
-                    undetermined.push(why("the mount yaw: its cost is flat or least at the edge of ±8°".into()));
+                    undetermined.push(why(format!(
+                        "the mount yaw: its cost is flat or least at the edge of ±{:.0}°",
+                        search.yaw_span_rad.to_degrees()
+                    )));
                 }
                 out.push(CameraEstimate { name: name.clone(), report: report.clone(), fit, base_turn: 0.0 });
             }
@@ -88,9 +92,10 @@ pub(super) fn cameras_against_lidar(run: &MapRun, undetermined: &mut Vec<String>
     out
 }
 
-/// A correction added to a configured value.
-fn shifted(i: Interval, by: f64) -> Interval {
-    Interval { value: i.value + by, low: i.low + by, high: i.high + by }
+/// A yaw interval moved into (−π, π] as a whole (its ends by the same turn).
+fn wrapped(i: fusemap_core::calibration::Interval) -> fusemap_core::calibration::Interval {
+    let turn = fusemap_core::geometry::normalize_angle(i.value) - i.value;
+    shifted(i, turn)
 }
 
 impl CameraEstimate {
@@ -107,7 +112,7 @@ impl CameraEstimate {
             kind: SensorKind::Camera,
             x: None,
             y: None,
-            yaw: f.yaw.map(|y| shifted(y, self.mount().yaw + self.base_turn)),
+            yaw: f.yaw.map(|y| wrapped(shifted(y, self.mount().yaw + self.base_turn))),
             time_offset_s: f.clock.map(|c| shifted(c, self.report.time_offset_s)),
             scale: None,
             wheel_base: None,

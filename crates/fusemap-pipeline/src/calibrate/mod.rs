@@ -146,11 +146,7 @@ impl CalibrateJob {
         let mut text = format!("# fusemap calibrate on {input}\n# A value whose interval holds the configured one is left as configured.\n");
         if let (Some(mut estimate), Some((name, topic, configured))) = (estimate, mount) {
             // The search's offset is relative to the configured one.
-            estimate.clock = estimate.clock.map(|c| Interval {
-                value: c.value + configured_offset,
-                low: c.low + configured_offset,
-                high: c.high + configured_offset,
-            });
+            estimate.clock = estimate.clock.map(|c| shifted(c, configured_offset));
             calibration.sensors = sensors_of(&estimate, &name, &configured, &mut undetermined);
             text.push_str(&calibration_toml(&estimate, &name, &topic, &configured, configured_offset));
             base_turn = claim(corrected(&estimate.motion, &configured).0, configured.yaw) - configured.yaw;
@@ -328,6 +324,11 @@ fn clock_minimum(steps_at: &dyn Fn(i64) -> Vec<MotionStep>, (from, to): (f64, f6
     Ok((vertex, (sigma2 / a).sqrt()))
 }
 
+/// A correction's interval moved by the configured value it corrects.
+fn shifted(i: Interval, by: f64) -> Interval {
+    Interval { value: i.value + by, low: i.low + by, high: i.high + by }
+}
+
 /// No change smaller than its interval is claimed: a configured value inside the
 /// estimate's interval stays.
 fn claim(i: Interval, configured: f64) -> f64 {
@@ -439,9 +440,8 @@ fn calibration_toml(est: &Estimate, name: &str, topic: &str, m: &Mount3, configu
         let _ = writeln!(s, "#   time_offset_s {:.4} s ({:.4} .. {:.4}), against the odometry", c.value, c.low, c.high);
     }
     let _ = writeln!(s, "[[sensor]]\nkind = \"lidar\"\nname = {}\ntopic = {}", q(name), q(topic));
-    if let Some(c) = est.clock {
-        let _ = writeln!(s, "time_offset_s = {}", claim(c, configured_offset));
-    }
+    // Always written: a table pasted without it would reset the clock to 0.
+    let _ = writeln!(s, "time_offset_s = {}", est.clock.map_or(configured_offset, |c| claim(c, configured_offset)));
     let (x, y) = lever.map_or((m.x, m.y), |[x, y]| (claim(x, m.x), claim(y, m.y)));
     let _ = writeln!(s, "\n[sensor.base_from_sensor]");
     for (k, v) in [("x", x), ("y", y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", claim(yaw, m.yaw))] {

@@ -115,7 +115,11 @@ pub(super) fn revalidate(
         .iter()
         .filter_map(|(s, a)| {
             let b = before.fused_hit_rates.iter().find(|(t, _)| t == s)?.1?;
-            (a.is_some_and(|a| a < b - HIT_RATE_SLACK)).then(|| format!("`{s}` {b:.3} → {:.3}", a.unwrap_or(0.0)))
+            // A sensor with no held-out point left after the calibration fell too.
+            (a.is_none_or(|a| a < b - HIT_RATE_SLACK)).then(|| match a {
+                Some(a) => format!("`{s}` {b:.3} → {a:.3}"),
+                None => format!("`{s}` {b:.3} → none"),
+            })
         })
         .collect();
     let worse = (judged(&after) && !judged(&before)) || !fell.is_empty();
@@ -128,7 +132,7 @@ pub(super) fn revalidate(
         )
     } else {
         format!(
-            "validated with the calibration pasted in: verdict {} → {}, the fused map's mean entropy {:.4} → {:.4} nats, no sensor's hit rate on it falls",
+            "validated with the calibration pasted in: verdict {} → {}, the fused map's mean entropy {:.4} → {:.4} nats, no sensor's hit rate on it falls by more than {HIT_RATE_SLACK}",
             code(before.verdict),
             code(after.verdict),
             before.fused_entropy_nats,

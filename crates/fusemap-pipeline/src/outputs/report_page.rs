@@ -90,7 +90,8 @@ fn nonzero(v: &Value) -> String {
     }
 }
 
-fn section(id: &str, title: &str, body: &str) -> String {
+/// A section of the page.
+pub(crate) fn section(id: &str, title: &str, body: &str) -> String {
     format!("<section id=\"{id}\"><h2>{}</h2>{body}</section>\n", escape(title))
 }
 
@@ -195,6 +196,9 @@ fn map(pictures: &[Picture]) -> String {
             100.0 * bar / shown_m.max(1e-9),
             title = escape(&p.title),
         );
+    }
+    if body.is_empty() {
+        body.push_str("<p class=\"none\">The run's pictures could not be read back.</p>");
     }
     section("map", "Map", &body)
 }

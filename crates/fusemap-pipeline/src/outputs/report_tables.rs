@@ -2,14 +2,10 @@
 //! maps and verdict, the calibration's estimates with their intervals and cost curves, and
 //! the estimator's rejections over time.
 
-use super::report_page::escape;
+use super::report_page::{escape, section};
 use super::svg_plot::{svg, Plot};
 use serde_json::Value;
 use std::fmt::Write;
-
-fn section(id: &str, title: &str, body: &str) -> String {
-    format!("<section id=\"{id}\"><h2>{}</h2>{body}</section>\n", escape(title))
-}
 
 fn f(v: &Value, digits: usize) -> String {
     v.as_f64().map_or("—".into(), |x| format!("{x:.digits$}"))

@@ -36,15 +36,23 @@ fn tick_step(span: f64) -> f64 {
     [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|s| *s >= raw).unwrap_or(10.0 * mag)
 }
 
-/// `[lo, hi]` of the finite values, widened to a non-empty range.
+/// `[lo, hi]` of the finite values, widened to a range a tick step can divide (a flat
+/// curve's span of a few ulps would give a step below the floats' spacing).
 fn range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     let (lo, hi) =
         values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
     if lo > hi {
         return None;
     }
-    let pad = if hi > lo { 0.0 } else { lo.abs().max(1.0) * 0.05 };
+    let least = 1e-6 * lo.abs().max(hi.abs()).max(1e-12);
+    let pad = if hi - lo > least { 0.0 } else { least.max(lo.abs() * 0.05) };
     Some((lo - pad, hi + pad))
+}
+
+/// The ticks of `[lo, hi]` at multiples of `step`, at most a dozen.
+fn ticks(lo: f64, hi: f64, step: f64) -> impl Iterator<Item = f64> {
+    let first = (lo / step).ceil();
+    (0..12).map(move |k| (first + k as f64) * step).take_while(move |&v| v <= hi + 1e-9 * step)
 }
 
 /// A number for a tick label: few digits, no trailing noise.
@@ -118,8 +126,7 @@ fn axes(s: &mut String, (x0, x1): (f64, f64), (y0, y1): (f64, f64), sx: &dyn Fn(
         H - BOTTOM - TOP
     );
     let (xs, ys) = (tick_step(x1 - x0), tick_step(y1 - y0));
-    let mut x = (x0 / xs).ceil() * xs;
-    while x <= x1 + 1e-9 * xs {
+    for x in ticks(x0, x1, xs) {
         let _ = write!(
             s,
             r##"<line x1="{0:.1}" x2="{0:.1}" y1="{1:.1}" y2="{2:.1}" stroke="#555"/><text x="{0:.1}" y="{3:.1}" font-size="11" text-anchor="middle">{4}</text>"##,
@@ -129,10 +136,8 @@ fn axes(s: &mut String, (x0, x1): (f64, f64), (y0, y1): (f64, f64), sx: &dyn Fn(
             H - BOTTOM + 16.0,
             label(x, xs)
         );
-        x += xs;
     }
-    let mut y = (y0 / ys).ceil() * ys;
-    while y <= y1 + 1e-9 * ys {
+    for y in ticks(y0, y1, ys) {
         let _ = write!(
             s,
             r##"<line x1="{0:.1}" x2="{1:.1}" y1="{2:.1}" y2="{2:.1}" stroke="#555"/><text x="{3:.1}" y="{4:.1}" font-size="11" text-anchor="end">{5}</text>"##,
@@ -143,7 +148,6 @@ fn axes(s: &mut String, (x0, x1): (f64, f64), (y0, y1): (f64, f64), sx: &dyn Fn(
             sy(y) + 4.0,
             label(y, ys)
         );
-        y += ys;
     }
 }
 
@@ -174,5 +178,9 @@ mod tests {
         assert!(s.starts_with("<svg") && s.ends_with("</svg>"));
         assert!(s.contains("<polyline") && s.contains("estimate") && s.contains("offset, s"));
         assert!(svg(&Plot { line: &[[f64::NAN, 1.0]], ..Default::default() }).is_none());
+        // A flat curve a few ulps high ends, with a dozen ticks at most.
+        let flat = [[0.0, 0.1], [1.0, 0.1 + f64::EPSILON / 8.0], [2.0, 1e-300]];
+        assert!(svg(&Plot { line: &flat[..2], ..Default::default() }).unwrap().matches("<text").count() < 30);
+        assert!(svg(&Plot { line: &flat[1..], ..Default::default() }).is_some());
     }
 }
