@@ -229,22 +229,7 @@ fn validate(
 ) -> Result<(Validation, Vec<Option<Raster>>), PipelineError> {
     let held = engine.held_out().cloned().unwrap_or_default();
     let all = sensors(engine);
-    let roles = [("m1", MapRole::Lidar), ("m2", MapRole::Camera), ("m3", MapRole::Fused)];
-    let mut built = Vec::new();
-    let mut not_built = Vec::new();
-    for (name, role) in roles.iter().copied() {
-        let m = engine.maps().by_name(name).expect("the validation's maps");
-        let used: Vec<String> =
-            all.iter().filter(|(id, _, kind)| m.sensors().includes(*id, *kind)).map(|(_, n, _)| n.clone()).collect();
-        match (used.is_empty(), m.grid().known_box()) {
-            (true, _) => not_built.push(format!("{name}: {}", missing(&role))),
-            (false, None) => not_built.push(format!(
-                "{name}: its sensors observed nothing before the held-out period (the log is shorter than the \
-                 training period, its stamps do not advance, or its sensors are silent until late)"
-            )),
-            (false, Some(b)) => built.push((name, role, used, m.grid(), b)),
-        }
-    }
+    let (built, mut not_built) = built_maps(engine, &all);
     if built.is_empty() {
         return Err(PipelineError::Refused(format!("nothing to validate: {}", not_built.join("; "))));
     }
@@ -261,7 +246,7 @@ fn validate(
     }
     let mut rasters: Vec<Option<Raster>> = vec![None, None, None];
     for (name, _, _, grid, _) in &built {
-        let slot = roles.iter().position(|r| r.0 == *name).expect("a role");
+        let slot = ROLES.iter().position(|r| r.0 == *name).expect("a role");
         rasters[slot] = Some(grid.raster(area));
     }
     // The same cells for every map (§5.1): those any map observed, unknown ones at the
@@ -272,7 +257,7 @@ fn validate(
     }
     let mut figures = Vec::new();
     for (name, role, used, grid, _) in built {
-        let slot = roles.iter().position(|r| r.0 == name).expect("a role");
+        let slot = ROLES.iter().position(|r| r.0 == name).expect("a role");
         let raster = rasters[slot].as_ref().expect("rastered above");
         figures.push(MapFigures {
             name: name.to_string(),
@@ -298,20 +283,7 @@ fn validate(
     let split = gain_split(&figures, &rasters, &shared);
     let mut judgement = judge(&figures, &motion, &plan.validation);
     if let (Verdict::NoGain, Some(_), Some(g)) = (judgement.verdict, judgement.fusion_gain_nats, &split) {
-        judgement.sentence.push_str(&format!(
-            ". Why: the {} map already knows {:.1} % of the cells, and there the fused map is {:.4} nats more \
-             certain on average ({:.1} % of them are at a clamp already, where no evidence lowers the entropy: \
-             map.clamp_min {} holds {:.3} nats); the {} cells only the fused map knows are {:.3} nats more certain \
-             each",
-            g.single,
-            100.0 * g.shared_cells as f64 / (g.shared_cells + g.added_cells).max(1) as f64,
-            g.shared_gain_nats,
-            100.0 * g.at_clamp_share,
-            plan.occupancy.clamp_min,
-            binary_entropy(plan.occupancy.clamp_min),
-            g.added_cells,
-            g.added_gain_nats
-        ));
+        judgement.sentence.push_str(&why_no_gain(g, plan));
     }
     let validation = Validation {
         holdout_share: plan.holdout_share,
@@ -324,6 +296,50 @@ fn validate(
         judgement,
     };
     Ok((validation, rasters))
+}
+
+/// The roles of the validation's maps, in the order of `fusion_validate.npz`.
+const ROLES: [(&str, MapRole); 3] = [("m1", MapRole::Lidar), ("m2", MapRole::Camera), ("m3", MapRole::Fused)];
+
+/// A map the pass built: its name, role, sensors, grid and observed box.
+type Built<'a> = (&'static str, MapRole, Vec<String>, &'a FusionGrid, CellBox);
+
+/// M1, M2 and M3 as the pass built them, and those it could not build, each with why.
+fn built_maps<'a>(engine: &'a Engine, all: &[(SensorId, String, SensorKind)]) -> (Vec<Built<'a>>, Vec<String>) {
+    let mut built = Vec::new();
+    let mut not_built = Vec::new();
+    for (name, role) in ROLES {
+        let m = engine.maps().by_name(name).expect("the validation's maps");
+        let used: Vec<String> =
+            all.iter().filter(|(id, _, kind)| m.sensors().includes(*id, *kind)).map(|(_, n, _)| n.clone()).collect();
+        match (used.is_empty(), m.grid().known_box()) {
+            (true, _) => not_built.push(format!("{name}: {}", missing(&role))),
+            (false, None) => not_built.push(format!(
+                "{name}: its sensors observed nothing before the held-out period (the log is shorter than the \
+                 training period, its stamps do not advance, or its sensors are silent until late)"
+            )),
+            (false, Some(b)) => built.push((name, role, used, m.grid(), b)),
+        }
+    }
+    (built, not_built)
+}
+
+/// Why the fusion gains nothing: where the cells are, and how certain.
+fn why_no_gain(g: &GainSplit, plan: &Plan) -> String {
+    format!(
+        ". Why: the {} map already knows {:.1} % of the cells, and there the fused map is {:.4} nats more \
+         certain on average ({:.1} % of them are at a clamp already, where no evidence lowers the entropy: \
+         map.clamp_min {} holds {:.3} nats); the {} cells only the fused map knows are {:.3} nats more certain \
+         each",
+        g.single,
+        100.0 * g.shared_cells as f64 / (g.shared_cells + g.added_cells).max(1) as f64,
+        g.shared_gain_nats,
+        100.0 * g.at_clamp_share,
+        plan.occupancy.clamp_min,
+        binary_entropy(plan.occupancy.clamp_min),
+        g.added_cells,
+        g.added_gain_nats
+    )
 }
 
 /// The figures of the leave-one-out maps, over the same cells as M1, M2 and M3 (M3 knows

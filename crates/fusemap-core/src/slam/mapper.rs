@@ -33,6 +33,18 @@ use crate::geometry::{normalize_angle, Point2, Pose2};
 use crate::time::Stamp;
 use std::time::Instant;
 
+/// Where a scan is searched from (`Mapper::predict`).
+struct Prediction {
+    /// The track's reading repeats the last one bit for bit.
+    held: bool,
+    /// The track's motion since the last scan, when it has a plausible one.
+    track_motion: Option<Pose2>,
+    /// The prediction.
+    predicted: Pose2,
+    /// The constant-velocity hypothesis.
+    moving: Option<Pose2>,
+}
+
 /// One scan as SLAM takes it. Points are in the base frame.
 #[derive(Clone, Copy, Debug)]
 pub struct ScanInput<'a> {
@@ -237,6 +249,42 @@ impl Slam {
             q.is_finite() && dx * dx + dy * dy <= max2
         };
         let hits: Vec<Point2> = scan.hits.iter().filter(in_range).copied().collect();
+        let Prediction { held, track_motion, predicted, moving } = self.predict(&scan);
+        let t0 = Instant::now();
+        let (local, outcome, information) = on_worker(|| self.match_local(&hits, predicted, moving, track_motion));
+        // The track is judged only by matches that pin the scan down in every direction: along
+        // a corridor the match's position is the track's own, and would flatter it.
+        let well_posed = information.is_some_and(|i| translation_conditioning(&i) >= WELL_POSED);
+        if let (Some(d), Some((before, _)), ScanOutcome::Matched, true) = (track_motion, self.last, outcome, well_posed)
+        {
+            self.odometry.observe(&self.p, d, before.inverse().compose(local));
+            self.report.odometry_samples += 1;
+        }
+        self.recent = [self.recent[1], Some((scan.stamp, local))];
+        self.report.matching_s += t0.elapsed().as_secs_f64();
+        match outcome {
+            ScanOutcome::Matched => self.report.matched += 1,
+            ScanOutcome::Degenerate => self.report.degenerate += 1,
+            _ => self.report.predicted += 1,
+        }
+        if !held {
+            self.last = Some((local, scan.track));
+            self.last_stamp = scan.stamp;
+        }
+        let anchor = self.nodes.last().map(|_| self.nodes.len() - 1);
+        self.scans.push(ScanRecord { stamp: scan.stamp, local, anchor });
+        if self.is_new_node(scan.stamp, local) && !held {
+            let misses: Vec<Point2> = scan.misses.iter().filter(|q| q.is_finite()).copied().collect();
+            self.add_node(scan.stamp, local, scan.track, scan.origin, hits, &misses, information);
+            self.scans.last_mut().expect("pushed above").anchor = Some(self.nodes.len() - 1);
+        }
+        outcome
+    }
+
+    /// The pose the scan is searched from: the last scan's moved by the track's motion
+    /// since (none across a held reading or a jump of the track), and the
+    /// constant-velocity hypothesis; counts held readings, jumps and scans without a track.
+    fn predict(&mut self, scan: &ScanInput) -> Prediction {
         // A reading that repeats the anchor's bit for bit is held, not a standstill: odometry
         // latched on the scan lines (CARMEN logs) repeats its last value for a few scans
         // during a fast turn, then jumps by the whole turn. It says nothing of the motion
@@ -281,44 +329,21 @@ impl Slam {
             }
             _ => None,
         };
-        let t0 = Instant::now();
-        let (local, outcome, information) = on_worker(|| self.match_local(&hits, predicted, moving, track_motion));
-        // The track is judged only by matches that pin the scan down in every direction: along
-        // a corridor the match's position is the track's own, and would flatter it.
-        let well_posed = information.is_some_and(|i| translation_conditioning(&i) >= WELL_POSED);
-        if let (Some(d), Some((before, _)), ScanOutcome::Matched, true) = (track_motion, self.last, outcome, well_posed)
-        {
-            self.odometry.observe(&self.p, d, before.inverse().compose(local));
-            self.report.odometry_samples += 1;
-        }
-        self.recent = [self.recent[1], Some((scan.stamp, local))];
-        self.report.matching_s += t0.elapsed().as_secs_f64();
-        match outcome {
-            ScanOutcome::Matched => self.report.matched += 1,
-            ScanOutcome::Degenerate => self.report.degenerate += 1,
-            _ => self.report.predicted += 1,
-        }
-        if !held {
-            self.last = Some((local, scan.track));
-            self.last_stamp = scan.stamp;
-        }
-        let anchor = self.nodes.last().map(|_| self.nodes.len() - 1);
-        self.scans.push(ScanRecord { stamp: scan.stamp, local, anchor });
-        let new_node = match self.nodes.last() {
+        Prediction { held, track_motion, predicted, moving }
+    }
+
+    /// Whether a scan at `stamp` placed at `local` is far enough (in distance, angle or
+    /// time) from the last node to be a node.
+    fn is_new_node(&self, stamp: Stamp, local: Pose2) -> bool {
+        match self.nodes.last() {
             None => true,
             Some(n) => {
                 let d = n.local.inverse().compose(local);
                 d.x.hypot(d.y) >= self.p.node_distance_m
                     || d.theta.abs() >= self.p.node_angle_rad
-                    || (scan.stamp.0 - n.stamp.0) as f64 * 1e-9 >= self.p.node_time_s
+                    || (stamp.0 - n.stamp.0) as f64 * 1e-9 >= self.p.node_time_s
             }
-        };
-        if new_node && !held {
-            let misses: Vec<Point2> = scan.misses.iter().filter(|q| q.is_finite()).copied().collect();
-            self.add_node(scan.stamp, local, scan.track, scan.origin, hits, &misses, information);
-            self.scans.last_mut().expect("pushed above").anchor = Some(self.nodes.len() - 1);
         }
-        outcome
     }
 
     /// Whether the track moving from `before` (at `t0`) to `now` (at `t1`) is faster than
