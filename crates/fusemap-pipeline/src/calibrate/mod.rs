@@ -49,6 +49,9 @@ const MAX_LEVER_INTERVAL_M: f64 = 0.05;
 pub struct CalibrateJob {
     /// The configuration, the log and the output directory.
     pub job: LogJob,
+    /// Validate again with the calibration pasted in (the command always does; it costs two
+    /// validation passes).
+    pub revalidate: bool,
 }
 
 /// One sensor's estimates (`summary.json`'s `calibration.sensors[]`).
@@ -113,7 +116,7 @@ pub struct CalibrateRun {
 impl CalibrateJob {
     /// `fusemap calibrate [--config C] --out DIR LOG`.
     pub fn plan(config: Option<&Path>, log: &Path, out: &Path) -> Result<Self, JobError> {
-        Ok(Self { job: LogJob::plan(config, log, out)? })
+        Ok(Self { job: LogJob::plan(config, log, out)?, revalidate: true })
     }
 
     /// Estimates, maps with the configuration as given, and writes the set: the map's
@@ -159,9 +162,11 @@ impl CalibrateJob {
         if !calibration.sensors.is_empty() {
             let path = outputs.staged(CALIBRATION_TOML);
             fusemap_io::atomic::write_atomic(&path, |w| std::io::Write::write_all(w, text.as_bytes()))?;
-            match revalidate::revalidate(plan, &inv, &text, progress).map_err(named)? {
-                Ok(r) => calibration.revalidation = Some(r),
-                Err(why) => undetermined.push(why),
+            if self.revalidate {
+                match revalidate::revalidate(plan, &inv, &text, progress).map_err(named)? {
+                    Ok(r) => calibration.revalidation = Some(r),
+                    Err(why) => undetermined.push(why),
+                }
             }
         }
         calibration.undetermined = undetermined;
