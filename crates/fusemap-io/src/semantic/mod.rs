@@ -172,9 +172,18 @@ pub fn write_semantic(yaml_path: &Path, raster: &SemanticRaster) -> Result<PathB
         Ok(())
     })?;
 
+    let yaml = semantic_yaml(raster, &image_name);
+    write_atomic(yaml_path, |w| w.write_all(yaml.as_bytes()))?;
+    Ok(image_path)
+}
+
+/// The YAML that describes `raster`'s classes and placement, naming `image` as its picture
+/// (`semantic.yaml`'s text; `map.mcap` keeps it in a metadata record).
+pub fn semantic_yaml(raster: &SemanticRaster, image: &str) -> String {
+    let k = raster.classes.len();
     let mut yaml = format!(
         "image: {}\nresolution: {}\norigin: [{}, {}, 0.0]\nunknown_index: {k}\nunknown_color: {}\nclasses:",
-        yaml_string(&image_name),
+        yaml_string(image),
         yaml_float(raster.resolution),
         yaml_float(raster.origin[0]),
         yaml_float(raster.origin[1]),
@@ -192,8 +201,7 @@ pub fn write_semantic(yaml_path: &Path, raster: &SemanticRaster) -> Result<PathB
             color(c.color)
         ));
     }
-    write_atomic(yaml_path, |w| w.write_all(yaml.as_bytes()))?;
-    Ok(image_path)
+    yaml
 }
 
 /// Writes the dynamic layer's probabilities as an 8-bit greyscale PNG, one pixel per

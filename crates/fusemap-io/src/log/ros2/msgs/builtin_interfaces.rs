@@ -9,6 +9,10 @@ use fusemap_core::time::Stamp;
 /// `builtin_interfaces/Time`: whole seconds plus nanoseconds.
 pub static TIME: MsgDef = MsgDef { name: "builtin_interfaces/Time", text: "int32 sec\nuint32 nanosec\n", deps: &[] };
 
+/// `builtin_interfaces/Duration`: a signed span, whole seconds plus nanoseconds.
+pub static DURATION: MsgDef =
+    MsgDef { name: "builtin_interfaces/Duration", text: "int32 sec\nuint32 nanosec\n", deps: &[] };
+
 /// Splits `stamp` into `(sec, nanosec)` with `0 <= nanosec < 1e9` (so a stamp before the
 /// epoch has negative `sec` and positive `nanosec`, as `rclcpp::Time` does); the inverse
 /// of [`Stamp::from_sec_nsec`].

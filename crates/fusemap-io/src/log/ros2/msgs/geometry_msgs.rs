@@ -19,6 +19,12 @@ pub static POSE: MsgDef = MsgDef {
     text: "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n",
     deps: &[&POINT, &QUATERNION],
 };
+/// `geometry_msgs/PoseStamped`.
+pub static POSE_STAMPED: MsgDef = MsgDef {
+    name: "geometry_msgs/PoseStamped",
+    text: "std_msgs/Header header\ngeometry_msgs/Pose pose\n",
+    deps: &[&HEADER, &POSE],
+};
 /// `geometry_msgs/PoseWithCovariance`.
 pub static POSE_WITH_COVARIANCE: MsgDef = MsgDef {
     name: "geometry_msgs/PoseWithCovariance",
@@ -145,6 +151,15 @@ pub struct Pose {
     pub position: Point,
     /// Orientation.
     pub orientation: Quaternion,
+}
+
+/// `geometry_msgs/msg/PoseStamped`: a pose at a time in a frame. Written only (paths).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PoseStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// The pose.
+    pub pose: Pose,
 }
 
 /// `geometry_msgs/msg/PoseWithCovariance`: a pose estimate with its uncertainty.
@@ -351,5 +366,12 @@ impl CdrEncode for TransformStamped {
         self.header.encode(w)?;
         w.string("child_frame_id", &self.child_frame_id)?;
         self.transform.encode(w)
+    }
+}
+
+impl CdrEncode for PoseStamped {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        self.pose.encode(w)
     }
 }

@@ -4,9 +4,10 @@
 //! and each exists once: both readers decode it through [`RosMsg`] (ROS 1's packed
 //! layout and ROS 2's CDR differ only below the field, in their [`FieldReader`]), and the
 //! rosbag2 writer encodes it ([`CdrEncode`]) under the `.msg` text of its [`MsgDef`]
-//! static, so a field can never be read one way and written another. Stamps are fusemap's
-//! [`Stamp`](fusemap_core::time::Stamp) (`time` or `builtin_interfaces/Time` on the
-//! wire).
+//! static, so a field can never be read one way and written another. The map messages
+//! fusemap only writes (occupancy grids, paths, point clouds, markers) have no reader.
+//! Stamps are fusemap's [`Stamp`](fusemap_core::time::Stamp) (`time` or
+//! `builtin_interfaces/Time` on the wire).
 //!
 //! [`RosMsg`]: wire::RosMsg
 //! [`FieldReader`]: wire::FieldReader
@@ -19,4 +20,5 @@ pub mod nav_msgs;
 pub mod sensor_msgs;
 pub mod std_msgs;
 pub mod tf2_msgs;
+pub mod visualization_msgs;
 pub mod wire;

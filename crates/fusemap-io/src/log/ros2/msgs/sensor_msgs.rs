@@ -1,5 +1,6 @@
 //! `sensor_msgs`: planar laser scans, inertial measurements, satellite navigation fixes,
-//! camera images and calibrations.
+//! camera images and calibrations (read and written), and the point clouds and compressed
+//! images fusemap writes beside its maps.
 
 use super::geometry_msgs::{Quaternion, Vector3, QUATERNION, VECTOR3};
 use super::std_msgs::{Header, HEADER};
@@ -436,5 +437,115 @@ impl CdrEncode for CameraInfo {
         w.u32(self.roi.width);
         w.bool(self.roi.do_rectify);
         Ok(())
+    }
+}
+
+/// `sensor_msgs/PointField`.
+pub static POINT_FIELD: MsgDef = MsgDef {
+    name: "sensor_msgs/PointField",
+    text: "uint8 INT8=1\nuint8 UINT8=2\nuint8 INT16=3\nuint8 UINT16=4\nuint8 INT32=5\nuint8 UINT32=6\n\
+           uint8 FLOAT32=7\nuint8 FLOAT64=8\nstring name\nuint32 offset\nuint8 datatype\nuint32 count\n",
+    deps: &[],
+};
+/// `sensor_msgs/PointCloud2`.
+pub static POINT_CLOUD2: MsgDef = MsgDef {
+    name: "sensor_msgs/PointCloud2",
+    text: "std_msgs/Header header\nuint32 height\nuint32 width\nsensor_msgs/PointField[] fields\n\
+           bool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense\n",
+    deps: &[&HEADER, &POINT_FIELD],
+};
+/// `sensor_msgs/CompressedImage`.
+pub static COMPRESSED_IMAGE: MsgDef = MsgDef {
+    name: "sensor_msgs/CompressedImage",
+    text: "std_msgs/Header header\nstring format\nuint8[] data\n",
+    deps: &[&HEADER],
+};
+
+/// `sensor_msgs/msg/PointField`: one field of a [`PointCloud2`]'s points. Written only.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PointField {
+    /// Its name (`x`, `intensity`, …).
+    pub name: String,
+    /// Byte offset in the point.
+    pub offset: u32,
+    /// Element type, one of the constants ([`PointField::FLOAT32`], …).
+    pub datatype: u8,
+    /// Elements.
+    pub count: u32,
+}
+
+impl PointField {
+    /// `uint16`.
+    pub const UINT16: u8 = 4;
+    /// `float32`.
+    pub const FLOAT32: u8 = 7;
+}
+
+/// `sensor_msgs/msg/PointCloud2`: points as packed records described by their fields.
+/// Written only.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PointCloud2 {
+    /// Stamp and frame.
+    pub header: Header,
+    /// Rows (1 for an unordered cloud).
+    pub height: u32,
+    /// Points per row.
+    pub width: u32,
+    /// The record layout.
+    pub fields: Vec<PointField>,
+    /// Multi-byte fields are big-endian.
+    pub is_bigendian: bool,
+    /// Bytes per point.
+    pub point_step: u32,
+    /// Bytes per row.
+    pub row_step: u32,
+    /// The records.
+    pub data: Vec<u8>,
+    /// No invalid (NaN) points.
+    pub is_dense: bool,
+}
+
+/// `sensor_msgs/msg/CompressedImage`: an encoded image (PNG, JPEG). Written only, empty,
+/// inside markers.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct CompressedImage {
+    /// Stamp and frame.
+    pub header: Header,
+    /// `png`, `jpeg`.
+    pub format: String,
+    /// The encoded bytes.
+    pub data: Vec<u8>,
+}
+
+impl CdrEncode for PointField {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        w.string("name", &self.name)?;
+        w.u32(self.offset);
+        w.u8(self.datatype);
+        w.u32(self.count);
+        Ok(())
+    }
+}
+
+impl CdrEncode for PointCloud2 {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        w.u32(self.height);
+        w.u32(self.width);
+        w.seq("fields", &self.fields)?;
+        w.bool(self.is_bigendian);
+        w.u32(self.point_step);
+        w.u32(self.row_step);
+        w.bytes("data", &self.data)?;
+        w.bool(self.is_dense);
+        Ok(())
+    }
+}
+
+impl CdrEncode for CompressedImage {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        self.header.encode(w)?;
+        w.string("format", &self.format)?;
+        w.bytes("data", &self.data)
     }
 }

@@ -1,4 +1,4 @@
-//! `std_msgs`: the header shared by stamped messages.
+//! `std_msgs`: the header shared by stamped messages, and colours.
 
 use super::builtin_interfaces::{write_time, TIME};
 use super::wire::{FieldReader, RosMsg};
@@ -39,5 +39,31 @@ impl CdrEncode for Header {
     fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
         write_time(w, "header.stamp", self.stamp)?;
         w.string("header.frame_id", &self.frame_id)
+    }
+}
+
+/// `std_msgs/ColorRGBA`.
+pub static COLOR_RGBA: MsgDef =
+    MsgDef { name: "std_msgs/ColorRGBA", text: "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n", deps: &[] };
+
+/// `std_msgs/msg/ColorRGBA`: a colour, each channel in [0, 1]. Written only (markers).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ColorRgba {
+    /// Red.
+    pub r: f32,
+    /// Green.
+    pub g: f32,
+    /// Blue.
+    pub b: f32,
+    /// Opacity (0 is invisible).
+    pub a: f32,
+}
+
+impl CdrEncode for ColorRgba {
+    fn encode(&self, w: &mut CdrWriter) -> Result<(), CdrWriteError> {
+        for c in [self.r, self.g, self.b, self.a] {
+            w.f32(c);
+        }
+        Ok(())
     }
 }

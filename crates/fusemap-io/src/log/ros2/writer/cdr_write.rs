@@ -207,6 +207,13 @@ impl CdrWriter {
         Ok(())
     }
 
+    /// An `int8[]` sequence (occupancy cells): the count, then the bytes.
+    pub fn i8_seq(&mut self, field: &'static str, v: &[i8]) -> Result<(), CdrWriteError> {
+        self.count(field, v.len())?;
+        self.buf.extend(v.iter().map(|&x| x as u8));
+        Ok(())
+    }
+
     /// A sequence of structs: the count, then each element.
     pub fn seq<T: CdrEncode>(&mut self, field: &'static str, v: &[T]) -> Result<(), CdrWriteError> {
         self.count(field, v.len())?;
