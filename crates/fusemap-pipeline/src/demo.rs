@@ -81,7 +81,7 @@ impl DemoJob {
         log["scenario_scores"] = serde_json::to_value(&scores)?;
         let bag_in_out = out.join(sim.bag.dir.strip_prefix(files.staged("")).unwrap_or(&sim.bag.dir));
         let source = format!("built-in production line, simulated to {}", bag_in_out.display());
-        let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
+        let export = ExportOptions::of(plan, None);
         let mut other_maps = Vec::new();
         let mut notes = run.notes.clone();
         for m in run.engine.maps().iter().skip(1) {

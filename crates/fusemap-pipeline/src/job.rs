@@ -159,7 +159,7 @@ impl MapJob {
         crop: Option<Crop>,
     ) -> Result<Self, JobError> {
         let plan = plan_of(config)?;
-        let export = ExportOptions { crop, export_cells: plan.limits.export_cells };
+        let export = ExportOptions::of(&plan, crop);
         if let Some(c) = &crop {
             crop_area(&plan.geometry, c, export.export_cells)?;
         }
@@ -197,7 +197,7 @@ impl MapJob {
         out: &Path,
     ) -> Result<Self, JobError> {
         let plan = plan_of(config)?;
-        let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
+        let export = ExportOptions::of(&plan, None);
         let inputs = config.map(Path::to_path_buf).into_iter().collect();
         let source = MapSource::World { world, scanner, poses, name: name.to_string() };
         Ok(Self { plan, source, out: out.to_path_buf(), export, inputs })

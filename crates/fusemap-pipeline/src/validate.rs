@@ -189,7 +189,7 @@ impl ValidateJob {
             validation: Some(serde_json::to_value(&validation)?),
             calibration: None,
         };
-        let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
+        let export = ExportOptions::of(plan, None);
         let summary = finish(&run.engine, outputs, &export, record)?;
         Ok(ValidateRun { summary, validation })
     }

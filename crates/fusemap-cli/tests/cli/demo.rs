@@ -178,8 +178,25 @@ fn demo_writes_every_output_and_prints_its_summary() {
     // hold two locks.
     assert_eq!(
         file_names(&out),
-        [".fusemap.lock", "map.npz", "map.pgm", "map.png", "map.yaml", "report.html", "summary.json"]
+        [
+            ".fusemap.lock",
+            "map.mcap",
+            "map.npz",
+            "map.pcd",
+            "map.pgm",
+            "map.ply",
+            "map.png",
+            "map.yaml",
+            "report.html",
+            "summary.json"
+        ]
     );
+    // Foxglove's, ROS 2's and the point-cloud tools' readers agree with map.pgm.
+    if let Some(c) = crate::util::check_map_outputs(&out) {
+        assert_eq!(c["topics"], serde_json::json!(["/map", "/map_points", "/trajectory"]), "{c}");
+        assert_eq!(c["poses"], 0, "a world run has no track: {c}");
+        assert!(c["occupied"].as_u64().unwrap() > 100, "{c}");
+    }
     for name in file_names(&out).into_iter().filter(|n| n != ".fusemap.lock") {
         assert!(!(name.starts_with('.') && name.contains(".tmp")), "temp file left: {name}");
         assert!(std::fs::metadata(out.join(&name)).unwrap().len() > 0, "{name} is empty");
@@ -634,5 +651,38 @@ fn outputs_never_overwrite_inputs() {
         let left: Vec<String> = file_names(&out).into_iter().filter(|n| n != "sub").collect();
         assert_eq!(left, [name], "nothing else may be written");
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `[output]` turns the optional formats off one by one; a second run into the same
+/// directory removes the files the first wrote and it does not.
+#[test]
+fn the_output_table_chooses_the_optional_formats() {
+    let dir = temp_dir("output-table");
+    let out = dir.join("out");
+    assert_success(&run(&["demo", "--corridor", "--out", path_str(&out)]));
+    assert!(["map.mcap", "map.pcd", "map.ply"].iter().all(|f| out.join(f).is_file()));
+    let config = write_file(&dir, "c.toml", "[output]\nmcap = false\npcd = false\n");
+    assert_success(&run(&["demo", "--corridor", "--config", path_str(&config), "--out", path_str(&out)]));
+    let names = file_names(&out);
+    assert!(names.contains(&"map.ply".to_string()), "{names:?}");
+    assert!(!names.contains(&"map.mcap".to_string()) && !names.contains(&"map.pcd".to_string()), "{names:?}");
+    let listed: Vec<String> = read_json(&out.join("summary.json"))["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["name"].as_str().unwrap().to_string())
+        .collect();
+    assert!(listed.contains(&"map.ply".to_string()) && !listed.contains(&"map.mcap".to_string()), "{listed:?}");
+    let config = write_file(&dir, "bad.toml", "[output]\nmcap = \"yes\"\n");
+    let line = crate::util::one_line_error(&run(&[
+        "demo",
+        "--corridor",
+        "--config",
+        path_str(&config),
+        "--out",
+        path_str(&out),
+    ]));
+    assert!(line.contains("bad.toml:2") && line.contains("expected a boolean"), "{line}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

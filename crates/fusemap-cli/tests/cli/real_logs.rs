@@ -89,6 +89,13 @@ fn intel_raw_bag_maps() {
     for f in ["slam.png", "trajectory.tum", "map.png"] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
+    // The map as ROS 2 messages and point clouds, read by third-party readers, agrees with
+    // map.pgm and trajectory.tum; SLAM's loop closures come as markers.
+    if let Some(c) = crate::util::check_map_outputs(&dir) {
+        let topics = serde_json::json!(["/map", "/map_points", "/slam/loop_closures", "/trajectory"]);
+        assert_eq!(c["topics"], topics, "{c}");
+        assert_eq!(c["pcd_fields"], serde_json::json!(["x", "y", "z", "probability"]), "{c}");
+    }
     // The README's benchmark command: every relation finds its scans' poses in
     // trajectory.tum, and the error is the one the SLAM-benchmark test asserts (within 1.5×
     // Cartographer's 0.0229 m; the same code path, so the same figure).

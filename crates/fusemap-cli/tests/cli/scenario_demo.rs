@@ -78,6 +78,16 @@ fn the_scenario_demo_writes_three_scored_maps_and_their_layers() {
     let (w, h) = (info.info().width, info.info().height);
     assert!(w > 4 * h, "five panels side by side: {w} x {h}");
 
+    // map.mcap, map.pcd and map.ply through third-party readers: /map's cells are
+    // map.pgm's, /trajectory has trajectory.tum's poses, the points are the occupied
+    // cells, and the camera's layers and classes come along.
+    if let Some(c) = crate::util::check_map_outputs(&out) {
+        let topics = ["/map", "/map/dynamic", "/map/semantic", "/map_points", "/slam/loop_closures", "/trajectory"];
+        assert_eq!(c["topics"], serde_json::json!(topics), "{c}");
+        assert_eq!(c["pcd_fields"], serde_json::json!(["x", "y", "z", "probability", "class", "rgb"]), "{c}");
+        assert!(c["poses"].as_u64().unwrap() > 1000, "{c}");
+    }
+
     if python_with(&["numpy"]) {
         let npz = out.join("map.npz");
         let js: serde_json::Value =

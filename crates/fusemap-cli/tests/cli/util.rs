@@ -111,3 +111,23 @@ pub fn run_python(script: &str, args: &[&std::ffi::OsStr]) -> String {
     assert!(o.status.success(), "python failed:\nstdout: {}\nstderr: {}", stdout(&o), stderr(&o));
     stdout(&o)
 }
+
+/// Reads `dir`'s `map.mcap`, `map.pcd` and `map.ply` with third-party readers
+/// (`tests/fixtures/check_map_outputs.py`: mcap-ros2-support, rosbags with ROS 2 Humble's
+/// definitions, pypcd4, plyfile) and checks them against `map.pgm` and `trajectory.tum`,
+/// classifying `/map` with the default thresholds. Returns the script's counts, `None`
+/// when the readers are missing (a skip).
+pub fn check_map_outputs(dir: &Path) -> Option<serde_json::Value> {
+    if !python_with(&["mcap_ros2", "rosbags", "plyfile", "pypcd4", "numpy"]) {
+        return None;
+    }
+    let params = fusemap_core::grid::OccupancyParams::default();
+    let o = python()
+        .arg(repo_file("tests/fixtures/check_map_outputs.py"))
+        .arg(dir)
+        .args([params.occupied_threshold.to_string(), params.free_threshold.to_string()])
+        .output()
+        .expect("cannot start python");
+    assert!(o.status.success(), "map outputs disagree:\nstdout: {}\nstderr: {}", stdout(&o), stderr(&o));
+    Some(serde_json::from_str(&stdout(&o)).expect("the checker prints JSON"))
+}

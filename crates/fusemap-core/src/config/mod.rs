@@ -11,6 +11,7 @@ mod fusion;
 mod limits;
 mod log;
 mod map;
+mod output;
 mod plan;
 mod pose_sensor;
 mod sensor;
@@ -22,6 +23,7 @@ pub use fusion::FusionConfig;
 pub use limits::LimitsConfig;
 pub use log::{ExtrinsicsSource, LogConfig, PoseSource, SyncConfig};
 pub use map::MapConfig;
+pub use output::OutputConfig;
 pub use plan::auto_sensor;
 pub use sensor::{GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 pub use slam::{SlamConfig, SlamMode};
@@ -64,6 +66,9 @@ pub struct Config {
     /// `fusemap validate`: the held-out share and the verdict's thresholds (§5).
     #[serde(default)]
     pub validate: ValidateConfig,
+    /// Which optional map formats a run writes (`map.mcap`, `map.pcd`, `map.ply`).
+    #[serde(default)]
+    pub output: OutputConfig,
 }
 
 /// A configuration error names the field ([`FieldError`], the error of every parameter
@@ -147,6 +152,8 @@ pub struct Plan {
     pub holdout_share: f64,
     /// The validation verdict's thresholds (`[validate]`).
     pub validation: Thresholds,
+    /// The optional map formats to write (`[output]`).
+    pub output: OutputConfig,
 }
 
 impl Config {
@@ -194,6 +201,7 @@ impl Config {
             limits: self.limits,
             holdout_share: self.validate.holdout_share,
             validation,
+            output: self.output,
         })
     }
 

@@ -183,7 +183,7 @@ impl CalibrateJob {
             validation: None,
             calibration: Some(serde_json::to_value(&calibration)?),
         };
-        let export = ExportOptions { crop: None, export_cells: plan.limits.export_cells };
+        let export = ExportOptions::of(plan, None);
         let summary = finish(&run.engine, outputs, &export, record)?;
         Ok(CalibrateRun { summary, calibration })
     }

@@ -29,6 +29,12 @@ pub struct OutputFiles {
     /// `slam.png`: the optimised trajectory and its loop closures over the map, for a run
     /// SLAM corrected.
     pub slam: PathBuf,
+    /// `map.mcap`: the map as ROS 2 messages.
+    pub mcap: PathBuf,
+    /// `map.pcd`: the occupied cells as a PCL point cloud.
+    pub pcd: PathBuf,
+    /// `map.ply`: the same points as PLY.
+    pub ply: PathBuf,
 }
 
 impl OutputFiles {
@@ -45,12 +51,15 @@ impl OutputFiles {
             semantic_png: dir.join("semantic.png"),
             dynamic: dir.join("dynamic.png"),
             slam: dir.join("slam.png"),
+            mcap: dir.join("map.mcap"),
+            pcd: dir.join("map.pcd"),
+            ply: dir.join("map.ply"),
         }
     }
 
     /// The file names of a run's set, for removing an earlier run's files this run does
     /// not write.
-    pub const NAMES: [&'static str; 13] = [
+    pub const NAMES: [&'static str; 16] = [
         "map.npz",
         "map.yaml",
         "map.pgm",
@@ -64,9 +73,12 @@ impl OutputFiles {
         "fusion_validate.npz",
         "calibration.toml",
         "report.html",
+        "map.mcap",
+        "map.pcd",
+        "map.ply",
     ];
 
-    pub(crate) fn all(&self) -> [&PathBuf; 10] {
+    pub(crate) fn all(&self) -> [&PathBuf; 13] {
         [
             &self.npz,
             &self.yaml,
@@ -78,6 +90,9 @@ impl OutputFiles {
             &self.semantic_png,
             &self.dynamic,
             &self.slam,
+            &self.mcap,
+            &self.pcd,
+            &self.ply,
         ]
     }
 }

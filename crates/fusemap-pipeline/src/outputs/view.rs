@@ -4,6 +4,7 @@
 //! still written instead of failing after it was built.
 
 use super::OutputError;
+use fusemap_core::config::{OutputConfig, Plan};
 use fusemap_core::geometry::Point2;
 use fusemap_core::grid::{CellBox, ExtraLayers, GridGeometry, LayeredGrid, Raster, SparseTiles};
 
@@ -43,11 +44,24 @@ pub struct ExportOptions {
     pub crop: Option<Crop>,
     /// `[limits] export_cells`.
     pub export_cells: u64,
+    /// `[output]`: the optional formats to write.
+    pub formats: OutputConfig,
 }
 
 impl Default for ExportOptions {
     fn default() -> Self {
-        Self { crop: None, export_cells: fusemap_core::config::LimitsConfig::default().export_cells }
+        Self {
+            crop: None,
+            export_cells: fusemap_core::config::LimitsConfig::default().export_cells,
+            formats: OutputConfig::default(),
+        }
+    }
+}
+
+impl ExportOptions {
+    /// The export `plan` asks for, with `crop` when the user gave one.
+    pub fn of(plan: &Plan, crop: Option<Crop>) -> Self {
+        Self { crop, export_cells: plan.limits.export_cells, formats: plan.output }
     }
 }
 
@@ -219,10 +233,10 @@ mod tests {
     fn past_the_export_budget_the_map_is_sparse_and_a_crop_is_dense() {
         let g = two_sites(50.0);
         let mut notes = Vec::new();
-        let within = ExportOptions { crop: None, export_cells: 1_000 };
+        let within = ExportOptions { crop: None, export_cells: 1_000, ..Default::default() };
         assert!(matches!(view_of(&g, &within, None, &mut notes).unwrap(), MapView::Dense(_)));
         assert!(notes.is_empty());
-        let tight = ExportOptions { crop: None, export_cells: 100 };
+        let tight = ExportOptions { crop: None, export_cells: 100, ..Default::default() };
         let MapView::Sparse { tiles, overview, .. } = view_of(&g, &tight, None, &mut notes).unwrap() else {
             panic!("sparse")
         };
@@ -230,11 +244,13 @@ mod tests {
         assert_eq!(overview.resolution, 0.1);
         assert!(notes[0].contains("limits.export_cells = 100") && notes[0].contains("--crop"), "{}", notes[0]);
         assert_eq!(overview.log_odds, g.known_raster().unwrap().log_odds);
-        let crop = ExportOptions { crop: Some(parse_crop("49,-1,53,1").unwrap()), export_cells: 1_000 };
+        let crop =
+            ExportOptions { crop: Some(parse_crop("49,-1,53,1").unwrap()), export_cells: 1_000, ..Default::default() };
         let MapView::Dense(r) = view_of(&g, &crop, None, &mut notes).unwrap() else { panic!("dense") };
         assert_eq!((r.width, r.height), (41, 21));
         assert!(r.known_count() > 0);
-        let big = ExportOptions { crop: Some(parse_crop("0,0,100,100").unwrap()), export_cells: 1_000 };
+        let big =
+            ExportOptions { crop: Some(parse_crop("0,0,100,100").unwrap()), export_cells: 1_000, ..Default::default() };
         let e = view_of(&g, &big, None, &mut notes).err().unwrap().to_string();
         assert!(e.contains("limits.export_cells = 1000") && e.contains("1001 x 1001"), "{e}");
     }
@@ -243,7 +259,8 @@ mod tests {
     fn a_dense_raster_the_memory_budget_cannot_hold_is_written_sparsely() {
         let g = two_sites(50.0);
         let n = g.known_box().map(cells).unwrap() as u64;
-        let (mut notes, options) = (Vec::new(), ExportOptions { crop: None, export_cells: 1_000_000 });
+        let (mut notes, options) =
+            (Vec::new(), ExportOptions { crop: None, export_cells: 1_000_000, ..Default::default() });
         let ample = ExportRoom { bytes: 9 * n, per_cell: 9 };
         assert!(matches!(view_of(&g, &options, Some(ample), &mut notes).unwrap(), MapView::Dense(_)));
         let short = ExportRoom { bytes: 9 * n - 1, per_cell: 9 };

@@ -3,11 +3,13 @@
 //! `summary.json` goes last with each file's size and SHA-256. A failing run leaves the
 //! previous set as it was; no output is ever written over an input.
 
+use super::map_formats::write_map_formats;
 use super::report_page::{self, Picture};
 use super::set::{OutputFiles, Outputs};
 use super::summary::{CellsUpdated, MapInfo, Summary};
 use super::view::{view_of, ExportOptions, ExportRoom, MapView};
 use super::OutputError;
+use fusemap_core::config::OutputConfig;
 use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells, shown_classes};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::{Point2, Pose2};
@@ -114,6 +116,7 @@ pub fn write(
     layers: Option<&Layers>,
     summary: &mut Summary,
     trajectory: Option<&[(Stamp, Pose2)]>,
+    formats: OutputConfig,
 ) -> Result<(), OutputError> {
     let Outputs { files, set, owned } = outputs;
     if let Some(t) = trajectory {
@@ -136,9 +139,11 @@ pub fn write(
         }
         fusemap_io::map_server::write_map_server(&files.yaml, r)?;
         fusemap_io::picture::write_map_png(&files.png, r)?;
-        if let Some((trajectory, closures, fixes)) = graph {
-            fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, &trajectory, &closures, &fixes)?;
+        if let Some((trajectory, closures, fixes)) = &graph {
+            fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, trajectory, closures, fixes)?;
         }
+        let closures = graph.as_ref().map_or(&[][..], |g| &g.1[..]);
+        write_map_formats(&files, formats, r, layers, trajectory.unwrap_or_default(), closures)?;
     }
     let value =
         serde_json::to_value(&*summary).map_err(|e| fusemap_io::Error::io(&files.summary, std::io::Error::other(e)))?;
@@ -353,8 +358,18 @@ pub fn finish(
     if matches!(view, MapView::Sparse { .. }) && camera_of(engine).is_some() {
         summary.notes.push("the semantic and dynamic layers are written only with a dense map (--crop)".into());
     }
+    if matches!(view, MapView::Sparse { .. }) {
+        let f = export.formats;
+        if f.mcap || f.pcd || f.ply {
+            summary.notes.push(
+                "map.mcap, map.pcd and map.ply are written only with a dense map (--crop a region within \
+                 limits.export_cells)"
+                    .into(),
+            );
+        }
+    }
     summary.wall_time_s = started.elapsed().as_secs_f64();
-    write(outputs, &view, layers.as_ref(), &mut summary, trajectory)?;
+    write(outputs, &view, layers.as_ref(), &mut summary, trajectory, export.formats)?;
     summary.wall_time_s = started.elapsed().as_secs_f64();
     Ok(summary)
 }

@@ -1,0 +1,25 @@
+//! `[output]`: which of a run's optional map formats are written. The map itself
+//! (`map.npz`, `map.pgm` + `map.yaml`, `map.png`), `trajectory.tum`, `summary.json` and
+//! `report.html` are always written; these are the hand-overs to other tools (§4.4).
+
+use serde::{Deserialize, Serialize};
+
+/// The `[output]` table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OutputConfig {
+    /// `map.mcap`: the map, the track and the occupied cells as ROS 2 messages
+    /// (`nav_msgs/OccupancyGrid`, `nav_msgs/Path`, `sensor_msgs/PointCloud2`), for
+    /// Foxglove, `ros2 bag play` and RViz.
+    pub mcap: bool,
+    /// `map.pcd`: the occupied cells as a PCL point cloud (v0.7, binary).
+    pub pcd: bool,
+    /// `map.ply`: the same points as a binary little-endian PLY.
+    pub ply: bool,
+}
+
+impl Default for OutputConfig {
+    fn default() -> Self {
+        Self { mcap: true, pcd: true, ply: true }
+    }
+}

@@ -1,0 +1,50 @@
+//! The optional hand-over formats of a dense map (`[output]`): `map.mcap` (ROS 2
+//! messages for Foxglove, `ros2 bag play` and RViz2), `map.pcd` and `map.ply` (the
+//! occupied cells as points for PCL, Open3D and CloudCompare).
+
+use super::set::OutputFiles;
+use super::write::Layers;
+use super::OutputError;
+use fusemap_core::config::OutputConfig;
+use fusemap_core::geometry::{Point2, Pose2};
+use fusemap_core::grid::Raster;
+use fusemap_core::time::Stamp;
+use fusemap_io::map_mcap::{write_map_mcap, MapMessages};
+use fusemap_io::point_cloud::{write_pcd, write_ply, MapCloud};
+
+/// Writes the formats `formats` turns on for the dense map `r`: nothing for a map with no
+/// observed cell.
+pub(crate) fn write_map_formats(
+    files: &OutputFiles,
+    formats: OutputConfig,
+    r: &Raster,
+    layers: Option<&Layers>,
+    trajectory: &[(Stamp, Pose2)],
+    closures: &[(Point2, Point2)],
+) -> Result<(), OutputError> {
+    if r.known_count() == 0 || !(formats.mcap || formats.pcd || formats.ply) {
+        return Ok(());
+    }
+    let picture = layers.map(Layers::picture);
+    let classes = picture.as_ref().map(|s| (s.best.as_slice(), s.classes.as_slice()));
+    let cloud = MapCloud::occupied_cells(r, classes);
+    if formats.pcd {
+        write_pcd(&files.pcd, &cloud)?;
+    }
+    if formats.ply {
+        write_ply(&files.ply, &cloud)?;
+    }
+    if formats.mcap {
+        let content = MapMessages {
+            raster: r,
+            stamp: trajectory.last().map_or(Stamp(0), |p| p.0),
+            trajectory,
+            cloud: &cloud,
+            semantic: picture.as_ref(),
+            dynamic: layers.map(|l| &l.dynamic),
+            closures,
+        };
+        write_map_mcap(&files.mcap, &content)?;
+    }
+    Ok(())
+}
