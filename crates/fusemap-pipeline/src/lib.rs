@@ -36,6 +36,7 @@ pub mod estimation;
 pub mod estimation_report;
 pub mod extrinsics;
 pub mod gnss_fixes;
+pub mod in_memory;
 mod insert;
 pub mod job;
 mod lidar_frames;
