@@ -75,6 +75,9 @@ class Grid:
     the defaults)."""
 
     def __init__(self, resolution: Optional[float] = None, config: Config = None) -> None:
+        """``config``: a TOML file's path or TOML text (with a newline); ``resolution``
+        replaces its ``[map] resolution``. Calls from several threads wait for each
+        other."""
         self._grid = _fusemap.Grid(resolution, _config(config))
 
     def insert_scan(self, ranges: Any, angle_min: float, angle_increment: float,
@@ -87,7 +90,9 @@ class Grid:
     def insert_points(self, points: Any, pose: tuple, stamp: float) -> None:
         """Inserts obstacle points (N × 2, x y in the base frame, metres) seen from
         ``pose``: free space along each ray from the lidar's mount, occupied at the point."""
-        p = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        p = np.ascontiguousarray(points, dtype=np.float64)
+        if p.ndim != 2 or p.shape[1] != 2:
+            raise ValueError(f"points must be N x 2 (x, y), got shape {p.shape}")
         self._grid.insert_points(p, tuple(map(float, pose)), float(stamp))
 
     def arrays(self) -> dict:

@@ -21,6 +21,7 @@ use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// An error and its causes on one line, as the CLI prints it after `error: `.
 fn message(e: &dyn std::error::Error) -> String {
@@ -54,19 +55,31 @@ fn job_error(e: JobError) -> PyErr {
     }
 }
 
-/// The plan of `config`: a path to a TOML file, the TOML text itself, or the defaults.
-fn plan_of(config: Option<&str>) -> PyResult<Plan> {
-    let Some(config) = config else {
-        return Config::default().validate().map_err(|e| PyValueError::new_err(format!("configuration: {e}")));
-    };
+/// The configuration `config` names: a TOML file's path (an existing file, or any text
+/// without a newline: a missing file is then an `OSError`), or the TOML text itself.
+fn config_of(config: &str) -> PyResult<(Config, PathBuf, String)> {
     let path = Path::new(config);
-    let is_text = config.contains('\n') || config.contains('=') || config.contains('[');
-    if !is_text || path.is_file() {
-        return fusemap_io::config_file::load_plan(path).map_err(io_error);
+    if path.is_file() || !config.contains('\n') {
+        let text = fusemap_io::config_file::read_text(path).map_err(io_error)?;
+        let parsed = fusemap_io::config_file::parse_config_str(&text, path).map_err(io_error)?;
+        return Ok((parsed, path.to_path_buf(), text));
     }
-    fusemap_io::config_file::parse_plan_str(config, Path::new("<config string>"))
-        .map(|(_, plan)| plan)
-        .map_err(io_error)
+    let name = PathBuf::from("<config string>");
+    let parsed = fusemap_io::config_file::parse_config_str(config, &name).map_err(io_error)?;
+    Ok((parsed, name, config.to_string()))
+}
+
+/// The plan of `config` (see [`config_of`]; the defaults without), with the map's
+/// resolution replaced by `resolution` when given. Field errors name the file and line.
+fn plan_of(config: Option<&str>, resolution: Option<f64>) -> PyResult<Plan> {
+    let (mut parsed, path, text) = match config {
+        Some(c) => config_of(c)?,
+        None => (Config::default(), PathBuf::from("<defaults>"), String::new()),
+    };
+    if let Some(r) = resolution {
+        parsed.map.resolution = r;
+    }
+    parsed.validate().map_err(|e| io_error(fusemap_io::config_file::field_error(&path, &text, &e.field, e.message)))
 }
 
 /// The raster's arrays as numpy arrays, row 0 = lowest y: occupancy (float32), log-odds
@@ -127,17 +140,19 @@ fn mapped_fields<'py>(py: Python<'py>, m: MappedLog) -> PyResult<Bound<'py, PyDi
 #[pyfunction]
 #[pyo3(signature = (path, config=None))]
 fn map_log_fields<'py>(py: Python<'py>, path: PathBuf, config: Option<String>) -> PyResult<Bound<'py, PyDict>> {
-    let plan = plan_of(config.as_deref())?;
+    let plan = plan_of(config.as_deref(), None)?;
     // Boxed: a job error is large, and it crosses the detach boundary by value.
     let mapped = py.detach(|| map_log_in_memory(&plan, &path).map_err(Box::new)).map_err(|e| job_error(*e))?;
     mapped_fields(py, mapped)
 }
 
 /// An occupancy grid mapped online with one lidar: the config's `[map]` and the first
-/// lidar's model (or the defaults), scans and points inserted one call at a time.
-#[pyclass(module = "fusemap._fusemap")]
+/// lidar's model (or the defaults), scans and points inserted one call at a time. The
+/// engine sits behind a mutex: calls from several threads (an rclpy multi-threaded
+/// executor) wait for each other, with the GIL released while they map.
+#[pyclass(module = "fusemap._fusemap", frozen)]
 struct Grid {
-    engine: Engine,
+    inner: Mutex<Engine>,
     lidar: SensorId,
     plan: Plan,
 }
@@ -148,25 +163,19 @@ impl Grid {
     #[new]
     #[pyo3(signature = (resolution=None, config=None))]
     fn new(resolution: Option<f64>, config: Option<String>) -> PyResult<Self> {
-        let mut plan = plan_of(config.as_deref())?;
-        if let Some(res) = resolution {
-            let mut c = Config::default();
-            c.map.resolution = res;
-            let geometry = c.validate().map_err(|e| PyValueError::new_err(format!("resolution: {e}")))?.geometry;
-            plan.geometry = geometry;
-        }
+        let plan = plan_of(config.as_deref(), resolution)?;
         let mut engine = Engine::new(FusionGrid::new(plan.geometry, plan.occupancy));
         engine.set_limits(&plan.limits);
         let lidar = plan.lidars.first().ok_or_else(|| PyValueError::new_err("the configuration enables no lidar"))?;
         let lidar = engine.add_lidar(lidar.name.clone(), lidar.model);
-        Ok(Self { engine, lidar, plan })
+        Ok(Self { inner: Mutex::new(engine), lidar, plan })
     }
 
     /// Inserts one scan: `ranges` (metres, float32; NaN, inf, 0 are handled as the
     /// lidar model says), beam `i` at `angle_min + i * angle_increment` radians, taken
     /// with the base at `pose` = (x, y, yaw) in the map frame, at `stamp` seconds.
     fn insert_scan(
-        &mut self,
+        &self,
         py: Python<'_>,
         ranges: PyReadonlyArray1<'_, f32>,
         angle_min: f64,
@@ -178,8 +187,7 @@ impl Grid {
         let ranges = ranges.as_slice().map_err(|e| PyValueError::new_err(e.to_string()))?.to_vec();
         let scan = LaserScan { stamp, angle_min, angle_increment, ranges };
         let pose = Pose2::new(pose.0, pose.1, pose.2);
-        let (engine, lidar) = (&mut self.engine, self.lidar);
-        py.detach(|| engine.insert_scan(lidar, &scan, pose))
+        py.detach(|| self.engine().insert_scan(self.lidar, &scan, pose))
             .map(|_| ())
             .map_err(|e| PyValueError::new_err(e.to_string()))
     }
@@ -188,7 +196,7 @@ impl Grid {
     /// metres), each the end of a ray from the lidar's mount; a point past the lidar's
     /// maximum range clears its ray up to that range and marks nothing.
     fn insert_points(
-        &mut self,
+        &self,
         py: Python<'_>,
         points: PyReadonlyArray2<'_, f64>,
         pose: (f64, f64, f64),
@@ -199,7 +207,7 @@ impl Grid {
         if points.ncols() != 2 {
             return Err(PyValueError::new_err(format!("points must be N x 2, got N x {}", points.ncols())));
         }
-        let model = self.engine.lidar_model(self.lidar).ok_or_else(|| PyValueError::new_err("no lidar"))?;
+        let model = *self.engine().lidar_model(self.lidar).ok_or_else(|| PyValueError::new_err("no lidar"))?;
         let world_from_base = Pose2::new(pose.0, pose.1, pose.2);
         let origin = world_from_base.transform_point(model.mount().origin_in_base());
         let max_range = model.params().max_range;
@@ -220,8 +228,9 @@ impl Grid {
             };
             data.rays.push(ray);
         }
-        let engine = &mut self.engine;
-        py.detach(|| engine.insert_range_data(&data)).map(|_| ()).map_err(|e| PyValueError::new_err(e.to_string()))
+        py.detach(|| self.engine().insert_range_data(&data))
+            .map(|_| ())
+            .map_err(|e| PyValueError::new_err(e.to_string()))
     }
 
     /// The map over the observed cells' bounding box, as `map.npz` holds it: a dict of
@@ -240,9 +249,15 @@ impl Grid {
 }
 
 impl Grid {
+    /// The engine, locked (a panic in another call leaves it usable: each insert is whole).
+    fn engine(&self) -> std::sync::MutexGuard<'_, Engine> {
+        self.inner.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
     fn raster(&self) -> PyResult<Raster> {
-        let grid = self.engine.grid();
-        let room = ExportRoom::of(self.engine.export_room(self.engine.maps().primary()));
+        let engine = self.engine();
+        let grid = engine.grid();
+        let room = ExportRoom::of(engine.export_room(engine.maps().primary()));
         let mut notes = Vec::new();
         match view_of(grid, &ExportOptions::of(&self.plan, None), room, &mut notes) {
             Ok(MapView::Dense(r)) => Ok(r),

@@ -1,8 +1,8 @@
 //! `map.mcap`: a run's map as ROS 2 messages in one MCAP file (profile `ros2`, schemas
 //! `ros2msg` with their full definitions, messages CDR), so that Foxglove opens it, `ros2
-//! bag play map.mcap` replays it to RViz2 and Nav2, and `rosbags` or `mcap-ros2-support`
-//! read it in Python — the design document's §4.4 advice to hand long-term maps over in
-//! the standard message types.
+//! bag play` can replay it, and `rosbags` or `mcap-ros2-support` read it in Python — the
+//! design document's §4.4 advice to hand long-term maps over in the standard message
+//! types.
 //!
 //! | topic | type | what |
 //! |---|---|---|
@@ -15,7 +15,10 @@
 //!
 //! Everything is in the `map` frame, stamped at the run's last pose, and offered latched
 //! (transient local, depth 1), as `map_server` offers `/map`: a subscriber that starts
-//! after the message was played still gets it. `/map`'s cells agree with `map.pgm`'s:
+//! after the message was played still gets it while the player runs. `/map` holds
+//! probabilities (0–100), not `map_server`'s 0/100: a Nav2 static layer takes only 100 as
+//! lethal by default, so navigation should load `map.yaml` with `map_server` (or set the
+//! layer's `lethal_cost_threshold`). `/map`'s cells agree with `map.pgm`'s:
 //! row-major from the lowest y, `info.origin` the lower-left corner of cell (0, 0) as in
 //! `map.yaml`. `/map/semantic`'s rows run from the highest y down, as in `semantic.png`
 //! (an image's row 0 is its top); its palette (`semantic.yaml`'s text) is the metadata
@@ -68,12 +71,12 @@ pub fn write_map_mcap(path: &Path, content: &MapMessages<'_>) -> Result<()> {
     check_raster(path, content.raster, true)?;
     let stamp = representable(content.stamp);
     let mut messages: Vec<(&str, &'static MsgDef, Vec<u8>)> = Vec::new();
-    let mut add = |topic, def, msg: &dyn CdrEncode| -> io::Result<()> {
-        let payload = encode_cdr(msg).map_err(|e| io::Error::other(format!("{topic}: {e}")))?;
+    let mut add = |topic, def, msg: &dyn CdrEncode| -> std::result::Result<(), String> {
+        let payload = encode_cdr(msg).map_err(|e| format!("{topic}: {e}"))?;
         messages.push((topic, def, payload));
         Ok(())
     };
-    let packed = (|| -> io::Result<()> {
+    let packed = (|| -> std::result::Result<(), String> {
         add("/map", &OCCUPANCY_GRID, &grid_message(content.raster, stamp, content.raster.occupancy_percent()))?;
         add("/trajectory", &PATH, &path_message(content.trajectory, stamp))?;
         add("/map_points", &POINT_CLOUD2, &cloud_message(content.cloud, stamp))?;
@@ -88,7 +91,7 @@ pub fn write_map_mcap(path: &Path, content: &MapMessages<'_>) -> Result<()> {
         }
         Ok(())
     })();
-    packed.map_err(|e| crate::Error::io(path, e))?;
+    packed.map_err(|e| crate::Error::format(path, crate::Location::File, e))?;
     let semantic = content.semantic.map(|s| semantic_yaml(s, "/map/semantic"));
     write_atomic(path, |w| {
         let mut mcap = mcap::WriteOptions::new()

@@ -79,6 +79,28 @@ impl MapCloud {
         Self { points, classes: semantic.is_some() }
     }
 
+    /// Lidar returns as points (`[output] points = "endpoints"`), each with the occupancy
+    /// probability of the map cell it lands in (NaN outside the raster); no classes.
+    pub fn endpoints(raster: &Raster, points: &[[f32; 2]]) -> Self {
+        let occupancy = raster.occupancy();
+        let res = raster.resolution;
+        let cell = |v: f32, o: f64, n: usize| {
+            let i = ((f64::from(v) - o) / res).floor();
+            (i >= 0.0 && i < n as f64).then_some(i as usize)
+        };
+        let points = points
+            .iter()
+            .map(|&[x, y]| {
+                let p = match (cell(x, raster.origin.x, raster.width), cell(y, raster.origin.y, raster.height)) {
+                    (Some(c), Some(r)) => occupancy[r * raster.width + c],
+                    _ => f32::NAN,
+                };
+                MapPoint { xyz: [x, y, 0.0], probability: p, class: NO_CLASS, rgb: UNKNOWN_COLOR }
+            })
+            .collect();
+        Self { points, classes: false }
+    }
+
     /// Bytes per `PointCloud2` record: x, y, z, probability, and with classes the class
     /// (2 bytes, then 2 of padding) and the colour — 16 or 24, so every field is aligned.
     pub fn point_step(&self) -> usize {

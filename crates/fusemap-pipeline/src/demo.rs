@@ -99,6 +99,7 @@ impl DemoJob {
             trajectory: Some(&run.trajectory),
             validation: None,
             calibration: None,
+            endpoints: None,
         };
         let summary = finish(&run.engine, files, &export, record)?;
         Ok(DemoRun { summary, scores, other_maps })

@@ -13,7 +13,8 @@ use crate::PipelineError;
 use fusemap_core::calibration::SurfaceHits;
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
-use fusemap_core::measurement::{ObservationId, SensorId};
+use fusemap_core::grid::{CellIndex, GridGeometry};
+use fusemap_core::measurement::{ObservationId, RangeData, SensorId};
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::{Stamp, SyncMode};
 use fusemap_io::log::ScanMessage;
@@ -119,9 +120,38 @@ pub(crate) struct Inserter<'a> {
     pub(crate) next_id: u64,
     /// The lidars' returns per cell, when a calibration asked (see [`SurfaceHits`]).
     pub(crate) surface: Option<SurfaceHits>,
+    /// Every scan's returns, one a cell a scan, when `[output] points = "endpoints"`.
+    pub(crate) endpoints: Option<Endpoints>,
+}
+
+/// The lidar returns as placed, one point per cell per scan (`[output] points =
+/// "endpoints"`): a localisation map that keeps where in its cell each wall was hit.
+#[derive(Default)]
+pub(crate) struct Endpoints {
+    pub(crate) points: Vec<[f32; 2]>,
+    seen: HashSet<CellIndex>,
+}
+
+impl Endpoints {
+    /// Adds the hit rays' ends of one scan, the first in each cell.
+    fn add(&mut self, data: &RangeData, geometry: &GridGeometry) {
+        self.seen.clear();
+        for r in data.rays.iter().filter(|r| r.hit) {
+            if geometry.cell_of(r.end).is_some_and(|c| self.seen.insert(c)) {
+                self.points.push([r.end.x as f32, r.end.y as f32]);
+            }
+        }
+    }
 }
 
 impl Inserter<'_> {
+    /// Keeps the last inserted scan's returns, when asked.
+    fn keep_endpoints(&mut self) {
+        if let Some(e) = &mut self.endpoints {
+            e.add(self.engine.last_range_data(), self.engine.maps().primary().grid().geometry());
+        }
+    }
+
     fn insert(&mut self, l: &mut Mapped, key: Stamp, msg: &ScanMessage) -> Result<(), PipelineError> {
         if l.repeats.is_repeat(msg) {
             l.report.scans_skipped.repeated += 1;
@@ -161,6 +191,7 @@ impl Inserter<'_> {
                 self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;
                 self.placed.push((scan.stamp, pose));
                 self.last = Some(scan.stamp);
+                self.keep_endpoints();
             }
             Track::Timed(track) => {
                 let t = key;
@@ -192,6 +223,7 @@ impl Inserter<'_> {
                 if let Some(s) = &mut self.surface {
                     s.add(self.engine.last_range_data(), self.engine.maps().primary().grid().geometry());
                 }
+                self.keep_endpoints();
                 self.placed.push((t, pose));
                 self.last = Some(t);
             }

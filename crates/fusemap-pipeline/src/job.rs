@@ -227,6 +227,7 @@ impl MapJob {
                     trajectory: Some(&run.trajectory),
                     validation: None,
                     calibration: None,
+                    endpoints: Some(&run.endpoints),
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }
@@ -242,6 +243,7 @@ impl MapJob {
                     trajectory: None,
                     validation: None,
                     calibration: None,
+                    endpoints: None,
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }

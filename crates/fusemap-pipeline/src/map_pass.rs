@@ -6,7 +6,7 @@
 
 use crate::camera::{build_camera, BuiltCamera, MappedCamera};
 use crate::extrinsics::frame_tree;
-use crate::insert::{release, Inserter, Mapped};
+use crate::insert::{release, Endpoints, Inserter, Mapped};
 use crate::lidar_frames::{lidar_setup, other_frames};
 use crate::merge::{OrderedMerge, Pushed};
 use crate::pass_notes::lidar_notes;
@@ -18,7 +18,7 @@ use crate::sync::{limits, offset_ns, sync_mode, Skipped};
 use crate::track::{count_reordered, ChosenTrack, Track};
 use crate::PipelineError;
 use fusemap_core::calibration::{CameraSample, SurfaceHits};
-use fusemap_core::config::{default_camera, Plan, PlannedCamera, SensorKind};
+use fusemap_core::config::{default_camera, Plan, PlannedCamera, PointsMode, SensorKind};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::fusion::{Correlation, Engine, MapSet};
 use fusemap_core::geometry::Pose2;
@@ -50,6 +50,9 @@ pub struct MapRun {
     pub camera_samples: Vec<(String, Vec<CameraSample>)>,
     /// The lidars' returns per cell, kept with the camera samples.
     pub lidar_surface: Option<SurfaceHits>,
+    /// Every lidar return as placed, one point per cell per scan, when `[output] points =
+    /// "endpoints"` asked (empty otherwise).
+    pub endpoints: Vec<[f32; 2]>,
 }
 
 /// A timed track's samples with the pose every scan was placed with, by stamp (a sample
@@ -108,8 +111,9 @@ struct Streams {
     planned: Vec<PlannedCamera>,
 }
 
-/// The pose every scan was placed with, and the lidars' returns per cell if kept.
-type Placed = (Vec<(Stamp, Pose2)>, Option<SurfaceHits>);
+/// The pose every scan was placed with, the lidars' returns per cell if kept, and their
+/// returns as points if kept.
+type Placed = (Vec<(Stamp, Pose2)>, Option<SurfaceHits>, Vec<[f32; 2]>);
 
 /// The maps a pass builds, and whether the log's later part is held out of them.
 #[derive(Default)]
@@ -171,7 +175,9 @@ pub fn map_with_track(
     // held-out period there (the images of such a log, if any, carry stamps).
     let scans_only = matches!(chosen.track, Track::ScanLine(_));
     let hold_from = hold_from.map(|k| (k, scans_only));
-    let (placed, lidar_surface) = streams.run(&input, &mut engine, mode, hold_from, maps.camera_samples, progress)?;
+    let keep_endpoints = plan.output.points == PointsMode::Endpoints;
+    let (placed, lidar_surface, endpoints) =
+        streams.run(&input, &mut engine, mode, hold_from, (maps.camera_samples, keep_endpoints), progress)?;
     let map_s = t_map.elapsed().as_secs_f64();
     let trajectory = match &chosen.track {
         Track::ScanLine(_) => placed,
@@ -200,6 +206,7 @@ pub fn map_with_track(
         track: chosen.track,
         camera_samples,
         lidar_surface,
+        endpoints,
     })
 }
 
@@ -365,7 +372,7 @@ impl Streams {
         engine: &mut Engine,
         mode: SyncMode,
         hold_from: Option<(i64, bool)>,
-        sample: bool,
+        (sample, keep_endpoints): (bool, bool),
         progress: &mut dyn FnMut(Progress),
     ) -> Result<Placed, PipelineError> {
         let inv = input.inv;
@@ -386,6 +393,7 @@ impl Streams {
             lines_seen: Default::default(),
             next_id: 0,
             surface: sample.then(SurfaceHits::default),
+            endpoints: keep_endpoints.then(Endpoints::default),
         };
         let mut seq = 0i64;
         for_each_range_message(&inv.path, &inv.limits, &topics, &image_topics, |msg| {
@@ -410,7 +418,8 @@ impl Streams {
             c.finish();
         }
         progress(Progress::Done);
-        Ok((std::mem::take(&mut inserter.placed), inserter.surface.take()))
+        let endpoints = inserter.endpoints.take().map_or_else(Vec::new, |e| e.points);
+        Ok((std::mem::take(&mut inserter.placed), inserter.surface.take(), endpoints))
     }
 
     /// The merge key from which the later `share` of the log is held out: the

@@ -188,6 +188,7 @@ impl ValidateJob {
             trajectory: Some(&run.trajectory),
             validation: Some(serde_json::to_value(&validation)?),
             calibration: None,
+            endpoints: None,
         };
         let export = ExportOptions::of(plan, None);
         let summary = finish(&run.engine, outputs, &export, record)?;

@@ -23,7 +23,7 @@ pub use fusion::FusionConfig;
 pub use limits::LimitsConfig;
 pub use log::{ExtrinsicsSource, LogConfig, PoseSource, SyncConfig};
 pub use map::MapConfig;
-pub use output::OutputConfig;
+pub use output::{OutputConfig, PointsMode};
 pub use plan::auto_sensor;
 pub use sensor::{GnssNoise, OdometryNoise, PlannedLidar, PlannedSensor, SensorConfig, SensorKind};
 pub use slam::{SlamConfig, SlamMode};

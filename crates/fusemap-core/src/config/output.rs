@@ -16,10 +16,24 @@ pub struct OutputConfig {
     pub pcd: bool,
     /// `map.ply`: the same points as a binary little-endian PLY.
     pub ply: bool,
+    /// What the point clouds (`map.pcd`, `map.ply`, `/map_points`) hold.
+    pub points: PointsMode,
 }
 
 impl Default for OutputConfig {
     fn default() -> Self {
-        Self { mcap: true, pcd: true, ply: true }
+        Self { mcap: true, pcd: true, ply: true, points: PointsMode::Cells }
     }
+}
+
+/// What the map's point clouds hold.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PointsMode {
+    /// The occupied cells' centres: the map itself.
+    #[default]
+    Cells,
+    /// Every valid lidar return, placed with the final (SLAM-corrected) track, one point
+    /// per cell per scan: a localisation map keeping the returns' sub-cell positions.
+    Endpoints,
 }

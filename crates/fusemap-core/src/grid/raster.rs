@@ -170,6 +170,9 @@ mod tests {
             let class = r.ternary()[0];
             if v < 0 {
                 prop_assert_eq!(class, Ternary::Unknown);
+                // −1 for an observed cell only when no whole percentage is undecided.
+                let undecided = (0..=100).any(|k| table.classify(f64::from(k) / 100.0) == Ternary::Unknown);
+                prop_assert!(!known || !undecided, "{} written -1 though a percentage fits its band", p);
             } else {
                 prop_assert_eq!(table.classify(f64::from(v) / 100.0), class);
                 let p32 = probability(r.log_odds[0] as f64);

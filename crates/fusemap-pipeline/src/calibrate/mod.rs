@@ -182,6 +182,7 @@ impl CalibrateJob {
             trajectory: Some(&run.trajectory),
             validation: None,
             calibration: Some(serde_json::to_value(&calibration)?),
+            endpoints: None,
         };
         let export = ExportOptions::of(plan, None);
         let summary = finish(&run.engine, outputs, &export, record)?;

@@ -5,29 +5,42 @@
 use super::set::OutputFiles;
 use super::write::Layers;
 use super::OutputError;
-use fusemap_core::config::OutputConfig;
+use fusemap_core::config::{OutputConfig, PointsMode};
 use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::grid::Raster;
 use fusemap_core::time::Stamp;
 use fusemap_io::map_mcap::{write_map_mcap, MapMessages};
 use fusemap_io::point_cloud::{write_pcd, write_ply, MapCloud};
 
-/// Writes the formats `formats` turns on for the dense map `r`: nothing for a map with no
+/// The formats a run writes, and the lidar returns for `[output] points = "endpoints"`
+/// (a log run's; `None` for the other runs, whose clouds hold the occupied cells).
+pub struct FormatRequest<'a> {
+    /// `[output]`.
+    pub formats: OutputConfig,
+    /// The returns as placed.
+    pub endpoints: Option<&'a [[f32; 2]]>,
+}
+
+/// Writes the formats `request` turns on for the dense map `r`: nothing for a map with no
 /// observed cell.
 pub(crate) fn write_map_formats(
     files: &OutputFiles,
-    formats: OutputConfig,
+    request: FormatRequest<'_>,
     r: &Raster,
     layers: Option<&Layers>,
     trajectory: &[(Stamp, Pose2)],
     closures: &[(Point2, Point2)],
 ) -> Result<(), OutputError> {
+    let formats = request.formats;
     if r.known_count() == 0 || !(formats.mcap || formats.pcd || formats.ply) {
         return Ok(());
     }
     let picture = layers.map(Layers::picture);
     let classes = picture.as_ref().map(|s| (s.best.as_slice(), s.classes.as_slice()));
-    let cloud = MapCloud::occupied_cells(r, classes);
+    let cloud = match request.endpoints {
+        Some(points) if formats.points == PointsMode::Endpoints => MapCloud::endpoints(r, points),
+        _ => MapCloud::occupied_cells(r, classes),
+    };
     if formats.pcd {
         write_pcd(&files.pcd, &cloud)?;
     }

@@ -4,7 +4,7 @@
 //! validation and calibration runs to come) goes through [`finish`], so the files and
 //! `summary.json`'s schema are the same whichever command made them.
 
-mod map_formats;
+pub mod map_formats;
 mod report_page;
 mod report_tables;
 pub mod set;

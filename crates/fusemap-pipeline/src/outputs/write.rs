@@ -3,13 +3,13 @@
 //! `summary.json` goes last with each file's size and SHA-256. A failing run leaves the
 //! previous set as it was; no output is ever written over an input.
 
-use super::map_formats::write_map_formats;
+use super::map_formats::{write_map_formats, FormatRequest};
 use super::report_page::{self, Picture};
 use super::set::{OutputFiles, Outputs};
 use super::summary::{CellsUpdated, MapInfo, Summary};
 use super::view::{view_of, ExportOptions, ExportRoom, MapView};
 use super::OutputError;
-use fusemap_core::config::OutputConfig;
+use fusemap_core::config::{OutputConfig, PointsMode};
 use fusemap_core::fusion::rasters::{dynamic_cells, semantic_cells, shown_classes};
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::{Point2, Pose2};
@@ -40,6 +40,8 @@ pub struct RunRecord<'a> {
     pub validation: Option<serde_json::Value>,
     /// `fusemap calibrate`'s estimates, for `summary.json`'s `calibration`.
     pub calibration: Option<serde_json::Value>,
+    /// The lidar returns as placed, for point clouds of `[output] points = "endpoints"`.
+    pub endpoints: Option<&'a [[f32; 2]]>,
 }
 
 /// The semantic and dynamic layers of a run with a camera, over the occupancy raster's
@@ -116,7 +118,7 @@ pub fn write(
     layers: Option<&Layers>,
     summary: &mut Summary,
     trajectory: Option<&[(Stamp, Pose2)]>,
-    formats: OutputConfig,
+    request: FormatRequest<'_>,
 ) -> Result<(), OutputError> {
     let Outputs { files, set, owned } = outputs;
     if let Some(t) = trajectory {
@@ -143,7 +145,7 @@ pub fn write(
             fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, trajectory, closures, fixes)?;
         }
         let closures = graph.as_ref().map_or(&[][..], |g| &g.1[..]);
-        write_map_formats(&files, formats, r, layers, trajectory.unwrap_or_default(), closures)?;
+        write_map_formats(&files, request, r, layers, trajectory.unwrap_or_default(), closures)?;
     }
     let value =
         serde_json::to_value(&*summary).map_err(|e| fusemap_io::Error::io(&files.summary, std::io::Error::other(e)))?;
@@ -285,6 +287,35 @@ fn pose_graph_of(log: &serde_json::Value) -> Option<GraphPicture> {
     Some((trajectory, closures, fixes))
 }
 
+/// The notes a view of the map adds: what was not written, and why.
+fn view_notes(view: &MapView, camera: bool, formats: OutputConfig, endpoints: bool, notes: &mut Vec<String>) {
+    let any_format = formats.mcap || formats.pcd || formats.ply;
+    match view {
+        MapView::Empty => notes.push("no cell was observed: only summary.json was written".into()),
+        MapView::Sparse { .. } => {
+            if camera {
+                notes.push("the semantic and dynamic layers are written only with a dense map (--crop)".into());
+            }
+            if any_format {
+                notes.push(
+                    "map.mcap, map.pcd and map.ply are written only with a dense map (--crop a region within \
+                     limits.export_cells)"
+                        .into(),
+                );
+            }
+        }
+        MapView::Dense(_) => {
+            if any_format && formats.points == PointsMode::Endpoints && !endpoints {
+                notes.push(
+                    "[output] points = \"endpoints\" applies to `fusemap map` on a log; the point clouds hold the \
+                     occupied cells"
+                        .into(),
+                );
+            }
+        }
+    }
+}
+
 /// Builds the summary of a finished engine and writes every output: the view of the map
 /// `export` asks for (see [`view_of`]).
 pub fn finish(
@@ -293,7 +324,8 @@ pub fn finish(
     export: &ExportOptions,
     record: RunRecord<'_>,
 ) -> Result<Summary, OutputError> {
-    let RunRecord { source_kind, source, started, mut notes, log, trajectory, validation, calibration } = record;
+    let RunRecord { source_kind, source, started, mut notes, log, trajectory, validation, calibration, endpoints } =
+        record;
     let grid = engine.grid();
     let room = ExportRoom::of(engine.export_room(engine.maps().primary()));
     let view = view_of(grid, export, room, &mut notes)?;
@@ -352,24 +384,10 @@ pub fn finish(
         calibration,
         files: Vec::new(),
     };
-    if matches!(view, MapView::Empty) {
-        summary.notes.push("no cell was observed: only summary.json was written".into());
-    }
-    if matches!(view, MapView::Sparse { .. }) && camera_of(engine).is_some() {
-        summary.notes.push("the semantic and dynamic layers are written only with a dense map (--crop)".into());
-    }
-    if matches!(view, MapView::Sparse { .. }) {
-        let f = export.formats;
-        if f.mcap || f.pcd || f.ply {
-            summary.notes.push(
-                "map.mcap, map.pcd and map.ply are written only with a dense map (--crop a region within \
-                 limits.export_cells)"
-                    .into(),
-            );
-        }
-    }
+    view_notes(&view, camera_of(engine).is_some(), export.formats, endpoints.is_some(), &mut summary.notes);
     summary.wall_time_s = started.elapsed().as_secs_f64();
-    write(outputs, &view, layers.as_ref(), &mut summary, trajectory, export.formats)?;
+    let request = FormatRequest { formats: export.formats, endpoints };
+    write(outputs, &view, layers.as_ref(), &mut summary, trajectory, request)?;
     summary.wall_time_s = started.elapsed().as_secs_f64();
     Ok(summary)
 }
@@ -400,6 +418,7 @@ mod tests {
             trajectory: None,
             validation: None,
             calibration: None,
+            endpoints: None,
         };
         let summary = finish(&run.engine, outputs, &ExportOptions::default(), record).unwrap();
         assert_eq!((summary.scans, summary.source_kind.as_str()), (40, "world"));
