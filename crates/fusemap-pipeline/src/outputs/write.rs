@@ -425,7 +425,8 @@ mod tests {
         assert!(summary.entropy.is_some());
         let mut listed: Vec<&str> = summary.files.iter().map(|f| f.name.as_str()).collect();
         listed.sort_unstable();
-        assert_eq!(listed, ["map.npz", "map.pgm", "map.png", "map.yaml", "report.html"]);
+        let want = ["map.mcap", "map.npz", "map.pcd", "map.pgm", "map.ply", "map.png", "map.yaml", "report.html"];
+        assert_eq!(listed, want);
         for f in &summary.files {
             assert_eq!(std::fs::metadata(out.join(&f.name)).unwrap().len(), f.bytes, "{}", f.name);
         }
