@@ -25,18 +25,7 @@ use std::sync::Mutex;
 
 /// An error and its causes on one line, as the CLI prints it after `error: `.
 fn message(e: &dyn std::error::Error) -> String {
-    let mut s = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let c_text = c.to_string();
-        if !s.contains(&c_text) {
-            s.push_str(": ");
-            s.push_str(&c_text);
-        }
-        cause = c.source();
-    }
-    let s = fusemap_io::text::compact_numbers(&s).replace('\n', " ");
-    fusemap_io::text::printable(&s).into_owned()
+    fusemap_io::text::error_line(e)
 }
 
 /// `OSError` for a file that could not be read or written, `ValueError` otherwise.

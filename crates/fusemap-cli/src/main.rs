@@ -222,16 +222,5 @@ fn main() {
 
 /// The error and its causes on one line.
 fn format_chain(e: &anyhow::Error) -> String {
-    let mut s = e.to_string();
-    for cause in e.chain().skip(1) {
-        let c = cause.to_string();
-        if !s.contains(&c) {
-            s.push_str(": ");
-            s.push_str(&c);
-        }
-    }
-    // One line, numbers a reader can take in, and nothing a log wrote into a name (escape
-    // sequences, NUL) reaches the terminal as itself.
-    let s = fusemap_io::text::compact_numbers(&s).replace('\n', " ");
-    fusemap_io::text::printable(&s).into_owned()
+    fusemap_io::text::error_line(e.as_ref())
 }

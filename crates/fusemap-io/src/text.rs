@@ -80,6 +80,30 @@ pub fn table_cell(s: &str) -> Cow<'_, str> {
     }
 }
 
+/// An error and its sources, `outer: inner: innermost` (a source whose text the outer
+/// message already holds is not repeated).
+pub fn error_chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut source = e.source();
+    while let Some(inner) = source {
+        let text = inner.to_string();
+        if !s.contains(&text) {
+            s.push_str(": ");
+            s.push_str(&text);
+        }
+        source = inner.source();
+    }
+    s
+}
+
+/// An error as fusemap prints it after `error: `: its chain on one line, numbers a
+/// reader can take in, and nothing a log wrote into a name (escape sequences, NUL)
+/// reaching the terminal as itself. The CLI and the Python package both use it.
+pub fn error_line(e: &dyn std::error::Error) -> String {
+    let s = compact_numbers(&error_chain(e)).replace('\n', " ");
+    printable(&s).into_owned()
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
