@@ -4,13 +4,14 @@
 //! (a bag whose lidar stamps run 40 ms late), and the camera's clock offset and mount yaw
 //! against the lidar's map.
 
-use crate::validation::{bag, config, validate};
+use crate::validation::{bag, config, once_per_key, recording, validate, Memo};
 use fusemap_core::calibration::Interval;
 use fusemap_core::metrics::Verdict;
 use fusemap_pipeline::calibrate::{CalibrateJob, Calibration, CALIBRATION_TOML};
 use fusemap_pipeline::validate::Validation;
 use fusemap_sim::{simulate, Scenario};
 use std::path::Path;
+use std::sync::OnceLock;
 
 /// Where `calibrate(name, …)` wrote its set.
 fn out_dir(name: &str) -> std::path::PathBuf {
@@ -23,7 +24,17 @@ fn calibrate(name: &str, log: &Path, cfg: &str) -> Calibration {
     calibrate_with(name, log, cfg, false)
 }
 
+/// `fusemap calibrate` of `log` with `cfg`, once per (log, configuration, re-validation)
+/// in this test binary: the on-time bag's calibration serves both clock tests, the wrong
+/// lidar mount's both the mount test and the re-validation test. The first caller's `name`
+/// names the directory ([`out_dir`]).
 fn calibrate_with(name: &str, log: &Path, cfg: &str, revalidate: bool) -> Calibration {
+    static MEMO: Memo<Calibration> = OnceLock::new();
+    let key = format!("{}\n{revalidate}\n{cfg}", log.display());
+    once_per_key(&MEMO, &key, || calibrate_now(name, log, cfg, revalidate))
+}
+
+fn calibrate_now(name: &str, log: &Path, cfg: &str, revalidate: bool) -> Calibration {
     let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), &format!("calibration-{name}"));
     let path = dir.join("config.toml");
     std::fs::write(&path, cfg).unwrap();
@@ -55,9 +66,17 @@ fn get(
     what(s).unwrap_or_else(|| panic!("no estimate in {}", serde_json::to_string(s).unwrap()))
 }
 
+/// The directory name of [`wrong_mount_calibration`].
+const WRONG_MOUNT: &str = "lidar-mount";
+
+/// The lidar configured 5 cm and 2° off, calibrated with its re-validation.
+fn wrong_mount_calibration() -> Calibration {
+    calibrate_with(WRONG_MOUNT, bag(), &config((0.30, 2.0), 0.0), true)
+}
+
 #[test]
 fn finds_the_lidar_mount_and_the_odometry_scale() {
-    let c = calibrate("lidar-mount", bag(), &config((0.30, 2.0), 0.0));
+    let c = wrong_mount_calibration();
     let (x, y, yaw) = (get(&c, "lidar", |s| s.x), get(&c, "lidar", |s| s.y), get(&c, "lidar", |s| s.yaw));
     // The simulator's mount: (0.25, 0, 0°).
     assert!((x.value - 0.25).abs() < 0.01 && y.value.abs() < 0.01, "{x:?} {y:?}");
@@ -85,7 +104,7 @@ fn finds_a_lidar_clock_running_late() {
     let late = dir.join("bag");
     fusemap_sim::bag::write_bag(&rec, &late, true).expect("the bag is written");
     let c = calibrate("lidar-late", &late, &config((0.25, 0.0), 0.0));
-    let on_time = calibrate("lidar-on-time", bag(), &config((0.25, 0.0), 0.0));
+    let on_time = calibrate("on-time", bag(), &config((0.25, 0.0), 0.0));
     // Its stamps are 40 ms late: −0.04 s corrects them. The two bags share every noise
     // draw, so the difference of the estimates shows the search's response alone.
     let (late, on_time) = (get(&c, "lidar", |s| s.time_offset_s), get(&on_time, "lidar", |s| s.time_offset_s));
@@ -110,7 +129,7 @@ fn late_camera_bag() -> &'static Path {
 #[test]
 fn finds_a_camera_clock_running_late() {
     let late = calibrate("camera-late", late_camera_bag(), &config((0.25, 0.0), 0.0));
-    let on_time = calibrate("camera-on-time", bag(), &config((0.25, 0.0), 0.0));
+    let on_time = calibrate("on-time", bag(), &config((0.25, 0.0), 0.0));
     let (late, on_time) = (get(&late, "camera", |s| s.time_offset_s), get(&on_time, "camera", |s| s.time_offset_s));
     // The two bags share every noise draw: the difference is the search's response to a
     // clock 40 ms late, −0.040 s ± 0.005 s.
@@ -165,23 +184,23 @@ fn fused_f1(cfg: &fusemap_core::config::Config, truth: &fusemap_sim::SimRecordin
 fn the_calibrated_configuration_maps_as_well_as_the_right_one() {
     let parse = |text: &str| fusemap_io::config_file::parse_config_str(text, Path::new("config.toml")).unwrap();
     let (right, wrong) = (parse(&config((0.25, 0.0), 0.0)), parse(&config((0.30, 2.0), 0.0)));
-    let c = calibrate_with("apply", bag(), &config((0.30, 2.0), 0.0), true);
+    let c = wrong_mount_calibration();
     // calibrate's own re-validation: named before, not after, and not worse.
     let r = c.revalidation.as_ref().expect("re-validated: the configuration's mounts count");
     assert!(
         r.before.suspect.as_deref() == Some("laser") && r.after.verdict != Verdict::CheckSyncAndExtrinsics && !r.worse,
         "{r:?}"
     );
-    let pasted = fusemap_io::config_file::load_config(&out_dir("apply").join(CALIBRATION_TOML)).unwrap();
+    let pasted = fusemap_io::config_file::load_config(&out_dir(WRONG_MOUNT).join(CALIBRATION_TOML)).unwrap();
     let mut calibrated = wrong.clone();
     for table in &pasted.sensor {
         let s = calibrated.sensor.iter_mut().find(|s| s.name == table.name && s.kind == table.kind).unwrap();
         s.base_from_sensor = table.base_from_sensor;
         s.time_offset_s = table.time_offset_s;
     }
-    let truth = simulate(&Scenario::default()).unwrap();
+    let truth = recording();
     let (f_right, f_wrong, f_calibrated) =
-        (fused_f1(&right, &truth), fused_f1(&wrong, &truth), fused_f1(&calibrated, &truth));
+        (fused_f1(&right, truth), fused_f1(&wrong, truth), fused_f1(&calibrated, truth));
     eprintln!("fused F1: right {f_right:.4}, wrong {f_wrong:.4}, calibrated {f_calibrated:.4}");
     assert!(f_calibrated > f_right - 0.01, "right {f_right}, wrong {f_wrong}, calibrated {f_calibrated}");
     let text = toml::to_string(&calibrated).unwrap();

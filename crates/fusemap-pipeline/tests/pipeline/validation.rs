@@ -6,20 +6,42 @@
 use fusemap_core::metrics::Verdict;
 use fusemap_pipeline::scenario::PRODUCTION_LINE_CONFIG;
 use fusemap_pipeline::validate::{ValidateJob, Validation, VALIDATE_NPZ};
-use fusemap_sim::{simulate, Scenario};
+use fusemap_sim::{simulate, Scenario, SimRecording};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// The production line's simulated run (its truth), simulated once per test binary.
+pub(crate) fn recording() -> &'static SimRecording {
+    static REC: OnceLock<SimRecording> = OnceLock::new();
+    REC.get_or_init(|| simulate(&Scenario::default()).expect("the default scenario simulates"))
+}
 
 /// The production line's bag, written once.
 pub(crate) fn bag() -> &'static Path {
     static BAG: OnceLock<PathBuf> = OnceLock::new();
     BAG.get_or_init(|| {
-        let rec = simulate(&Scenario::default()).expect("the default scenario simulates");
         let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), "validation");
         let bag = dir.join("bag");
-        fusemap_sim::bag::write_bag(&rec, &bag, true).expect("the bag is written");
+        fusemap_sim::bag::write_bag(recording(), &bag, true).expect("the bag is written");
         bag
     })
+}
+
+/// Results by key, each computed once ([`once_per_key`]).
+pub(crate) type Memo<T> = OnceLock<Mutex<HashMap<String, Arc<OnceLock<T>>>>>;
+
+/// Runs `compute` once per `key` in this test binary, however many tests ask for it and
+/// whichever asks first (tests run in parallel: a second asker waits for the first).
+/// The slow passes of the validation and calibration tests (a validation ~10 s, a
+/// calibration ~20 s in the test profile) are shared this way where tests need the same one.
+pub(crate) fn once_per_key<T: Clone + Send + Sync + 'static>(
+    memo: &'static Memo<T>,
+    key: &str,
+    compute: impl FnOnce() -> T,
+) -> T {
+    let cell = Arc::clone(memo.get_or_init(Default::default).lock().unwrap().entry(key.to_owned()).or_default());
+    cell.get_or_init(compute).clone()
 }
 
 /// The production line's configuration with the lidar mounted at `lidar` (x, yaw) and
@@ -48,7 +70,14 @@ pub(crate) fn config(lidar: (f64, f64), camera_yaw_deg: f64) -> String {
     format!("{c}\n[log]\nextrinsics = \"config\"\n")
 }
 
+/// `fusemap validate` of the bag with `cfg`, once per configuration text in this test
+/// binary (the first caller's `name` names the directory).
 pub(crate) fn validate(name: &str, cfg: &str) -> Validation {
+    static MEMO: Memo<Validation> = OnceLock::new();
+    once_per_key(&MEMO, cfg, || validate_now(name, cfg))
+}
+
+fn validate_now(name: &str, cfg: &str) -> Validation {
     let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), &format!("validation-{name}"));
     let path = dir.join("config.toml");
     std::fs::write(&path, cfg).unwrap();
