@@ -179,10 +179,15 @@ impl DistanceField {
         }
         let (i, j) = (u as usize, v as usize);
         let mut best = self.max_m * self.max_m;
+        // Neighbouring cells mostly share their nearest face: each face is scored once
+        // (the least over the same set, so the same result; a calibration calls this for
+        // every point at every step of its searches).
+        let (mut seen, mut n) = ([u32::MAX; 9], 0);
         for jj in j.saturating_sub(1)..(j + 2).min(self.height) {
             for ii in i.saturating_sub(1)..(i + 2).min(self.width) {
                 let f = self.nearest[jj * self.width + ii];
-                if f != u32::MAX {
+                if f != u32::MAX && !seen[..n].contains(&f) {
+                    (seen[n], n) = (f, n + 1);
                     best = best.min(self.piece_distance2(f as usize, p));
                 }
             }
