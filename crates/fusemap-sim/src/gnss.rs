@@ -30,6 +30,49 @@ pub struct GnssOutput {
     pub dropouts: Vec<(Stamp, Stamp)>,
 }
 
+/// The intervals (receiver clock) in which the antenna is `inside` a dropout zone, from
+/// the 200 Hz truth.
+fn dropout_intervals(
+    traj: &Trajectory,
+    inside: impl Fn(f64) -> bool,
+    clock: impl Fn(f64) -> Stamp,
+) -> Vec<(Stamp, Stamp)> {
+    let mut dropouts = Vec::new();
+    let mut open: Option<Stamp> = None;
+    let mut last = Stamp::ZERO;
+    for s in traj.samples() {
+        match (inside(s.t), open) {
+            (true, None) => open = Some(clock(s.t)),
+            (false, Some(a)) => {
+                dropouts.push((a, last));
+                open = None;
+            }
+            _ => {}
+        }
+        last = clock(s.t);
+    }
+    if let Some(a) = open {
+        dropouts.push((a, last));
+    }
+    dropouts
+}
+
+/// A receiver's message without a fix (status NO_FIX, NaN position).
+fn no_fix(topic: &str, stamp: Stamp, frame_id: &str) -> SimFix {
+    SimFix::new(
+        topic,
+        NavSatFix {
+            header: Header::new(stamp, frame_id),
+            status: NavSatStatus { status: NavSatStatus::STATUS_NO_FIX, service: SERVICES },
+            latitude: f64::NAN,
+            longitude: f64::NAN,
+            altitude: f64::NAN,
+            position_covariance: [0.0; 9],
+            position_covariance_type: NavSatFix::COVARIANCE_TYPE_UNKNOWN,
+        },
+    )
+}
+
 /// Simulates the receiver over the run. `start` is the clock at t = 0.
 pub fn simulate_gnss(
     cfg: &GnssConfig,
@@ -44,25 +87,10 @@ pub fn simulate_gnss(
         let p = traj.pose_at(t) * Point2::new(cfg.mount.x, cfg.mount.y);
         (p, cfg.zone_at(p))
     };
-    let mut out = GnssOutput::default();
-    // Dropout intervals from the 200 Hz truth.
-    let mut open: Option<Stamp> = None;
-    let mut last = Stamp::ZERO;
-    for s in traj.samples() {
-        let inside = antenna(s.t).1 == Some(ZoneKind::Dropout);
-        match (inside, open) {
-            (true, None) => open = Some(clock(s.t)),
-            (false, Some(a)) => {
-                out.dropouts.push((a, last));
-                open = None;
-            }
-            _ => {}
-        }
-        last = clock(s.t);
-    }
-    if let Some(a) = open {
-        out.dropouts.push((a, last));
-    }
+    let mut out = GnssOutput {
+        dropouts: dropout_intervals(traj, |t| antenna(t).1 == Some(ZoneKind::Dropout), clock),
+        ..GnssOutput::default()
+    };
     let dt = 1.0 / cfg.rate_hz;
     let phi = (-dt / cfg.degraded_tau_s).exp();
     let drive = cfg.degraded_sigma_m * (1.0 - phi * phi).sqrt();
@@ -78,18 +106,7 @@ pub fn simulate_gnss(
         let (status, sigma, err) = match zone {
             Some(ZoneKind::Dropout) => {
                 if cfg.dropout_mode == DropoutMode::NoFix {
-                    out.fixes.push(SimFix::new(
-                        &cfg.topic,
-                        NavSatFix {
-                            header: Header::new(stamp, frame_id),
-                            status: NavSatStatus { status: NavSatStatus::STATUS_NO_FIX, service: SERVICES },
-                            latitude: f64::NAN,
-                            longitude: f64::NAN,
-                            altitude: f64::NAN,
-                            position_covariance: [0.0; 9],
-                            position_covariance_type: NavSatFix::COVARIANCE_TYPE_UNKNOWN,
-                        },
-                    ));
+                    out.fixes.push(no_fix(&cfg.topic, stamp, frame_id));
                 }
                 continue;
             }

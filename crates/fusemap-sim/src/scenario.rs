@@ -152,7 +152,32 @@ pub const MAX_LOOKAHEAD_M: f64 = 20.0;
 impl Scenario {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), FieldError> {
-        let w = &self.world;
+        self.world.validate()?;
+        self.robot.validate()?;
+        self.lidar.validate()?;
+        let beams = self.lidar.beams as f64 * self.lidar.rate_hz * self.robot.duration_s;
+        if beams > MAX_BEAMS {
+            return Err(FieldError::new(
+                "lidar.beams",
+                format!(
+                "makes {beams:.3e} beams with lidar.rate_hz × robot.duration_s, more than the {MAX_BEAMS:.0e} a run \
+                 may hold in memory"
+            ),
+            ));
+        }
+        self.odometry.validate()?;
+        self.imu.validate()?;
+        self.gnss.validate()?;
+        self.camera.validate(self.robot.duration_s)?;
+        self.person.validate()?;
+        self.frames.validate()
+    }
+}
+
+impl WorldConfig {
+    /// Checks `world.*`.
+    fn validate(&self) -> Result<(), FieldError> {
+        let w = self;
         w.extent.check("world.extent")?;
         // The bag's log times are unsigned nanoseconds since 1970 (MCAP), and stamps must
         // fit an i64 of nanoseconds.
@@ -174,7 +199,14 @@ impl Scenario {
         for (i, g) in w.grooves.iter().enumerate() {
             g.check(&format!("world.grooves[{i}]"))?;
         }
-        let r = &self.robot;
+        Ok(())
+    }
+}
+
+impl RobotConfig {
+    /// Checks `robot.*`.
+    fn validate(&self) -> Result<(), FieldError> {
+        let r = self;
         positive("robot.max_speed_mps", r.max_speed_mps)?;
         positive("robot.max_turn_rate_radps", r.max_turn_rate_radps)?;
         positive("robot.max_accel_mps2", r.max_accel_mps2)?;
@@ -216,23 +248,14 @@ impl Scenario {
                 format!("make a loop {length:.3e} m long, more than the {MAX_LOOP_M:.0e} m a simulated run may drive"),
             ));
         }
-        self.lidar.validate()?;
-        let beams = self.lidar.beams as f64 * self.lidar.rate_hz * r.duration_s;
-        if beams > MAX_BEAMS {
-            return Err(FieldError::new(
-                "lidar.beams",
-                format!(
-                "makes {beams:.3e} beams with lidar.rate_hz × robot.duration_s, more than the {MAX_BEAMS:.0e} a run \
-                 may hold in memory"
-            ),
-            ));
-        }
-        self.odometry.validate()?;
-        self.imu.validate()?;
-        self.gnss.validate()?;
-        self.camera.validate(r.duration_s)?;
-        self.person.validate()?;
-        let f = &self.frames;
+        Ok(())
+    }
+}
+
+impl FramesConfig {
+    /// Checks `frames.*`: every frame named.
+    fn validate(&self) -> Result<(), FieldError> {
+        let f = self;
         for (field, name) in [
             ("frames.map", &f.map),
             ("frames.odom", &f.odom),

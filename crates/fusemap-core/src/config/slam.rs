@@ -433,6 +433,14 @@ impl SlamConfig {
                 self.loop_closure_max_linear_window_m,
             )?
             .min(100.0),
+            ..self.with_closure_acceptance(params)?
+        })
+    }
+
+    /// `params` with what makes a found match an edge (accepting, confirming, global
+    /// searches, batches, the edges' weights), the optimisation's and the fix priors'.
+    fn with_closure_acceptance(&self, params: SlamParams) -> Result<SlamParams, FieldError> {
+        Ok(SlamParams {
             loop_closure_accept_shift_m: non_negative("loop_closure_accept_shift_m", self.loop_closure_accept_shift_m)?,
             loop_closure_accept_shift_rad: non_negative(
                 "loop_closure_accept_shift_deg",

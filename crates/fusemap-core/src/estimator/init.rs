@@ -195,23 +195,22 @@ fn course_over_ground(
     Err(travelled)
 }
 
-/// Finds the heading (and position) at the first odometry stamp.
-pub(crate) fn initialise(
-    odo: &OdometryTrack,
-    gyro: Option<&GyroTrack>,
-    corrections: &[(Stamp, Correction)],
-    cfg: &EstimatorConfig,
-) -> Result<Init, EstimatorError> {
-    let (bias, bias_sigma) = stationary_bias(odo, gyro).unwrap_or((0.0, cfg.initial_gyro_bias_sigma));
-    let dr = dead_reckon(odo, gyro, bias, cfg);
-    let t0 = odo.stamps[0];
-    // Heading drift of the dead reckoning between the start and t.
-    let drift_var = |t: Stamp| {
-        let (_, v) = dr.at(odo, t);
-        v + if gyro.is_some() { (bias_sigma * t.secs_since(t0)).powi(2) } else { 0.0 }
-    };
+/// The absolute corrections inside the odometry's span that can start the track.
+struct Starts {
+    /// Position fixes precise enough to fit the course over ground: stamp, position,
+    /// covariance, antenna lever arm.
+    good_fixes: Vec<(Stamp, [f64; 2], Mat<2, 2>, Point2)>,
+    /// The first position fix, however precise.
+    first_fix: Option<(Stamp, [f64; 2], Point2)>,
+    /// The first absolute heading: stamp, yaw, variance.
+    first_heading: Option<(Stamp, f64, f64)>,
+    /// The first absolute pose: stamp, pose, yaw variance.
+    first_pose: Option<(Stamp, [f64; 3], f64)>,
+}
+
+fn starts(odo: &OdometryTrack, corrections: &[(Stamp, Correction)], cfg: &EstimatorConfig) -> Starts {
     let inside = |t: &Stamp| odo.contains(*t);
-    let good_fixes: Vec<(Stamp, [f64; 2], Mat<2, 2>, Point2)> = corrections
+    let good_fixes = corrections
         .iter()
         .filter(|(t, _)| inside(t))
         .filter_map(|(t, c)| match c {
@@ -233,6 +232,49 @@ pub(crate) fn initialise(
         Correction::Pose { z, r } => Some((*t, *z, r[2][2])),
         _ => None,
     });
+    Starts { good_fixes, first_fix, first_heading, first_pose }
+}
+
+/// The start position that puts `a` (a point dead-reckoned from the start, in the start's
+/// frame) on the absolute position `z` when the start is turned by `phi`.
+fn start_from(z: [f64; 2], a: Point2, phi: f64) -> Point2 {
+    let (s, c) = phi.sin_cos();
+    Point2::new(z[0] - (c * a.x - s * a.y), z[1] - (s * a.x + c * a.y))
+}
+
+/// The filter's first state and covariance: position, heading, no gyro bias, unit scale.
+fn first_state(
+    (stamp, source): (Option<Stamp>, HeadingSource),
+    (phi, phi_var): (f64, f64),
+    (position, p_var): (Point2, f64),
+    cfg: &EstimatorConfig,
+) -> Init {
+    let mut p = [[0.0; 5]; 5];
+    p[0][0] = p_var;
+    p[1][1] = p_var;
+    p[2][2] = phi_var;
+    p[3][3] = cfg.initial_gyro_bias_sigma.powi(2);
+    p[4][4] = cfg.initial_scale_sigma.powi(2);
+    let info = HeadingInit { stamp, source, start_heading_rad: phi, start_heading_sigma_rad: phi_var.sqrt() };
+    Init { x: [position.x, position.y, phi, 0.0, 1.0], p, info }
+}
+
+/// Finds the heading (and position) at the first odometry stamp.
+pub(crate) fn initialise(
+    odo: &OdometryTrack,
+    gyro: Option<&GyroTrack>,
+    corrections: &[(Stamp, Correction)],
+    cfg: &EstimatorConfig,
+) -> Result<Init, EstimatorError> {
+    let (bias, bias_sigma) = stationary_bias(odo, gyro).unwrap_or((0.0, cfg.initial_gyro_bias_sigma));
+    let dr = dead_reckon(odo, gyro, bias, cfg);
+    let t0 = odo.stamps[0];
+    // Heading drift of the dead reckoning between the start and t.
+    let drift_var = |t: Stamp| {
+        let (_, v) = dr.at(odo, t);
+        v + if gyro.is_some() { (bias_sigma * t.secs_since(t0)).powi(2) } else { 0.0 }
+    };
+    let Starts { good_fixes, first_fix, first_heading, first_pose } = starts(odo, corrections, cfg);
     let course = course_over_ground(odo, &dr, &good_fixes, cfg);
 
     // The earliest source wins.
@@ -263,8 +305,7 @@ pub(crate) fn initialise(
         Some((t, Source::Pose(z, var))) => {
             let (pose, _) = dr.at(odo, t);
             let phi = normalize_angle(z[2] - pose.theta);
-            let (s, c) = phi.sin_cos();
-            let p = Point2::new(z[0] - (c * pose.x - s * pose.y), z[1] - (s * pose.x + c * pose.y));
+            let p = start_from([z[0], z[1]], Point2::new(pose.x, pose.y), phi);
             (Some(t), HeadingSource::AbsolutePose, phi, var + drift_var(t), p, carried_var(t))
         }
         Some((t, Source::Heading(yaw, var))) => {
@@ -273,10 +314,7 @@ pub(crate) fn initialise(
             // Position from the first fix when there is one; otherwise the start is the origin.
             let (p, p_var) = match first_fix {
                 Some((tf, z, antenna)) => {
-                    let (pf, _) = dr.at(odo, tf);
-                    let a = pf.transform_point(antenna);
-                    let (s, c) = phi.sin_cos();
-                    (Point2::new(z[0] - (c * a.x - s * a.y), z[1] - (s * a.x + c * a.y)), carried_var(tf))
+                    (start_from(z, dr.at(odo, tf).0.transform_point(antenna), phi), carried_var(tf))
                 }
                 None => (Point2::default(), gauge),
             };
@@ -301,15 +339,7 @@ pub(crate) fn initialise(
             (None, HeadingSource::StartPose, 0.0, gauge, Point2::default(), gauge)
         }
     };
-    let phi_var = phi_var.max(gauge);
-    let mut p = [[0.0; 5]; 5];
-    p[0][0] = p_var;
-    p[1][1] = p_var;
-    p[2][2] = phi_var;
-    p[3][3] = cfg.initial_gyro_bias_sigma.powi(2);
-    p[4][4] = cfg.initial_scale_sigma.powi(2);
-    let info = HeadingInit { stamp, source, start_heading_rad: phi, start_heading_sigma_rad: phi_var.sqrt() };
-    Ok(Init { x: [position.x, position.y, phi, 0.0, 1.0], p, info })
+    Ok(first_state((stamp, source), (phi, phi_var.max(gauge)), (position, p_var), cfg))
 }
 
 #[cfg(test)]

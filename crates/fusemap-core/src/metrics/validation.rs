@@ -130,6 +130,22 @@ fn turned_lidar<'a>(motion: &'a [(String, MotionAgreement)], t: &Thresholds) -> 
         .map(|(n, m)| (n.as_str(), m.median_deg))
 }
 
+/// Each sensor's relative drop of its held-out hit rate from its own map to the fused one
+/// (only with more than one single-sensor map to compare).
+fn hit_rate_drops(maps: &[MapFigures], fused: &MapFigures, singles: usize, t: &Thresholds) -> Vec<(String, f64)> {
+    let mut drops = Vec::new();
+    for h in &fused.hit_rates {
+        let own = rate_on(maps, &own_role(h.kind), &h.sensor, t.min_endpoints);
+        let on_fused = rate_on(maps, &MapRole::Fused, &h.sensor, t.min_endpoints);
+        if let (Some(own), Some(f)) = (own, on_fused) {
+            if singles > 1 && own > 0.0 {
+                drops.push((h.sensor.clone(), (own - f) / own));
+            }
+        }
+    }
+    drops
+}
+
 /// Judges the maps of a validation, with each SLAM lidar's motion against the pose
 /// sensors' (see the module docs).
 pub fn judge(maps: &[MapFigures], motion: &[(String, MotionAgreement)], t: &Thresholds) -> Judgement {
@@ -144,16 +160,7 @@ pub fn judge(maps: &[MapFigures], motion: &[(String, MotionAgreement)], t: &Thre
     };
     let singles: Vec<&MapFigures> =
         maps.iter().filter(|m| matches!(m.role, MapRole::Lidar | MapRole::Camera)).collect();
-    let mut drops = Vec::new();
-    for h in &fused.hit_rates {
-        let own = rate_on(maps, &own_role(h.kind), &h.sensor, t.min_endpoints);
-        let on_fused = rate_on(maps, &MapRole::Fused, &h.sensor, t.min_endpoints);
-        if let (Some(own), Some(f)) = (own, on_fused) {
-            if singles.len() > 1 && own > 0.0 {
-                drops.push((h.sensor.clone(), (own - f) / own));
-            }
-        }
-    }
+    let drops = hit_rate_drops(maps, fused, singles.len(), t);
     let best_single = singles.iter().map(|m| m.mean_entropy_nats).min_by(f64::total_cmp);
     let gain = best_single.filter(|_| singles.len() > 1).map(|h| h - fused.mean_entropy_nats);
     let worst = drops.iter().max_by(|a, b| a.1.total_cmp(&b.1)).filter(|d| d.1 >= t.hit_rate_drop);

@@ -19,8 +19,9 @@
 //! composed with the local offset between the two.
 
 use super::fixes::{FixNode, FixPriors, PositionFix};
+use super::grid::ProbabilityGrid;
 use super::grid_cache::GridCache;
-use super::local_match::{refine, LocalMatchParams};
+use super::local_match::{refine, LocalMatch, LocalMatchParams};
 use super::loop_closure::{Loops, OpenSearch};
 use super::odometry::OdometryAgreement;
 use super::optimisation::Pending;
@@ -387,19 +388,8 @@ impl Slam {
         // corridor both fit equally, and preferring the extrapolation there would feed its
         // own slide back into the next prediction.
         let local = &self.p.local;
-        let alt = moving.filter(|alt| {
-            let d = predicted.inverse().compose(*alt);
-            d.x.hypot(d.y) > 0.5 * local.linear_window_m || d.theta.abs() > 0.5 * local.angular_window_rad
-        });
         let g = &submap.grid;
-        let search = |at: Pose2| super::local_match::match_scan(g, hits, at, local);
-        let (mut m, m2) = match alt {
-            Some(alt) => {
-                let (m, m2) = join(|| search(predicted), || search(alt));
-                (m, Some((m2, alt)))
-            }
-            None => (search(predicted), None),
-        };
+        let (mut m, m2) = search_predictions(g, hits, predicted, moving, local);
         let mut predicted = predicted;
         // The constant-velocity prediction, clearly better, is the odometry's failure (a jump,
         // a stall).
@@ -537,6 +527,30 @@ impl Slam {
             report: self.report,
             open_loops: self.loops.open,
         }
+    }
+}
+
+/// The local match at the track's prediction and, when the constant-velocity prediction
+/// `moving` lies outside half the search window of it, at that one too (on the other
+/// thread), with the pose it was searched at.
+fn search_predictions(
+    g: &ProbabilityGrid,
+    hits: &[Point2],
+    predicted: Pose2,
+    moving: Option<Pose2>,
+    local: &LocalMatchParams,
+) -> (LocalMatch, Option<(LocalMatch, Pose2)>) {
+    let alt = moving.filter(|alt| {
+        let d = predicted.inverse().compose(*alt);
+        d.x.hypot(d.y) > 0.5 * local.linear_window_m || d.theta.abs() > 0.5 * local.angular_window_rad
+    });
+    let search = |at: Pose2| super::local_match::match_scan(g, hits, at, local);
+    match alt {
+        Some(alt) => {
+            let (m, m2) = join(|| search(predicted), || search(alt));
+            (m, Some((m2, alt)))
+        }
+        None => (search(predicted), None),
     }
 }
 

@@ -127,12 +127,9 @@ impl<'a> Renderer<'a> {
         [c * d[0] - s * d[1], s * d[0] + c * d[1], d[2]]
     }
 
-    /// Renders the robot at `pose` with the person (centre, radius, height) if present.
-    /// Glass draws its depth-or-transmission choice from `rng`.
-    pub fn render(&mut self, pose: Pose2, person: Option<(Point2, f64, f64)>, rng: &mut SplitMix64, out: &mut Frame) {
-        let c3 = self.centre_in_map(pose);
-        let c = Point2::new(c3[0], c3[1]);
-        // One horizontal cast per fan.
+    /// One horizontal cast per fan from the camera's centre `c`: each fan's walls in order
+    /// of distance, and whether it passes near the person (tested per pixel only there).
+    fn cast_fans(&mut self, pose: Pose2, c: Point2, person: Option<(Point2, f64, f64)>) {
         self.fan_start.clear();
         self.fan_hits.clear();
         self.fan_person.clear();
@@ -141,7 +138,6 @@ impl<'a> Renderer<'a> {
             self.caster.cast_all(c, (co, s), f64::INFINITY, &mut self.hits);
             self.fan_start.push(self.fan_hits.len() as u32);
             self.fan_hits.extend_from_slice(&self.hits);
-            // The person is tested per pixel only in fans passing near it.
             let near = person.is_some_and(|(p, r, _)| {
                 let (dx, dy) = (p.x - c.x, p.y - c.y);
                 let along = dx * co + dy * s;
@@ -150,6 +146,14 @@ impl<'a> Renderer<'a> {
             self.fan_person.push(near);
         }
         self.fan_start.push(self.fan_hits.len() as u32);
+    }
+
+    /// Renders the robot at `pose` with the person (centre, radius, height) if present.
+    /// Glass draws its depth-or-transmission choice from `rng`.
+    pub fn render(&mut self, pose: Pose2, person: Option<(Point2, f64, f64)>, rng: &mut SplitMix64, out: &mut Frame) {
+        let c3 = self.centre_in_map(pose);
+        let c = Point2::new(c3[0], c3[1]);
+        self.cast_fans(pose, c, person);
         let n = self.rays.len();
         out.labels.clear();
         out.depth.clear();

@@ -23,6 +23,49 @@ impl Slam {
             self.update_drift();
             self.loops.drift_stale = false;
         }
+        let (work, planned) = self.plan_batch();
+        if planned.is_empty() {
+            self.report.loop_search_s += t0.elapsed().as_secs_f64();
+            return;
+        }
+        let mut needed: Vec<usize> = planned.iter().map(|p| p.pair.submap).collect();
+        needed.sort_unstable();
+        needed.dedup();
+        let submaps = self.submaps.all();
+        self.grids.prepare(&needed, |s| &submaps[s].grid);
+        let (grids, nodes) = (&self.grids, &self.nodes);
+        let local = LocalMatchParams { degeneracy_ratio: self.p.loop_closure_degeneracy_ratio, ..self.p.local };
+        let local = &local;
+        // The costliest searches start first, so the threads finish together; the results
+        // are taken in the pairs' order whatever the order they ran in.
+        let mut order: Vec<usize> = (0..planned.len()).collect();
+        order.sort_by(|&a, &b| work[b].total_cmp(&work[a]).then(a.cmp(&b)));
+        let mut ran: Vec<(usize, Outcome)> = map_all(&order, |&k| {
+            let pl = &planned[k];
+            let sm = &submaps[pl.pair.submap];
+            let node = &nodes[pl.pair.node];
+            let pre = grids.peek(pl.pair.submap).expect("prepared above");
+            let out = search_branch_and_bound(pre, &node.search_points, pl.initial, &pl.search);
+            let found = out.found.map(|f| {
+                let pose = refine(&sm.grid, &node.points, f.pose, f.pose, local);
+                let score = mean_probability(&sm.grid, &node.points, pose);
+                (pose, score, match_information(&sm.grid, &node.points, pose, local).1)
+            });
+            (k, Outcome { found, best_score: out.best_score, on_edge: out.on_edge })
+        });
+        ran.sort_unstable_by_key(|r| r.0);
+        self.report.loop_searches += planned.len() as u64;
+        for (pl, (_, out)) in planned.iter().zip(ran) {
+            self.take_outcome(pl, out);
+        }
+        self.expire_hypotheses();
+        self.report.loop_search_s += t0.elapsed().as_secs_f64();
+    }
+
+    /// The batch's searches, each with its work: the pending pairs and the global ones,
+    /// planned; confirmations first, then local, then global, cheaper ones first within a
+    /// kind, until the batch's work budget is spent (the first one always runs).
+    fn plan_batch(&mut self) -> (Vec<f64>, Vec<Planned>) {
         let mut pairs = std::mem::take(&mut self.loops.pending);
         pairs.extend(self.global_pairs());
         // Confirmations first, then local, then global, within the budget.
@@ -62,42 +105,7 @@ impl Slam {
             .map(|(_, w, pl)| (w, pl))
             .unzip();
         self.report.loop_over_budget += (total - planned.len()) as u64;
-        if planned.is_empty() {
-            self.report.loop_search_s += t0.elapsed().as_secs_f64();
-            return;
-        }
-        let mut needed: Vec<usize> = planned.iter().map(|p| p.pair.submap).collect();
-        needed.sort_unstable();
-        needed.dedup();
-        let submaps = self.submaps.all();
-        self.grids.prepare(&needed, |s| &submaps[s].grid);
-        let (grids, nodes) = (&self.grids, &self.nodes);
-        let local = LocalMatchParams { degeneracy_ratio: self.p.loop_closure_degeneracy_ratio, ..self.p.local };
-        let local = &local;
-        // The costliest searches start first, so the threads finish together; the results
-        // are taken in the pairs' order whatever the order they ran in.
-        let mut order: Vec<usize> = (0..planned.len()).collect();
-        order.sort_by(|&a, &b| work[b].total_cmp(&work[a]).then(a.cmp(&b)));
-        let mut ran: Vec<(usize, Outcome)> = map_all(&order, |&k| {
-            let pl = &planned[k];
-            let sm = &submaps[pl.pair.submap];
-            let node = &nodes[pl.pair.node];
-            let pre = grids.peek(pl.pair.submap).expect("prepared above");
-            let out = search_branch_and_bound(pre, &node.search_points, pl.initial, &pl.search);
-            let found = out.found.map(|f| {
-                let pose = refine(&sm.grid, &node.points, f.pose, f.pose, local);
-                let score = mean_probability(&sm.grid, &node.points, pose);
-                (pose, score, match_information(&sm.grid, &node.points, pose, local).1)
-            });
-            (k, Outcome { found, best_score: out.best_score, on_edge: out.on_edge })
-        });
-        ran.sort_unstable_by_key(|r| r.0);
-        self.report.loop_searches += planned.len() as u64;
-        for (pl, (_, out)) in planned.iter().zip(ran) {
-            self.take_outcome(pl, out);
-        }
-        self.expire_hypotheses();
-        self.report.loop_search_s += t0.elapsed().as_secs_f64();
+        (work, planned)
     }
 
     pub(super) fn record_open(&mut self, pl: &Planned, best_score: f32, reason: OpenReason, on_edge: bool) {
@@ -158,50 +166,60 @@ impl Slam {
         let small = shift.x.hypot(shift.y) <= pl.base.0 && normalize_angle(shift.theta).abs() <= pl.base.1;
         match pl.pair.kind {
             Kind::Local if small => self.accept(edge, n, s),
-            Kind::Confirm(id) => {
-                let Some(i) = self.loops.hypotheses.iter().position(|h| h.id == id) else { return };
-                let h = self.loops.hypotheses.remove(i);
-                let (correction, expires_m) = (h.correction, h.expires_m);
-                let second = Hypothesis {
-                    id: u64::MAX,
-                    edge,
-                    node: n,
-                    submap: s,
-                    correction,
-                    expires_m,
-                    score,
-                    global: false,
-                    attempts: 0,
-                };
-                self.confirmed(h, second);
-            }
-            _ => {
-                // Where the graph has the node now, and where the match puts it.
-                let gs = self.graph.nodes()[self.submap_graph[s]];
-                let gn = self.graph.nodes()[self.nodes[n].graph];
-                let truth = gs.compose(sm.local_pose.inverse()).compose(pose);
-                let correction = truth.compose(gn.inverse());
-                self.report.loop_hypotheses += 1;
+            Kind::Confirm(id) => self.confirm_hypothesis(id, edge, (n, s), score),
+            _ => self.hold_hypothesis(pl, edge, pose, score),
+        }
+    }
 
-                if self.loops.hypotheses.len() >= MAX_HYPOTHESES {
-                    let old = self.loops.hypotheses.remove(0);
-                    self.open_hypothesis(&old);
-                }
-                let id = self.loops.next_id;
-                self.loops.next_id += 1;
-                let expires_m = self.nodes.last().map_or(0.0, |l| l.path_m) + self.p.loop_closure_confirm_within_m;
-                let global = pl.pair.kind == Kind::Global;
-                let h = Hypothesis { id, edge, node: n, submap: s, correction, expires_m, score, global, attempts: 0 };
-                // Another hypothesis, from another node, that moves the trajectory the same
-                // way confirms this one (and this one it).
-                match self.loops.hypotheses.iter().position(|o| self.agree(o, &h)) {
-                    Some(i) => {
-                        let o = self.loops.hypotheses.remove(i);
-                        self.confirmed(o, h);
-                    }
-                    None => self.loops.hypotheses.push(h),
-                }
+    /// A confirming search found the place hypothesis `id` predicted: the two close
+    /// together (a hypothesis already dropped is left alone).
+    fn confirm_hypothesis(&mut self, id: u64, edge: Edge, (n, s): (usize, usize), score: f32) {
+        let Some(i) = self.loops.hypotheses.iter().position(|h| h.id == id) else { return };
+        let h = self.loops.hypotheses.remove(i);
+        let (correction, expires_m) = (h.correction, h.expires_m);
+        let second = Hypothesis {
+            id: u64::MAX,
+            edge,
+            node: n,
+            submap: s,
+            correction,
+            expires_m,
+            score,
+            global: false,
+            attempts: 0,
+        };
+        self.confirmed(h, second);
+    }
+
+    /// A match that moves the node too far to take alone: held as a hypothesis until another
+    /// node's match agrees with it (then both close), or it expires.
+    fn hold_hypothesis(&mut self, pl: &Planned, edge: Edge, pose: Pose2, score: f32) {
+        let (s, n) = (pl.pair.submap, pl.pair.node);
+        let sm = &self.submaps.all()[s];
+        // Where the graph has the node now, and where the match puts it.
+        let gs = self.graph.nodes()[self.submap_graph[s]];
+        let gn = self.graph.nodes()[self.nodes[n].graph];
+        let truth = gs.compose(sm.local_pose.inverse()).compose(pose);
+        let correction = truth.compose(gn.inverse());
+        self.report.loop_hypotheses += 1;
+
+        if self.loops.hypotheses.len() >= MAX_HYPOTHESES {
+            let old = self.loops.hypotheses.remove(0);
+            self.open_hypothesis(&old);
+        }
+        let id = self.loops.next_id;
+        self.loops.next_id += 1;
+        let expires_m = self.nodes.last().map_or(0.0, |l| l.path_m) + self.p.loop_closure_confirm_within_m;
+        let global = pl.pair.kind == Kind::Global;
+        let h = Hypothesis { id, edge, node: n, submap: s, correction, expires_m, score, global, attempts: 0 };
+        // Another hypothesis, from another node, that moves the trajectory the same
+        // way confirms this one (and this one it).
+        match self.loops.hypotheses.iter().position(|o| self.agree(o, &h)) {
+            Some(i) => {
+                let o = self.loops.hypotheses.remove(i);
+                self.confirmed(o, h);
             }
+            None => self.loops.hypotheses.push(h),
         }
     }
 

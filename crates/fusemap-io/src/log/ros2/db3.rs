@@ -231,7 +231,6 @@ impl Db3Source {
     fn fetch(&mut self, index: u64, id: i64, visit: &mut dyn FnMut(RawMessage<'_>)) -> Result<()> {
         self.budget.arm();
         let path = &self.path;
-        let at = |topic: String, message: String| Error::format(path, Location::Message { index, topic }, message);
         let topics = &self.topics;
         let max = i64::try_from(self.max_message).unwrap_or(i64::MAX);
         // Ok(Err(topic_id)): the row names a topic `topics` does not list. The payload is
@@ -277,37 +276,48 @@ impl Db3Source {
                 ),
             ));
         }
-        match row {
-            Ok(Some(Ok(()))) => Ok(()),
-            Ok(Some(Err(topic_id))) => Err(at(
-                format!("(topic id {topic_id})"),
-                format!("row id {id} of table `messages` has topic_id {topic_id}, which table `topics` does not list"),
-            )),
-            // Listed when the order was read, gone when fetched: the file is immutable to
-            // SQLite here, so the row's page is damaged (a cut file reads as empty pages).
-            Ok(None) => Err(Error::truncated(
-                path,
-                Location::Message { index, topic: format!("(row id {id})") },
-                format!(
-                    "row id {id} of table `messages` is listed but cannot be found: the database is truncated or \
-                     corrupt; the messages before it are read"
-                ),
-            )),
-            // The order came from the timestamp index, but the row lies in a damaged part
-            // of the file: the log's intact part ends here.
-            Err(e) if is_corrupt(&e) => Err(Error::truncated(
-                path,
-                Location::Message { index, topic: format!("(row id {id})") },
-                format!(
-                    "SQLite: row id {id} of table `messages` lies in a damaged part of the database ({}): it is \
-                     truncated or corrupt; the messages before it are read",
-                    error_chain(&e)
-                ),
-            )),
-            Err(e) => Err(at(
-                format!("(row id {id})"),
-                format!("SQLite: row id {id} of table `messages`: {}", error_chain(&e)),
-            )),
+        fetch_result(path, index, id, row)
+    }
+}
+
+/// What fetching row `id` came to: done, or the error naming the row (`Ok(Err(topic_id))`:
+/// the row names a topic `topics` does not list).
+fn fetch_result(
+    path: &Path,
+    index: u64,
+    id: i64,
+    row: rusqlite::Result<Option<std::result::Result<(), i64>>>,
+) -> Result<()> {
+    let at = |topic: String, message: String| Error::format(path, Location::Message { index, topic }, message);
+    match row {
+        Ok(Some(Ok(()))) => Ok(()),
+        Ok(Some(Err(topic_id))) => Err(at(
+            format!("(topic id {topic_id})"),
+            format!("row id {id} of table `messages` has topic_id {topic_id}, which table `topics` does not list"),
+        )),
+        // Listed when the order was read, gone when fetched: the file is immutable to
+        // SQLite here, so the row's page is damaged (a cut file reads as empty pages).
+        Ok(None) => Err(Error::truncated(
+            path,
+            Location::Message { index, topic: format!("(row id {id})") },
+            format!(
+                "row id {id} of table `messages` is listed but cannot be found: the database is truncated or \
+                 corrupt; the messages before it are read"
+            ),
+        )),
+        // The order came from the timestamp index, but the row lies in a damaged part
+        // of the file: the log's intact part ends here.
+        Err(e) if is_corrupt(&e) => Err(Error::truncated(
+            path,
+            Location::Message { index, topic: format!("(row id {id})") },
+            format!(
+                "SQLite: row id {id} of table `messages` lies in a damaged part of the database ({}): it is \
+                 truncated or corrupt; the messages before it are read",
+                error_chain(&e)
+            ),
+        )),
+        Err(e) => {
+            Err(at(format!("(row id {id})"), format!("SQLite: row id {id} of table `messages`: {}", error_chain(&e))))
         }
     }
 }
