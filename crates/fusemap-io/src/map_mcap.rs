@@ -12,6 +12,7 @@
 //! | `/map/semantic` | `sensor_msgs/msg/Image` | with a camera: the class map, `mono8` class indices |
 //! | `/map/dynamic` | `nav_msgs/msg/OccupancyGrid` | with a camera: the dynamic layer |
 //! | `/slam/loop_closures` | `visualization_msgs/msg/MarkerArray` | SLAM's loop closures as lines |
+//! | `/tf_static` | `tf2_msgs/msg/TFMessage` | where known: `map → odom` at the last pose |
 //!
 //! Everything is in the `map` frame, stamped at the run's last pose, and offered latched
 //! (transient local, depth 1), as `map_server` offers `/map`: a subscriber that starts
@@ -23,13 +24,23 @@
 //! `map.yaml`. `/map/semantic`'s rows run from the highest y down, as in `semantic.png`
 //! (an image's row 0 is its top); its palette (`semantic.yaml`'s text) is the metadata
 //! record `semantic`, key `yaml`. The file is written atomically.
+//!
+//! `/tf_static` joins the map to a bag's own TF tree (REP 105: `map → odom → base_link`), so
+//! that Foxglove or RViz2 draws `/map` under the robot of the recording played beside it.
+//! It is written where the track was odometry (identity: the map frame is `odom`) or SLAM's
+//! correction of odometry; SLAM's correction moves along the log, and a static transform
+//! holds its value at the last pose, so early in a long log the overlay is off by the drift
+//! corrected since.
 
 use crate::atomic::{check_raster, write_atomic};
 use crate::log::ros2::msgs::builtin_interfaces::split_stamp;
-use crate::log::ros2::msgs::geometry_msgs::{Point, Pose, PoseStamped, Quaternion};
+use crate::log::ros2::msgs::geometry_msgs::{
+    Point, Pose, PoseStamped, Quaternion, Transform, TransformStamped, Vector3,
+};
 use crate::log::ros2::msgs::nav_msgs::{MapMetaData, OccupancyGrid, Path as PathMsg, OCCUPANCY_GRID, PATH};
 use crate::log::ros2::msgs::sensor_msgs::{Image, PointCloud2, PointField, IMAGE, POINT_CLOUD2};
 use crate::log::ros2::msgs::std_msgs::{ColorRgba, Header};
+use crate::log::ros2::msgs::tf2_msgs::{TfMessageRef, TF_MESSAGE};
 use crate::log::ros2::msgs::visualization_msgs::{Marker, MarkerArray, MARKER_ARRAY};
 use crate::log::ros2::writer::cdr_write::{encode_cdr, CdrEncode};
 use crate::log::ros2::writer::definition::MsgDef;
@@ -64,6 +75,8 @@ pub struct MapMessages<'a> {
     pub dynamic: Option<&'a CellRaster<f32>>,
     /// SLAM's loop closures, as segments between the two poses they join.
     pub closures: &'a [(Point2, Point2)],
+    /// `map → odom` and the odometry frame's name, where known.
+    pub map_from_odom: Option<(&'a str, Pose2)>,
 }
 
 /// Writes `content` to `path` as one MCAP file.
@@ -88,6 +101,9 @@ pub fn write_map_mcap(path: &Path, content: &MapMessages<'_>) -> Result<()> {
         }
         if !content.closures.is_empty() {
             add("/slam/loop_closures", &MARKER_ARRAY, &closure_markers(content.closures, stamp))?;
+        }
+        if let Some((odom, m)) = content.map_from_odom {
+            add("/tf_static", &TF_MESSAGE, &TfMessageRef(&[map_to_odom(odom, m, stamp)]))?;
         }
         Ok(())
     })();
@@ -150,6 +166,16 @@ fn header(stamp: Stamp) -> Header {
 fn pose(x: f64, y: f64, yaw: f64) -> Pose {
     let (s, c) = (0.5 * yaw).sin_cos();
     Pose { position: Point { x, y, z: 0.0 }, orientation: Quaternion { x: 0.0, y: 0.0, z: s, w: c } }
+}
+
+/// `map → odom` as a TF edge: the pose of the odometry frame in the map.
+fn map_to_odom(odom: &str, m: Pose2, stamp: Stamp) -> TransformStamped {
+    let p = pose(m.x, m.y, m.theta);
+    TransformStamped {
+        header: header(stamp),
+        child_frame_id: odom.to_string(),
+        transform: Transform { translation: Vector3 { x: m.x, y: m.y, z: 0.0 }, rotation: p.orientation },
+    }
 }
 
 fn meta(width: usize, height: usize, resolution: f64, origin: Point2, stamp: Stamp) -> MapMetaData {

@@ -100,6 +100,7 @@ impl DemoJob {
             validation: None,
             calibration: None,
             endpoints: None,
+            map_from_odom: run.map_from_odom.as_ref().map(|(f, m)| (f.as_str(), *m)),
         };
         let summary = finish(&run.engine, files, &export, record)?;
         Ok(DemoRun { summary, scores, other_maps })

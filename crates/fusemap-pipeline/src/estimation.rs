@@ -270,6 +270,7 @@ pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Ch
         estimator: Some(Box::new(report)),
         notes,
         slam: None,
+        odom_frame: None,
     })
 }
 

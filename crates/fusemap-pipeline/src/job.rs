@@ -228,6 +228,7 @@ impl MapJob {
                     validation: None,
                     calibration: None,
                     endpoints: Some(&run.endpoints),
+                    map_from_odom: run.map_from_odom.as_ref().map(|(f, m)| (f.as_str(), *m)),
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }
@@ -244,6 +245,7 @@ impl MapJob {
                     validation: None,
                     calibration: None,
                     endpoints: None,
+                    map_from_odom: None,
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }

@@ -53,6 +53,10 @@ pub struct MapRun {
     /// Every lidar return as placed, one point per cell per scan, when `[output] points =
     /// "endpoints"` asked (empty otherwise).
     pub endpoints: Vec<[f32; 2]>,
+    /// `map → odom` at the track's last stamp, with the odometry frame's name, where the
+    /// track is odometry (identity) or SLAM's correction of it; for `map.mcap`'s
+    /// `/tf_static`.
+    pub map_from_odom: Option<(String, Pose2)>,
 }
 
 /// A timed track's samples with the pose every scan was placed with, by stamp (a sample
@@ -183,6 +187,13 @@ pub fn map_with_track(
         Track::ScanLine(_) => placed,
         Track::Timed(t) => with_scan_poses(t.samples(), placed),
     };
+    let map_from_odom = match (&chosen.track, &chosen.odom_frame, trajectory.last()) {
+        // Without SLAM the odometry frame is the map frame.
+        (Track::Timed(t), Some(frame), Some(&(last, _))) => {
+            Some((frame.clone(), t.frame_correction_at(last).unwrap_or(Pose2::IDENTITY)))
+        }
+        _ => None,
+    };
 
     let skipped = lidar_notes(&streams.lidars, cfg, &mut notes);
     if let Some(cut) = &inv.truncated {
@@ -207,6 +218,7 @@ pub fn map_with_track(
         camera_samples,
         lidar_surface,
         endpoints,
+        map_from_odom,
     })
 }
 

@@ -68,6 +68,10 @@ pub struct ChosenTrack {
     pub notes: Vec<String>,
     /// What SLAM did, when it corrected the track.
     pub slam: Option<Box<crate::slam_summary::SlamSummary>>,
+    /// The odometry frame the track's poses were given in (REP 105's `odom`: an odometry
+    /// topic's frame, or TF's root when it is `odom`), for `map → odom` in `map.mcap`;
+    /// `None` for a track in the map frame already (the estimator, poses on scan lines).
+    pub odom_frame: Option<String>,
 }
 
 /// SLAM's optimised poses of scan lines, found by the line's own stamp and pose: placed in
@@ -176,6 +180,7 @@ impl ChosenTrack {
             estimator: None,
             notes: Vec::new(),
             slam: None,
+            odom_frame: None,
         }
     }
 }
@@ -330,7 +335,18 @@ impl ChosenTrack {
         cfg: &LogConfig,
     ) -> Self {
         let notes = sample_notes(&name, &counts, cfg);
-        ChosenTrack { source, track, name, notes, counts, stamps, receive, estimator: None, slam: None }
+        ChosenTrack {
+            source,
+            track,
+            name,
+            notes,
+            counts,
+            stamps,
+            receive,
+            estimator: None,
+            slam: None,
+            odom_frame: None,
+        }
     }
 }
 
@@ -364,7 +380,11 @@ pub(crate) fn odometry_track(inv: &Inventory, cfg: &LogConfig, o: &BoundSensor) 
     }
     let stamps = (msgs.iter().map(|m| m.stamp).collect(), msgs.iter().map(|m| m.receive_stamp).collect());
     let name = format!("odometry `{}`", o.topic);
-    Ok(ChosenTrack::of(PoseSource::Odometry, Track::Timed(Box::new(buffer)), name, counts, stamps, cfg))
+    let frame = inv.frames.get(&o.topic).map(|f| f.trim_start_matches('/')).filter(|f| !f.is_empty());
+    Ok(ChosenTrack {
+        odom_frame: Some(frame.unwrap_or("odom").to_string()),
+        ..ChosenTrack::of(PoseSource::Odometry, Track::Timed(Box::new(buffer)), name, counts, stamps, cfg)
+    })
 }
 
 /// The TF edges that pose the base frame: its own dynamic edge, and every dynamic edge on
@@ -416,6 +436,8 @@ impl TfChain {
         let root = TfTrack::root_of(&self.tree, &self.base);
         let parent = self.tree.parent(&self.base).map(str::to_string);
         let single_edge = root.is_some() && root == parent && !self.samples.is_empty();
+        // TF under `odom` is odometry (as SLAM takes it, `slam::applies`).
+        let odom_frame = root.as_deref().map(|r| r.trim_start_matches('/')).filter(|r| *r == "odom").map(String::from);
         let no_pose = || PipelineError::Refused(format!("no usable TF pose of `{}`", cfg.base_frame));
         if let (Some(root), false) = (root, single_edge) {
             // Several edges above the base, or a static one under a dynamic one: compose
@@ -435,14 +457,11 @@ impl TfChain {
                 return Err(no_pose());
             }
             let receive = vec![None; stamps.len()];
-            return Ok(ChosenTrack::of(
-                PoseSource::Tf,
-                Track::Timed(Box::new(track)),
-                name,
-                counts,
-                (stamps, receive),
-                cfg,
-            ));
+            let timed = Track::Timed(Box::new(track));
+            return Ok(ChosenTrack {
+                odom_frame,
+                ..ChosenTrack::of(PoseSource::Tf, timed, name, counts, (stamps, receive), cfg)
+            });
         }
         let stamps: Vec<Stamp> = self.samples.iter().map(|s| s.0).collect();
         let buffer = buffer_of(cfg, self.samples, &mut counts);
@@ -451,6 +470,7 @@ impl TfChain {
         }
         let name = format!("TF `… → {}`", cfg.base_frame);
         let receive = vec![None; stamps.len()];
-        Ok(ChosenTrack::of(PoseSource::Tf, Track::Timed(Box::new(buffer)), name, counts, (stamps, receive), cfg))
+        let timed = Track::Timed(Box::new(buffer));
+        Ok(ChosenTrack { odom_frame, ..ChosenTrack::of(PoseSource::Tf, timed, name, counts, (stamps, receive), cfg) })
     }
 }

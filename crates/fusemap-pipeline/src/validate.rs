@@ -189,6 +189,7 @@ impl ValidateJob {
             validation: Some(serde_json::to_value(&validation)?),
             calibration: None,
             endpoints: None,
+            map_from_odom: run.map_from_odom.as_ref().map(|(f, m)| (f.as_str(), *m)),
         };
         let export = ExportOptions::of(plan, None);
         let summary = finish(&run.engine, outputs, &export, record)?;

@@ -90,10 +90,12 @@ fn intel_raw_bag_maps() {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
     // The map as ROS 2 messages and point clouds, read by third-party readers, agrees with
-    // map.pgm and trajectory.tum; SLAM's loop closures come as markers.
+    // map.pgm and trajectory.tum; SLAM's loop closures come as markers, and SLAM's
+    // correction of the odometry as `map → odom` (the bag's odometry frame).
     if let Some(c) = crate::util::check_map_outputs(&dir) {
-        let topics = serde_json::json!(["/map", "/map_points", "/slam/loop_closures", "/trajectory"]);
+        let topics = serde_json::json!(["/map", "/map_points", "/slam/loop_closures", "/tf_static", "/trajectory"]);
         assert_eq!(c["topics"], topics, "{c}");
+        assert_eq!(c["tf_static"]["child"], "odom", "{c}");
         assert_eq!(c["pcd_fields"], serde_json::json!(["x", "y", "z", "probability"]), "{c}");
     }
     // The README's benchmark command: every relation finds its scans' poses in

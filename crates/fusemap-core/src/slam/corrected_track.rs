@@ -97,6 +97,10 @@ impl PoseTrack for CorrectedTrack {
         self.base.span()
     }
 
+    fn frame_correction_at(&self, t: Stamp) -> Option<Pose2> {
+        Some(self.correction_at(t))
+    }
+
     /// The base track's samples, corrected (across a jump: the optimised poses
     /// interpolated, as [`pose_at`](Self::pose_at) gives them).
     fn samples(&self) -> Vec<(Stamp, Pose2)> {
@@ -126,6 +130,9 @@ mod tests {
             let q = track.pose_at(t, SyncMode::Interpolate).unwrap();
             assert!((q.x - p.x).abs() < 1e-12 && (q.y - p.y).abs() < 1e-12 && (q.theta - p.theta).abs() < 1e-12);
         }
+        // The correction is `map → odom`, the same at every stamp here.
+        let m = track.frame_correction_at(Stamp(250)).unwrap();
+        assert!((m.x - c.x).abs() < 1e-12 && (m.y - c.y).abs() < 1e-12 && (m.theta - c.theta).abs() < 1e-12);
         let mid = track.pose_at(Stamp(250), SyncMode::Interpolate).unwrap();
         let want = c.compose(Pose2::new(0.25, 0.0, 0.0));
         assert!((mid.x - want.x).abs() < 1e-12 && (mid.y - want.y).abs() < 1e-12);

@@ -29,6 +29,13 @@ pub trait PoseTrack: Send + Sync {
 
     /// The track's samples in time order (for `trajectory.tum`).
     fn samples(&self) -> Vec<(Stamp, Pose2)>;
+
+    /// For a track that is another track's poses moved into the map frame (SLAM's
+    /// correction of an odometry track), the transform `map_from_source` at `t`: REP 105's
+    /// `map → odom`. `None` for a track given in one frame.
+    fn frame_correction_at(&self, _t: Stamp) -> Option<Pose2> {
+        None
+    }
 }
 
 impl PoseTrack for PoseBuffer {

@@ -49,6 +49,7 @@ fn the_map_the_track_and_the_points_as_ros_messages() {
         semantic: None,
         dynamic: None,
         closures: &closures,
+        map_from_odom: Some(("odom", Pose2::new(0.5, -1.0, std::f64::consts::FRAC_PI_2))),
     };
     write_map_mcap(&path, &content).unwrap();
     let messages = read(&path);
@@ -60,8 +61,19 @@ fn the_map_the_track_and_the_points_as_ros_messages() {
             ("/trajectory", "nav_msgs/msg/Path"),
             ("/map_points", "sensor_msgs/msg/PointCloud2"),
             ("/slam/loop_closures", "visualization_msgs/msg/MarkerArray"),
+            ("/tf_static", "tf2_msgs/msg/TFMessage"),
         ]
     );
+    // /tf_static: one transform, map → odom, the odometry frame's pose in the map.
+    let mut c = CdrReader::new(&messages[4].2[4..]);
+    assert_eq!(c.u32("transforms").unwrap(), 1);
+    assert_eq!((c.i32("sec").unwrap(), c.u32("ns").unwrap()), (2, 0));
+    assert_eq!((c.string("frame").unwrap(), c.string("child").unwrap()), ("map".into(), "odom".into()));
+    let t: Vec<f64> = (0..7).map(|_| c.f64("transform").unwrap()).collect();
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    assert_eq!(t[..3], [0.5, -1.0, 0.0]);
+    assert!(t[3..5] == [0.0, 0.0] && (t[5] - h).abs() < 1e-15 && (t[6] - h).abs() < 1e-15, "{t:?}");
+    assert_eq!(c.remaining(), 0);
     // /map: header (stamp 2 s, "map"), map_load_time, resolution, width, height, origin, data.
     let mut c = CdrReader::new(&messages[0].2[4..]);
     assert_eq!((c.i32("sec").unwrap(), c.u32("ns").unwrap()), (2, 0));
@@ -110,6 +122,7 @@ fn a_camera_run_adds_its_layers_and_palette() {
         semantic: Some(&semantic),
         dynamic: Some(&dynamic),
         closures: &[],
+        map_from_odom: None,
     };
     write_map_mcap(&path, &content).unwrap();
     let messages = read(&path);

@@ -183,6 +183,7 @@ impl CalibrateJob {
             validation: None,
             calibration: Some(serde_json::to_value(&calibration)?),
             endpoints: None,
+            map_from_odom: run.map_from_odom.as_ref().map(|(f, m)| (f.as_str(), *m)),
         };
         let export = ExportOptions::of(plan, None);
         let summary = finish(&run.engine, outputs, &export, record)?;

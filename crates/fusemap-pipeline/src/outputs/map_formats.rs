@@ -3,14 +3,14 @@
 //! occupied cells as points for PCL, Open3D and CloudCompare).
 
 use super::set::OutputFiles;
-use super::write::Layers;
 use super::OutputError;
 use fusemap_core::config::{OutputConfig, PointsMode};
 use fusemap_core::geometry::{Point2, Pose2};
-use fusemap_core::grid::Raster;
+use fusemap_core::grid::{CellRaster, Raster};
 use fusemap_core::time::Stamp;
 use fusemap_io::map_mcap::{write_map_mcap, MapMessages};
 use fusemap_io::point_cloud::{write_pcd, write_ply, MapCloud};
+use fusemap_io::semantic::SemanticRaster;
 
 /// The formats a run writes, and the lidar returns for `[output] points = "endpoints"`
 /// (a log run's; `None` for the other runs, whose clouds hold the occupied cells).
@@ -19,15 +19,18 @@ pub struct FormatRequest<'a> {
     pub formats: OutputConfig,
     /// The returns as placed.
     pub endpoints: Option<&'a [[f32; 2]]>,
+    /// `map → odom` and the odometry frame's name, for `map.mcap`'s `/tf_static`.
+    pub map_from_odom: Option<(&'a str, Pose2)>,
 }
 
-/// Writes the formats `request` turns on for the dense map `r`: nothing for a map with no
-/// observed cell.
+/// Writes the formats `request` turns on for the dense map `r`, with a camera's layers
+/// (the semantic layer as `semantic.png` shows it, the dynamic layer): nothing for a map
+/// with no observed cell.
 pub(crate) fn write_map_formats(
     files: &OutputFiles,
     request: FormatRequest<'_>,
     r: &Raster,
-    layers: Option<&Layers>,
+    layers: Option<(&SemanticRaster, &CellRaster<f32>)>,
     trajectory: &[(Stamp, Pose2)],
     closures: &[(Point2, Point2)],
 ) -> Result<(), OutputError> {
@@ -35,8 +38,7 @@ pub(crate) fn write_map_formats(
     if r.known_count() == 0 || !(formats.mcap || formats.pcd || formats.ply) {
         return Ok(());
     }
-    let picture = layers.map(Layers::picture);
-    let classes = picture.as_ref().map(|s| (s.best.as_slice(), s.classes.as_slice()));
+    let classes = layers.map(|(s, _)| (s.best.as_slice(), s.classes.as_slice()));
     let cloud = match request.endpoints {
         Some(points) if formats.points == PointsMode::Endpoints => MapCloud::endpoints(r, points),
         _ => MapCloud::occupied_cells(r, classes),
@@ -53,9 +55,10 @@ pub(crate) fn write_map_formats(
             stamp: trajectory.last().map_or(Stamp(0), |p| p.0),
             trajectory,
             cloud: &cloud,
-            semantic: picture.as_ref(),
-            dynamic: layers.map(|l| &l.dynamic),
+            semantic: layers.map(|(s, _)| s),
+            dynamic: layers.map(|(_, d)| d),
             closures,
+            map_from_odom: request.map_from_odom,
         };
         write_map_mcap(&files.mcap, &content)?;
     }

@@ -15,7 +15,7 @@ use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::grid::{CellBox, CellIndex, CellRaster, DynamicParams, FusionGrid, Raster};
 use fusemap_core::measurement::{SensorId, SensorKind};
-use fusemap_core::metrics::{map_entropy, sparse_entropy};
+use fusemap_core::metrics::{map_entropy, sparse_entropy, EntropyReport};
 use fusemap_core::sensor::ReturnCounts;
 use fusemap_core::time::Stamp;
 use fusemap_io::npz::NpzLayers;
@@ -42,6 +42,8 @@ pub struct RunRecord<'a> {
     pub calibration: Option<serde_json::Value>,
     /// The lidar returns as placed, for point clouds of `[output] points = "endpoints"`.
     pub endpoints: Option<&'a [[f32; 2]]>,
+    /// `map → odom` and the odometry frame's name, where known (`MapRun::map_from_odom`).
+    pub map_from_odom: Option<(&'a str, Pose2)>,
 }
 
 /// The semantic and dynamic layers of a run with a camera, over the occupancy raster's
@@ -130,14 +132,16 @@ pub fn write(
         fusemap_io::picture::write_map_png(&files.png, overview)?;
     }
     if let MapView::Dense(r) = view {
-        match layers {
-            Some(l) => {
+        // semantic.png's classes, built once for it and map.mcap's /map/semantic.
+        let picture = layers.map(Layers::picture);
+        match (layers, &picture) {
+            (Some(l), Some(picture)) => {
                 let with = NpzLayers { semantic: Some(&l.semantic), dynamic: Some(&l.dynamic) };
                 fusemap_io::npz::write_map_npz_with(&files.npz, r, &with)?;
-                fusemap_io::semantic::write_semantic(&files.semantic, &l.picture())?;
+                fusemap_io::semantic::write_semantic(&files.semantic, picture)?;
                 fusemap_io::semantic::write_dynamic_png(&files.dynamic, &l.dynamic)?;
             }
-            None => fusemap_io::npz::write_map_npz(&files.npz, r)?,
+            _ => fusemap_io::npz::write_map_npz(&files.npz, r)?,
         }
         fusemap_io::map_server::write_map_server(&files.yaml, r)?;
         fusemap_io::picture::write_map_png(&files.png, r)?;
@@ -145,6 +149,7 @@ pub fn write(
             fusemap_io::slam_picture::write_pose_graph_png(&files.slam, r, trajectory, closures, fixes)?;
         }
         let closures = graph.as_ref().map_or(&[][..], |g| &g.1[..]);
+        let layers = layers.zip(picture.as_ref()).map(|(l, p)| (p, &l.dynamic));
         write_map_formats(&files, request, r, layers, trajectory.unwrap_or_default(), closures)?;
     }
     let value =
@@ -316,6 +321,28 @@ fn view_notes(view: &MapView, camera: bool, formats: OutputConfig, endpoints: bo
     }
 }
 
+/// The summary's `map` and `entropy` of `view`.
+fn map_info(view: &MapView, grid: &FusionGrid) -> (MapInfo, Option<EntropyReport>) {
+    match view {
+        MapView::Empty => (MapInfo::new(None, grid.geometry().resolution(), grid.tile_count()), None),
+        MapView::Dense(r) => {
+            (MapInfo::new(Some(r), grid.geometry().resolution(), grid.tile_count()), Some(map_entropy(r)))
+        }
+        MapView::Sparse { tiles, area, .. } => {
+            // Saturating: two sites 1e9 m apart make a box of more than 2^64 cells.
+            let cells = (area.width() as u64).saturating_mul(area.height() as u64);
+            let info = MapInfo {
+                resolution: grid.geometry().resolution(),
+                origin: [grid.geometry().cell_corner(area.min).x, grid.geometry().cell_corner(area.min).y],
+                width: area.width(),
+                height: area.height(),
+                tiles: grid.tile_count(),
+            };
+            (info, Some(sparse_entropy(tiles, cells, grid.table().prior)))
+        }
+    }
+}
+
 /// Builds the summary of a finished engine and writes every output: the view of the map
 /// `export` asks for (see [`view_of`]).
 pub fn finish(
@@ -324,8 +351,18 @@ pub fn finish(
     export: &ExportOptions,
     record: RunRecord<'_>,
 ) -> Result<Summary, OutputError> {
-    let RunRecord { source_kind, source, started, mut notes, log, trajectory, validation, calibration, endpoints } =
-        record;
+    let RunRecord {
+        source_kind,
+        source,
+        started,
+        mut notes,
+        log,
+        trajectory,
+        validation,
+        calibration,
+        endpoints,
+        map_from_odom,
+    } = record;
     let grid = engine.grid();
     let room = ExportRoom::of(engine.export_room(engine.maps().primary()));
     let view = view_of(grid, export, room, &mut notes)?;
@@ -344,24 +381,7 @@ pub fn finish(
             SensorKind::Camera => camera_frames += s.scans,
         }
     }
-    let (map, entropy) = match &view {
-        MapView::Empty => (MapInfo::new(None, grid.geometry().resolution(), grid.tile_count()), None),
-        MapView::Dense(r) => {
-            (MapInfo::new(Some(r), grid.geometry().resolution(), grid.tile_count()), Some(map_entropy(r)))
-        }
-        MapView::Sparse { tiles, area, .. } => {
-            // Saturating: two sites 1e9 m apart make a box of more than 2^64 cells.
-            let cells = (area.width() as u64).saturating_mul(area.height() as u64);
-            let info = MapInfo {
-                resolution: grid.geometry().resolution(),
-                origin: [grid.geometry().cell_corner(area.min).x, grid.geometry().cell_corner(area.min).y],
-                width: area.width(),
-                height: area.height(),
-                tiles: grid.tile_count(),
-            };
-            (info, Some(sparse_entropy(tiles, cells, grid.table().prior)))
-        }
-    };
+    let (map, entropy) = map_info(&view, grid);
     let mut summary = Summary {
         fusemap_version: env!("CARGO_PKG_VERSION"),
         source_kind: source_kind.to_string(),
@@ -386,7 +406,7 @@ pub fn finish(
     };
     view_notes(&view, camera_of(engine).is_some(), export.formats, endpoints.is_some(), &mut summary.notes);
     summary.wall_time_s = started.elapsed().as_secs_f64();
-    let request = FormatRequest { formats: export.formats, endpoints };
+    let request = FormatRequest { formats: export.formats, endpoints, map_from_odom };
     write(outputs, &view, layers.as_ref(), &mut summary, trajectory, request)?;
     summary.wall_time_s = started.elapsed().as_secs_f64();
     Ok(summary)
@@ -399,27 +419,37 @@ mod tests {
     use fusemap_core::config::Config;
     use fusemap_core::sim::{corridor, ScannerSpec};
 
-    /// The library alone, without the CLI: the document's corridor mapped and written, and
-    /// the summary lists exactly the files on disk, each with its size.
-    #[test]
-    fn a_finished_world_run_is_written_as_one_listed_set() {
+    /// The document's corridor mapped from a world.
+    fn corridor_run() -> crate::world::WorldRun {
         let plan = Config::default().validate().unwrap();
         let poses: Vec<Pose2> = (0..40).map(|i| Pose2::new(0.1 * f64::from(i), 0.0, 0.0)).collect();
-        let run = crate::world::map_world(&plan, &corridor(), &ScannerSpec::document(), &poses, &mut |_| {}).unwrap();
-        let dir = fusemap_io::testdata::temp_dir("outputs-world");
-        let out = dir.join("out");
-        let outputs = prepare(&out, &[]).unwrap();
-        let record = RunRecord {
+        crate::world::map_world(&plan, &corridor(), &ScannerSpec::document(), &poses, &mut |_| {}).unwrap()
+    }
+
+    fn world_record(notes: Vec<String>) -> RunRecord<'static> {
+        RunRecord {
             source_kind: "world",
             source: "corridor",
             started: Instant::now(),
-            notes: run.notes,
+            notes,
             log: None,
             trajectory: None,
             validation: None,
             calibration: None,
             endpoints: None,
-        };
+            map_from_odom: None,
+        }
+    }
+
+    /// The library alone, without the CLI: the document's corridor mapped and written, and
+    /// the summary lists exactly the files on disk, each with its size.
+    #[test]
+    fn a_finished_world_run_is_written_as_one_listed_set() {
+        let run = corridor_run();
+        let dir = fusemap_io::testdata::temp_dir("outputs-world");
+        let out = dir.join("out");
+        let outputs = prepare(&out, &[]).unwrap();
+        let record = world_record(run.notes);
         let summary = finish(&run.engine, outputs, &ExportOptions::default(), record).unwrap();
         assert_eq!((summary.scans, summary.source_kind.as_str()), (40, "world"));
         assert!(summary.entropy.is_some());
@@ -434,5 +464,39 @@ mod tests {
             serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
         assert_eq!(written["scans"], 40);
         assert!(summary.to_string().starts_with("source        corridor (world)\nscans         40\n"));
+    }
+
+    /// A run that fails while it writes `map.mcap` (written after every map file but the
+    /// report) leaves the previous set as it was: nothing of the failed run is in the
+    /// directory. (Here the staged `map.mcap` cannot be written because a directory holds
+    /// its name; the CLI's `output_set` test stops a run with a file-size limit instead,
+    /// as a full disk would.)
+    #[test]
+    fn a_run_failing_at_map_mcap_leaves_the_previous_set() {
+        let run = corridor_run();
+        let dir = fusemap_io::testdata::temp_dir("outputs-mcap-fails");
+        let out = dir.join("out");
+        finish(&run.engine, prepare(&out, &[]).unwrap(), &ExportOptions::default(), world_record(Vec::new())).unwrap();
+        let before: Vec<(std::ffi::OsString, Vec<u8>)> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap())
+            .filter(|e| e.file_type().unwrap().is_file())
+            .map(|e| (e.file_name(), std::fs::read(e.path()).unwrap()))
+            .collect();
+        assert!(before.iter().any(|(n, _)| n == "map.mcap"));
+        let outputs = prepare(&out, &[]).unwrap();
+        std::fs::create_dir_all(outputs.files.mcap.join("in-the-way")).unwrap();
+        let err = finish(&run.engine, outputs, &ExportOptions::default(), world_record(Vec::new())).unwrap_err();
+        assert!(err.to_string().contains("map.mcap"), "{err}");
+        let after: Vec<std::ffi::OsString> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap())
+            .filter(|e| e.file_type().unwrap().is_file())
+            .map(|e| e.file_name())
+            .collect();
+        assert_eq!(after.len(), before.len(), "{after:?}");
+        for (name, bytes) in &before {
+            assert!(std::fs::read(out.join(name)).unwrap() == *bytes, "{name:?} changed by the failed run");
+        }
     }
 }
