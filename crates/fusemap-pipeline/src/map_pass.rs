@@ -27,6 +27,7 @@ use fusemap_core::measurement::SensorId;
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::{Stamp, StreamTiming, SyncMode};
 use fusemap_io::log::LogFormat;
+use fusemap_io::map_mcap::MAP_FRAME;
 use std::collections::HashSet;
 use std::time::Instant;
 
@@ -188,6 +189,16 @@ pub fn map_with_track(
         Track::Timed(t) => with_scan_poses(t.samples(), placed),
     };
     let map_from_odom = match (&chosen.track, &chosen.odom_frame, trajectory.last()) {
+        // The log's own TF already places the odometry frame (a localiser's `map → odom`):
+        // a second parent would break the tree a player of both files builds.
+        (Track::Timed(_), Some(frame), Some(_))
+            if frame == MAP_FRAME || [frame.clone(), format!("/{frame}")].iter().any(|f| tree.parent(f).is_some()) =>
+        {
+            notes.push(format!(
+                "map.mcap has no /tf_static: the log's TF already gives `{frame}` a parent, or it is the map frame"
+            ));
+            None
+        }
         // Without SLAM the odometry frame is the map frame.
         (Track::Timed(t), Some(frame), Some(&(last, _))) => {
             Some((frame.clone(), t.frame_correction_at(last).unwrap_or(Pose2::IDENTITY)))

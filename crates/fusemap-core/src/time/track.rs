@@ -77,6 +77,10 @@ impl<T: PoseTrack> PoseTrack for InFrame<T> {
     fn samples(&self) -> Vec<(Stamp, Pose2)> {
         self.track.samples().into_iter().map(|(s, p)| (s, self.map_from_odom * p)).collect()
     }
+
+    fn frame_correction_at(&self, t: Stamp) -> Option<Pose2> {
+        Some(self.track.frame_correction_at(t).map_or(self.map_from_odom, |c| self.map_from_odom * c))
+    }
 }
 
 #[cfg(test)]
@@ -94,5 +98,6 @@ mod tests {
         assert!(matches!(t.pose_at(Stamp(2_000_000_000), SyncMode::Interpolate), Err(NoPose::AfterEnd(_))));
         assert_eq!(t.samples().len(), 2);
         assert!(t.covariance_at(Stamp(0)).is_none());
+        assert_eq!(t.frame_correction_at(Stamp(0)), Some(t.map_from_odom));
     }
 }

@@ -419,10 +419,10 @@ mod tests {
     use fusemap_core::config::Config;
     use fusemap_core::sim::{corridor, ScannerSpec};
 
-    /// The document's corridor mapped from a world.
-    fn corridor_run() -> crate::world::WorldRun {
+    /// The document's corridor mapped from a world, from its first `n` poses.
+    fn corridor_run(n: u32) -> crate::world::WorldRun {
         let plan = Config::default().validate().unwrap();
-        let poses: Vec<Pose2> = (0..40).map(|i| Pose2::new(0.1 * f64::from(i), 0.0, 0.0)).collect();
+        let poses: Vec<Pose2> = (0..n).map(|i| Pose2::new(0.1 * f64::from(i), 0.0, 0.0)).collect();
         crate::world::map_world(&plan, &corridor(), &ScannerSpec::document(), &poses, &mut |_| {}).unwrap()
     }
 
@@ -445,7 +445,7 @@ mod tests {
     /// the summary lists exactly the files on disk, each with its size.
     #[test]
     fn a_finished_world_run_is_written_as_one_listed_set() {
-        let run = corridor_run();
+        let run = corridor_run(40);
         let dir = fusemap_io::testdata::temp_dir("outputs-world");
         let out = dir.join("out");
         let outputs = prepare(&out, &[]).unwrap();
@@ -473,10 +473,11 @@ mod tests {
     /// as a full disk would.)
     #[test]
     fn a_run_failing_at_map_mcap_leaves_the_previous_set() {
-        let run = corridor_run();
         let dir = fusemap_io::testdata::temp_dir("outputs-mcap-fails");
         let out = dir.join("out");
-        finish(&run.engine, prepare(&out, &[]).unwrap(), &ExportOptions::default(), world_record(Vec::new())).unwrap();
+        let first = corridor_run(40);
+        finish(&first.engine, prepare(&out, &[]).unwrap(), &ExportOptions::default(), world_record(Vec::new()))
+            .unwrap();
         let before: Vec<(std::ffi::OsString, Vec<u8>)> = std::fs::read_dir(&out)
             .unwrap()
             .map(|e| e.unwrap())
@@ -484,17 +485,19 @@ mod tests {
             .map(|e| (e.file_name(), std::fs::read(e.path()).unwrap()))
             .collect();
         assert!(before.iter().any(|(n, _)| n == "map.mcap"));
+        // Another map (half the poses): any file of it moved into the directory would differ.
+        let second = corridor_run(20);
         let outputs = prepare(&out, &[]).unwrap();
         std::fs::create_dir_all(outputs.files.mcap.join("in-the-way")).unwrap();
-        let err = finish(&run.engine, outputs, &ExportOptions::default(), world_record(Vec::new())).unwrap_err();
+        let err = finish(&second.engine, outputs, &ExportOptions::default(), world_record(Vec::new())).unwrap_err();
         assert!(err.to_string().contains("map.mcap"), "{err}");
-        let after: Vec<std::ffi::OsString> = std::fs::read_dir(&out)
-            .unwrap()
-            .map(|e| e.unwrap())
-            .filter(|e| e.file_type().unwrap().is_file())
-            .map(|e| e.file_name())
-            .collect();
+        let entries: Vec<std::fs::DirEntry> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap()).collect();
+        let after: Vec<_> =
+            entries.iter().filter(|e| e.file_type().unwrap().is_file()).map(|e| e.file_name()).collect();
         assert_eq!(after.len(), before.len(), "{after:?}");
+        // No directory but the failed run's hidden staging (the next run removes it).
+        let dirs: Vec<_> = entries.iter().filter(|e| e.file_type().unwrap().is_dir()).map(|e| e.file_name()).collect();
+        assert!(dirs.iter().all(|d| d.to_string_lossy().starts_with('.')), "{dirs:?}");
         for (name, bytes) in &before {
             assert!(std::fs::read(out.join(name)).unwrap() == *bytes, "{name:?} changed by the failed run");
         }

@@ -124,3 +124,28 @@ fn the_verdict_names_the_sensor_whose_mount_is_wrong() {
     let d = lidar.lidar_motion[0].agreement.median_deg - turn;
     assert!((d - 2.0).abs() < 0.5, "{d}");
 }
+
+/// `map.mcap`'s `/tf_static` on the production line mapped from its wheel odometry alone,
+/// with SLAM: `map → odom` carries the odometry's last pose onto the track's pose at that
+/// stamp, and it is not the identity (SLAM corrected the simulator's 3 % scale error).
+#[test]
+fn map_to_odom_carries_the_odometry_onto_the_slam_track() {
+    let text = format!("{}pose_source = \"odometry\"\n", config((0.25, 0.0), 0.0));
+    let cfg = fusemap_io::config_file::parse_config_str(&text, Path::new("config.toml")).unwrap();
+    let run = fusemap_pipeline::map_log(&cfg.validate().unwrap(), bag(), &mut |_| {}).unwrap();
+    assert!(run.report.slam.is_some(), "SLAM ran over the odometry");
+    let (frame, m) = run.map_from_odom.clone().expect("odometry with SLAM gives map → odom");
+    assert_eq!(frame, "odom");
+    let inv = fusemap_pipeline::recording::Inventory::read(bag()).unwrap();
+    let odometry = inv.odom.values().next().expect("the bag has odometry");
+    let last = odometry.iter().rev().find(|o| run.trajectory.iter().any(|(t, _)| *t == o.stamp)).unwrap();
+    let placed = run.trajectory.iter().find(|(t, _)| *t == last.stamp).unwrap().1;
+    let carried = m.compose(last.pose);
+    let turn = fusemap_core::geometry::normalize_angle(carried.theta - placed.theta);
+    assert!(
+        (carried.x - placed.x).abs() < 1e-6 && (carried.y - placed.y).abs() < 1e-6 && turn.abs() < 1e-9,
+        "map → odom {m:?} carries {:?} to {carried:?}, the track has {placed:?}",
+        last.pose
+    );
+    assert!(m.x.hypot(m.y) > 0.01, "{m:?}");
+}
