@@ -42,6 +42,7 @@ pub mod geometry;
 pub mod grid;
 pub mod measurement;
 pub mod metrics;
+pub mod parallel;
 pub mod sensor;
 pub mod sim;
 pub mod slam;

@@ -147,3 +147,65 @@ fn the_layers_as_rasters() {
     let later = super::rasters::dynamic_cells(g, area, Stamp(60_000_000_000), 2.0);
     assert!((later.cells[j] - 0.5).abs() < 0.01);
 }
+
+/// Every stored value of a map (occupancy and semantic counts, as bits) with its tile key.
+fn fingerprint(g: &FusionGrid, k: usize) -> Vec<(crate::grid::TileKey, Vec<u32>)> {
+    g.tiles()
+        .map(|(key, t)| {
+            let mut bits = Vec::new();
+            for o in 0..crate::grid::TILE_CELLS {
+                bits.push(t.log_odds(o).map_or(u32::MAX, f32::to_bits));
+                bits.extend(t.layers().semantic_counts(o, k).unwrap_or_default().iter().map(|v| v.to_bits()));
+            }
+            (key, bits)
+        })
+        .collect()
+}
+
+/// A pass's maps are updated on the pool's threads, one thread per map: fused, camera-only
+/// and lidar-only maps, and a coarser fused map (whose camera cells are built apart), with
+/// the lidar and the camera in one correlation group and the dynamic layer on, are the
+/// same to the bit on 1, 2 and 4 threads.
+#[cfg(feature = "parallel")]
+#[test]
+fn a_pass_maps_bit_identical_on_one_two_and_four_threads() {
+    use crate::fusion::{Correlation, MapSet, SensorSelection};
+    use crate::geometry::PlanarMount;
+    use crate::grid::MergeRule;
+    use crate::measurement::{ObservationId, SensorKind};
+    use crate::sensor::{LaserScan, LidarModel, LidarParams};
+    let m = model();
+    let k = m.classes().len();
+    let frames: Vec<_> = (0..6).map(|i| render(&m, 3.0 + 0.2 * i as f64, -0.3..0.3)).collect();
+    let on = |threads: usize| {
+        let fine = || FusionGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default());
+        let coarse = FusionGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
+        let maps = MapSet::new("fused", SensorSelection::All, fine())
+            .with("camera", SensorSelection::Kinds(vec![SensorKind::Camera]), fine())
+            .with("lidar", SensorSelection::Kinds(vec![SensorKind::Lidar]), fine())
+            .with("coarse", SensorSelection::All, coarse);
+        let mut e = Engine::with_maps(maps);
+        let cam = e.add_camera("camera", model());
+        let laser = e.add_lidar("laser", LidarModel::new(LidarParams::default(), PlanarMount::default()));
+        e.set_correlation(Correlation { groups: vec![vec![cam, laser]], window_ns: 50_000_000, rule: MergeRule::Max });
+        e.set_dynamic(DynamicParams::default(), true);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            for (i, (labels, depth)) in frames.iter().enumerate() {
+                let (t, pose) = (Stamp(i as i64 * 100_000_000), Pose2::new(0.1 * i as f64, 0.05 * i as f64, 0.02));
+                let id = Some(ObservationId(i as u64));
+                e.insert_camera_frame(cam, id, t, labels, depth, pose).unwrap();
+                let ranges = (0..181).map(|b| 2.5 + 0.01 * ((b * 7 + i) % 13) as f32).collect();
+                let scan = LaserScan { stamp: t, angle_min: -1.57, angle_increment: 0.01745, ranges };
+                e.insert_scan_observed(laser, ObservationId(i as u64), &scan, f32::NAN, f32::NAN, |_| pose).unwrap();
+            }
+        });
+        e.maps().iter().map(|m| fingerprint(m.grid(), k)).collect::<Vec<_>>()
+    };
+    let one = on(1);
+    assert_eq!(one.len(), 4);
+    assert!(one.iter().all(|m| !m.is_empty()));
+    assert!(one[0] != one[1] && one[0] != one[2] && one[1] != one[2], "the maps differ from one another");
+    assert!(one == on(2), "2 threads");
+    assert!(one == on(4), "4 threads");
+}

@@ -390,19 +390,45 @@ impl Engine {
         let k = model.classes().len();
         let p_free = model.params().p_free;
         let weight = model.params().occupancy_weight as f32;
-        let mut total = InsertStats::default();
-        let mut fed = 0;
-        for m in self.maps.entries_mut() {
-            if !m.sensors().includes(sensor, SensorKind::Camera) {
-                continue;
+        let cells = &mut self.frame_cells;
+        let mut built = None;
+        for m in self.maps.iter().filter(|m| m.sensors().includes(sensor, SensorKind::Camera)) {
+            let on = (*m.grid().geometry(), *m.grid().table());
+            match built {
+                None => cells.build(&self.camera_scratch, model, m.grid()),
+                Some(b) if b == on => {}
+                // Maps of other geometries or log-odds tables: one after the other below.
+                Some(_) => {
+                    built = None;
+                    break;
+                }
             }
-            self.frame_cells.build(&self.camera_scratch, model, m.grid());
-            let free = weight * m.grid().table().increment(p_free);
-            let s = self.frame_cells.apply(m.grid_mut(), k, free, ctx.group, ctx.dynamic);
-            m.add_stats(&s);
-            total.add(&s);
-            fed += 1;
+            built = Some(on);
         }
+        let each = match built {
+            // The frame's cells are the same for every map: built once, applied to the maps
+            // on the pool's threads.
+            Some(_) => self.maps.each_taking(sensor, SensorKind::Camera, |m| {
+                let free = weight * m.grid().table().increment(p_free);
+                let s = cells.apply(m.grid_mut(), k, free, ctx.group, ctx.dynamic);
+                m.add_stats(&s);
+                s
+            }),
+            None => {
+                let mut each = Vec::new();
+                for m in self.maps.entries_mut().filter(|m| m.sensors().includes(sensor, SensorKind::Camera)) {
+                    cells.build(&self.camera_scratch, model, m.grid());
+                    let free = weight * m.grid().table().increment(p_free);
+                    let s = cells.apply(m.grid_mut(), k, free, ctx.group, ctx.dynamic);
+                    m.add_stats(&s);
+                    each.push(s);
+                }
+                each
+            }
+        };
+        let mut total = InsertStats::default();
+        each.iter().for_each(|s| total.add(s));
+        let fed = each.len() as u64;
         self.stats.measurements += 1;
         self.stats.insert.add(&total);
         slot.stats.scans += 1;

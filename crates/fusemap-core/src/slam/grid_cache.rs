@@ -50,7 +50,7 @@ impl GridCache {
     pub fn prepare<'a>(&mut self, needed: &[usize], grid_of: impl Fn(usize) -> &'a ProbabilityGrid + Sync) {
         let missing: Vec<usize> = needed.iter().copied().filter(|&s| self.grids[s].is_none()).collect();
         let depth = self.depth;
-        let built = super::parallel::map_all(&missing, |&s| PrecomputedGrids::new(grid_of(s), depth));
+        let built = crate::parallel::map_all(&missing, |&s| PrecomputedGrids::new(grid_of(s), depth));
         for (s, g) in missing.into_iter().zip(built) {
             self.bytes += g.memory_bytes();
             self.grids[s] = Some(g);

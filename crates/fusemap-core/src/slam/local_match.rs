@@ -18,8 +18,8 @@
 
 use super::grid::{floor_i64, ProbabilityGrid, P_MAX};
 use super::interpolation::probability_and_gradient;
-use super::parallel::{join, map_halves};
 use crate::geometry::{normalize_angle, Point2, Pose2};
+use crate::parallel::{join, map_halves};
 
 /// Parameters of one scan-to-submap match.
 #[derive(Clone, Copy, Debug, PartialEq)]

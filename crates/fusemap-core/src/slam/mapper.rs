@@ -25,12 +25,12 @@ use super::local_match::{refine, LocalMatch, LocalMatchParams};
 use super::loop_closure::{Loops, OpenSearch};
 use super::odometry::OdometryAgreement;
 use super::optimisation::Pending;
-use super::parallel::{join, on_worker};
 use super::params::SlamParams;
 use super::pose_graph::PoseGraph;
 use super::report::SlamReport;
 use super::submap::Submaps;
 use crate::geometry::{normalize_angle, Point2, Pose2};
+use crate::parallel::{join, on_worker};
 use crate::time::Stamp;
 use std::time::Instant;
 

@@ -14,7 +14,7 @@
 //! | GNSS fixes as position priors on nodes | `fixes.rs` |
 //! | the loop over scans | `mapper.rs` |
 //! | the corrected pose track | `corrected_track.rs` |
-//! | the matcher's exact two-way parallelism | `parallel.rs` |
+//! | the matcher's exact two-way parallelism | `crate::parallel` |
 #[cfg(test)]
 mod bad_input_tests;
 mod corrected_track;
@@ -30,7 +30,6 @@ mod mapper;
 mod node_edges;
 mod odometry;
 mod optimisation;
-mod parallel;
 mod params;
 pub mod pose_graph;
 mod report;
@@ -38,12 +37,12 @@ pub mod submap;
 #[cfg(test)]
 mod test_world;
 
+pub use crate::parallel::adopt_calling_thread;
 pub use corrected_track::CorrectedTrack;
 pub use fixes::PositionFix;
 pub use local_match::{search_candidates, LocalMatchParams};
 pub use loop_closure::{OpenReason, OpenSearch};
 pub use mapper::{ScanInput, ScanOutcome, Slam, SlamResult};
-pub use parallel::adopt_calling_thread;
 pub use params::SlamParams;
 pub use report::SlamReport;
 pub use submap::SubmapBounds;

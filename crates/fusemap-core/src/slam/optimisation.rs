@@ -150,7 +150,7 @@ impl Slam {
     fn start_optimisation(&mut self, lag: usize, last: bool) {
         let job = self.job(last);
         let loss = *job.losses.last().expect("one pass at least");
-        let work = if lag > 0 && super::parallel::threads() > 1 {
+        let work = if lag > 0 && crate::parallel::threads() > 1 {
             let spawned = std::thread::Builder::new().name("fusemap-optimiser".into()).spawn(move || {
                 lowest_priority();
                 job.run()

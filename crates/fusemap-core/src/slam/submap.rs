@@ -18,8 +18,8 @@
 
 use super::field::{self, Crossing, FieldKernel};
 use super::grid::{ProbabilityGrid, UpdateTable};
-use super::parallel::join;
 use crate::geometry::{Point2, Pose2};
+use crate::parallel::join;
 
 /// One submap.
 #[derive(Clone, Debug)]

@@ -6,10 +6,10 @@ use super::{
     MAX_OPEN_REPORTED,
 };
 use crate::geometry::{normalize_angle, Pose2};
+use crate::parallel::map_all;
 use crate::slam::global_match::{search_branch_and_bound, search_work, GlobalSearch};
 use crate::slam::local_match::{match_information, mean_probability, refine, LocalMatchParams};
 use crate::slam::mapper::Slam;
-use crate::slam::parallel::map_all;
 use crate::slam::pose_graph::{Edge, EdgeKind, Loss};
 use std::time::Instant;
 

@@ -1,9 +1,11 @@
-//! Two-way fork–join for the scan matcher (rayon's work-stealing `join` with the `parallel`
-//! feature, the same calls one after the other without it).
+//! Fork–join for the scan matcher and the map set (rayon's work-stealing `join` and
+//! indexed parallel iterators with the `parallel` feature, the same calls one after the
+//! other without it).
 //!
 //! Only work whose result does not depend on how it is split goes through here: halves of
 //! an argmax whose ties are broken by order, independent cost evaluations collected in a
-//! fixed order. So a run's poses are the same to the bit on one thread or many.
+//! fixed order, maps that share no cell. So a run's poses and maps are the same to the
+//! bit on one thread or many.
 
 /// Runs `a` and `b`, in parallel when the `parallel` feature is on.
 #[inline]
@@ -80,6 +82,21 @@ pub fn map_all<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync + Send)
     }
 }
 
+/// `items.iter_mut().map(f)` collected in order, each item a task of its own as in
+/// [`map_all`]: for a few heavy, independent items that `f` changes (the maps of one
+/// pass, each updated by one thread, so each ends as it would on one thread).
+pub fn map_all_mut<T: Send, R: Send>(items: &mut [T], f: impl Fn(&mut T) -> R + Sync + Send) -> Vec<R> {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        items.par_iter_mut().with_max_len(1).map(f).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        items.iter_mut().map(f).collect()
+    }
+}
+
 /// `items.iter().map(f)` collected in order, the two halves computed by [`join`].
 pub fn map_halves<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
     let (left, right) = items.split_at(items.len() / 2);
@@ -100,5 +117,8 @@ mod tests {
         assert_eq!(join(|| 1, || "b"), (1, "b"));
         assert_eq!(on_worker(|| join(|| 2, || 3)), (2, 3));
         assert_eq!(map_all(&v, |x| x + 1), (1..12).collect::<Vec<_>>());
+        let mut w = v.clone();
+        assert_eq!(map_all_mut(&mut w, |x| std::mem::replace(x, 0) * 3), (0..11).map(|x| x * 3).collect::<Vec<_>>());
+        assert!(w.iter().all(|&x| x == 0));
     }
 }
