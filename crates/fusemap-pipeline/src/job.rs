@@ -7,7 +7,7 @@
 //! summary. A front end (the CLI, a Python binding, a calibration search) builds jobs and
 //! runs them; it keeps only its flags, its progress display and its exit codes.
 
-use crate::outputs::{crop_area, finish, prepare, Crop, ExportOptions, OutputError, RunRecord, Summary};
+use crate::outputs::{crop_area, finish, prepare, Crop, ExportOptions, OutputError, RunRecord, Seconds, Summary};
 use crate::{PipelineError, Progress};
 use fusemap_core::config::{Config, FieldError, Plan};
 use fusemap_core::geometry::Pose2;
@@ -229,10 +229,12 @@ impl MapJob {
                     calibration: None,
                     endpoints: Some(&run.endpoints),
                     map_from_odom: run.map_from_odom.as_ref().map(|(f, m)| (f.as_str(), *m)),
+                    seconds: Seconds::of_log(&run.report),
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }
             MapSource::World { world, scanner, poses, name } => {
+                let t_map = Instant::now();
                 let run = crate::world::map_world(&self.plan, world, scanner, poses, progress)
                     .map_err(|error| JobError::Run { input: name.clone(), error })?;
                 let record = RunRecord {
@@ -246,6 +248,7 @@ impl MapJob {
                     calibration: None,
                     endpoints: None,
                     map_from_odom: None,
+                    seconds: Seconds { map: Some(t_map.elapsed().as_secs_f64()), ..Seconds::default() },
                 };
                 Ok(finish(&run.engine, outputs, &self.export, record)?)
             }

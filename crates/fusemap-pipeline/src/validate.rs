@@ -190,6 +190,7 @@ impl ValidateJob {
             calibration: None,
             endpoints: None,
             map_from_odom: run.map_from_odom.as_ref().map(|(f, m)| (f.as_str(), *m)),
+            seconds: crate::outputs::Seconds::of_log(&run.report),
         };
         let export = ExportOptions::of(plan, None);
         let summary = finish(&run.engine, outputs, &export, record)?;

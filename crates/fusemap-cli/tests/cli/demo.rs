@@ -221,6 +221,13 @@ fn demo_writes_every_output_and_prints_its_summary() {
     assert_eq!(e["known_share"], 1.0, "{e}");
     let t = s["wall_time_s"].as_f64().expect("wall_time_s");
     assert!(t > 0.0 && t < 60.0, "wall time {t}");
+    // Where the time went: a world has a map pass and outputs, no log phases, and the
+    // phases add up to the wall time.
+    let sec = &s["seconds"];
+    assert_eq!(sec["total"], s["wall_time_s"], "{sec}");
+    assert!(sec.get("read").is_none() && sec.get("slam").is_none(), "{sec}");
+    let phases: f64 = ["map", "outputs", "other"].iter().map(|k| sec[k].as_f64().expect(k)).sum();
+    assert!((phases - t).abs() < 1e-6 && sec["map"].as_f64().unwrap() > 0.0, "{sec}");
     assert_eq!(s["notes"], serde_json::json!([]));
     assert!(s.get("log").is_none(), "a simulated run has no log counters");
 

@@ -84,6 +84,13 @@ fn intel_raw_bag_maps() {
     assert_eq!(s["returns"]["valid"].as_u64().unwrap() + s["returns"]["no_return"].as_u64().unwrap(), 13631 * 180);
     let slam = &l["slam"];
     assert!(slam["counts"]["loop_accepted"].as_u64().unwrap() > 1000, "{}", slam["counts"]);
+    // Where the seconds went: every phase of a log run with SLAM, SLAM's as its report has it.
+    let sec = &s["seconds"];
+    for k in ["read", "estimator", "slam", "map", "outputs", "other", "total"] {
+        assert!(sec[k].as_f64().is_some_and(|v| v >= 0.0), "seconds.{k}: {sec}");
+    }
+    assert_eq!(sec["slam"], slam["seconds"], "{sec}");
+    assert_eq!(sec["map"], l["map_s"], "{sec}");
     let edges = slam["edges"].as_array().unwrap();
     assert!(edges.iter().any(|e| e["kind"] == "loop_closure") && edges.iter().any(|e| e["kind"] == "odometry"));
     for f in ["slam.png", "trajectory.tum", "map.png"] {

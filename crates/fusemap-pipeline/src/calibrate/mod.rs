@@ -184,6 +184,7 @@ impl CalibrateJob {
             calibration: Some(serde_json::to_value(&calibration)?),
             endpoints: None,
             map_from_odom: run.map_from_odom.as_ref().map(|(f, m)| (f.as_str(), *m)),
+            seconds: crate::outputs::Seconds::of_log(&run.report),
         };
         let export = ExportOptions::of(plan, None);
         let summary = finish(&run.engine, outputs, &export, record)?;

@@ -15,7 +15,7 @@ pub mod write;
 
 pub use report_page::SECTIONS as REPORT_SECTIONS;
 pub use set::{prepare, OutputFiles, Outputs};
-pub use summary::Summary;
+pub use summary::{Seconds, Summary};
 pub use view::{crop_area, parse_crop, view_of, Crop, ExportOptions, ExportRoom, MapView};
 pub use write::{finish, layers_of, Layers, RunRecord, REPORT_HTML};
 

@@ -150,11 +150,18 @@ fn overview(s: &Value) -> String {
             format!("{} ({} of the box)", num(&s["entropy"]["known_cells"]), num(&s["entropy"]["known_share"])),
         ),
         ("mean entropy, nats", num(&s["entropy"]["mean_entropy_nats"])),
-        ("wall time, s", num(&s["wall_time_s"])),
+        ("wall time, s", format!("{} ({})", num(&s["wall_time_s"]), phases(&s["seconds"]))),
         ("fusemap", num(&s["fusemap_version"])),
     ];
     let rows: Vec<Vec<String>> = rows.into_iter().map(|(k, v)| vec![escape(k), v]).collect();
     section("overview", "Overview", &table(&["", ""], &rows))
+}
+
+/// Where the wall time went (`summary.json`'s `seconds`), phase by phase.
+fn phases(seconds: &Value) -> String {
+    const PHASES: [&str; 8] = ["simulate", "write_simulation", "read", "estimator", "slam", "map", "outputs", "other"];
+    let shown = PHASES.iter().filter(|k| seconds[**k].is_number());
+    shown.map(|k| format!("{} {}", k.replace('_', " "), num(&seconds[*k]))).collect::<Vec<_>>().join(", ")
 }
 
 /// A round length near a fifth of `width_m`.

@@ -43,6 +43,8 @@ pub struct Summary {
     pub entropy: Option<EntropyReport>,
     /// Wall time of the whole run, seconds.
     pub wall_time_s: f64,
+    /// Where that time went, by phase.
+    pub seconds: Seconds,
     /// Facts about the input a user should know (skipped records, clock faults…).
     pub notes: Vec<String>,
     /// Extra counters of log input (absent for simulated runs).
@@ -57,6 +59,79 @@ pub struct Summary {
     /// The other files of this run's set, each with its size and SHA-256: written before
     /// this summary, which comes last (a summary whose files all match is a whole set).
     pub files: Vec<fusemap_io::output_set::OutputFile>,
+}
+
+/// Where a run's wall time went, seconds by phase in the order the phases run. A phase
+/// the run did not have is absent; `other` is what no named phase covers (a demo's scoring
+/// and its other maps' files, validation's leave-one-out maps, calibration's searches), so
+/// the phases add up to `total`, the summary's `wall_time_s`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Seconds {
+    /// `fusemap demo`: the simulator (scans, images and pose sensors of the world).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulate: Option<f64>,
+    /// `fusemap demo`: the simulation written as a rosbag2 bag.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub write_simulation: Option<f64>,
+    /// The first pass over the log: the pose sensors read and the scans inventoried.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub read: Option<f64>,
+    /// The pose track from the pose sensors (the estimator's filter and smoother, or the
+    /// odometry as it is), SLAM not included.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<f64>,
+    /// SLAM: scan matching, loop closure and the pose graph.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slam: Option<f64>,
+    /// The second pass: the scans (and camera frames) read again and inserted into the
+    /// maps; for a simulated world, its scans cast and inserted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub map: Option<f64>,
+    /// The primary map's rasters, pictures and files, up to `summary.json`.
+    pub outputs: f64,
+    /// What no phase above covers.
+    pub other: f64,
+    /// The whole run (`wall_time_s`).
+    pub total: f64,
+}
+
+impl Seconds {
+    /// The phases of a log's run as its report measured them: the first pass, the track
+    /// (SLAM's share apart) and the second pass.
+    pub fn of_log(report: &crate::report::LogReport) -> Self {
+        let slam = report.slam.as_ref().map(|s| s.seconds);
+        Self {
+            read: Some(report.decode_s),
+            estimator: Some((report.track_s - slam.unwrap_or(0.0)).max(0.0)),
+            slam,
+            map: Some(report.map_s),
+            ..Self::default()
+        }
+    }
+
+    /// Closes the account at `total` seconds, with `outputs` seconds of output: `other`
+    /// is what the named phases leave.
+    pub fn closed(mut self, outputs: f64, total: f64) -> Self {
+        let named = [self.simulate, self.write_simulation, self.read, self.estimator, self.slam, self.map];
+        let named: f64 = named.iter().flatten().sum::<f64>() + outputs;
+        (self.outputs, self.total, self.other) = (outputs, total, (total - named).max(0.0));
+        self
+    }
+
+    /// The phases as one line: `read 0.62, estimator 0.02, …, total 13.44`.
+    fn line(&self) -> String {
+        let named = [
+            ("simulate", self.simulate),
+            ("write simulation", self.write_simulation),
+            ("read", self.read),
+            ("estimator", self.estimator),
+            ("slam", self.slam),
+            ("map", self.map),
+            ("outputs", Some(self.outputs)),
+            ("other", Some(self.other)),
+        ];
+        named.iter().filter_map(|(n, s)| Some(format!("{n} {:.2}", (*s)?))).collect::<Vec<_>>().join(", ")
+    }
 }
 
 /// Cell updates by kind.
@@ -156,6 +231,23 @@ impl fmt::Display for Summary {
         for n in &self.notes {
             writeln!(f, "note          {}", printable(n))?;
         }
-        writeln!(f, "wall time     {:.3} s", self.wall_time_s)
+        writeln!(f, "wall time     {:.3} s ({})", self.wall_time_s, self.seconds.line())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Seconds;
+
+    #[test]
+    fn the_phases_add_up_to_the_total() {
+        let s =
+            Seconds { read: Some(0.5), estimator: Some(0.25), map: Some(2.0), ..Seconds::default() }.closed(1.0, 4.0);
+        assert_eq!((s.outputs, s.other, s.total), (1.0, 0.25, 4.0));
+        assert_eq!(s.line(), "read 0.50, estimator 0.25, map 2.00, outputs 1.00, other 0.25");
+        let json = serde_json::to_value(&s).unwrap();
+        assert!(json.get("slam").is_none() && json.get("simulate").is_none(), "{json}");
+        // Clock readings taken apart can overlap by a hair; `other` is never negative.
+        assert_eq!(Seconds { map: Some(3.0), ..Seconds::default() }.closed(1.0, 3.9).other, 0.0);
     }
 }

@@ -6,7 +6,7 @@
 use super::map_formats::{write_map_formats, FormatRequest};
 use super::report_page::{self, Picture};
 use super::set::{OutputFiles, Outputs};
-use super::summary::{CellsUpdated, MapInfo, Summary};
+use super::summary::{CellsUpdated, MapInfo, Seconds, Summary};
 use super::view::{view_of, ExportOptions, ExportRoom, MapView};
 use super::OutputError;
 use fusemap_core::config::{OutputConfig, PointsMode};
@@ -44,6 +44,8 @@ pub struct RunRecord<'a> {
     pub endpoints: Option<&'a [[f32; 2]]>,
     /// `map → odom` and the odometry frame's name, where known (`MapRun::map_from_odom`).
     pub map_from_odom: Option<(&'a str, Pose2)>,
+    /// The phases the job timed before the outputs (`finish` adds the outputs' share).
+    pub seconds: Seconds,
 }
 
 /// The semantic and dynamic layers of a run with a camera, over the occupancy raster's
@@ -112,15 +114,34 @@ impl Layers {
     }
 }
 
+/// The run's clock: when it began, when its outputs began, and the phases before them.
+struct RunClock {
+    started: Instant,
+    outputs_from: Instant,
+    phases: Seconds,
+}
+
+impl RunClock {
+    /// Sets the summary's wall time and its phases to now (the report page shows them as
+    /// of its writing; `summary.json` as of its own, the last file of the set).
+    fn stop(&self, summary: &mut Summary) {
+        let now = Instant::now();
+        summary.wall_time_s = (now - self.started).as_secs_f64();
+        let outputs = (now - self.outputs_from).as_secs_f64();
+        summary.seconds = self.phases.clone().closed(outputs, summary.wall_time_s);
+    }
+}
+
 /// Writes the map files of `view` and the trajectory (when there is one) into the set,
 /// then commits it with the summary, which lists them.
-pub fn write(
+fn write(
     outputs: Outputs,
     view: &MapView,
     layers: Option<&Layers>,
     summary: &mut Summary,
     trajectory: Option<&[(Stamp, Pose2)]>,
     request: FormatRequest<'_>,
+    clock: &RunClock,
 ) -> Result<(), OutputError> {
     let Outputs { files, set, owned } = outputs;
     if let Some(t) = trajectory {
@@ -152,6 +173,7 @@ pub fn write(
         let layers = layers.zip(picture.as_ref()).map(|(l, p)| (p, &l.dynamic));
         write_map_formats(&files, request, r, layers, trajectory.unwrap_or_default(), closures)?;
     }
+    clock.stop(summary);
     let value =
         serde_json::to_value(&*summary).map_err(|e| fusemap_io::Error::io(&files.summary, std::io::Error::other(e)))?;
     let width_m = summary.map.width as f64 * summary.map.resolution;
@@ -166,6 +188,7 @@ pub fn write(
     let known: Vec<&str> = OutputFiles::NAMES.iter().copied().chain(owned.iter().map(String::as_str)).collect();
     set.commit(&known, "summary.json", |list| {
         summary.files = list.to_vec();
+        clock.stop(summary);
         serde_json::to_vec_pretty(&*summary).map_err(|e| fusemap_io::Error::io(&summary_path, std::io::Error::other(e)))
     })?;
     Ok(())
@@ -362,7 +385,9 @@ pub fn finish(
         calibration,
         endpoints,
         map_from_odom,
+        seconds,
     } = record;
+    let clock = RunClock { started, outputs_from: Instant::now(), phases: seconds };
     let grid = engine.grid();
     let room = ExportRoom::of(engine.export_room(engine.maps().primary()));
     let view = view_of(grid, export, room, &mut notes)?;
@@ -398,6 +423,7 @@ pub fn finish(
         map,
         entropy,
         wall_time_s: 0.0,
+        seconds: Seconds::default(),
         notes,
         log,
         validation,
@@ -405,10 +431,9 @@ pub fn finish(
         files: Vec::new(),
     };
     view_notes(&view, camera_of(engine).is_some(), export.formats, endpoints.is_some(), &mut summary.notes);
-    summary.wall_time_s = started.elapsed().as_secs_f64();
+    clock.stop(&mut summary);
     let request = FormatRequest { formats: export.formats, endpoints, map_from_odom };
-    write(outputs, &view, layers.as_ref(), &mut summary, trajectory, request)?;
-    summary.wall_time_s = started.elapsed().as_secs_f64();
+    write(outputs, &view, layers.as_ref(), &mut summary, trajectory, request, &clock)?;
     Ok(summary)
 }
 
@@ -438,6 +463,7 @@ mod tests {
             calibration: None,
             endpoints: None,
             map_from_odom: None,
+            seconds: Seconds::default(),
         }
     }
 
