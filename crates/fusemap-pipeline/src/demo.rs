@@ -15,7 +15,7 @@ use fusemap_core::config::Plan;
 use fusemap_core::fusion::{Engine, MapEntry};
 use fusemap_core::grid::{CellBox, CellIndex, Raster};
 use fusemap_io::comparison::{write_comparison_png, Panel};
-use fusemap_sim::{simulate, Scenario, TruthRaster};
+use fusemap_sim::{Scenario, TruthRaster};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -53,19 +53,22 @@ impl DemoJob {
         let started = Instant::now();
         let (plan, out) = (&self.plan, &self.out);
         let mut files = prepare(out, &self.inputs)?;
-        let t_sim = Instant::now();
-        let mut rec = simulate(&Scenario::default())?;
-        let simulate_s = t_sim.elapsed().as_secs_f64();
         files.own_dir("sim");
         let sim_dir = files.staged("sim");
         let memory = plan.limits.memory_bytes();
-        let t_write = Instant::now();
-        let sim = fusemap_sim::bag::write_simulation(&rec, &sim_dir, plan.geometry.resolution(), true, memory)
-            .map_err(|source| JobError::Simulation { dir: sim_dir.clone(), source })?;
-        // The messages (most of them images) are in the bag now, which the run reads back;
-        // the truth needs only the world and the tracks.
-        rec.messages = Vec::new();
-        let write_s = t_write.elapsed().as_secs_f64();
+        // The simulator's messages go into the bag as they are made (most of them images):
+        // the run reads them back from there, and the truth needs only the world and the
+        // tracks. Simulating and writing overlap, so their seconds are one phase.
+        let t_sim = Instant::now();
+        let (rec, sim) =
+            fusemap_sim::bag::simulate_to(&Scenario::default(), &sim_dir, plan.geometry.resolution(), true, memory)
+                .map_err(|e| match e {
+                    fusemap_sim::bag::SimulationError::Scenario(e) => JobError::Scenario(e),
+                    fusemap_sim::bag::SimulationError::Write(source) => {
+                        JobError::Simulation { dir: sim_dir.clone(), source }
+                    }
+                })?;
+        let simulate_s = t_sim.elapsed().as_secs_f64();
         let inv = crate::recording::Inventory::read_with(&sim.bag.dir, &plan.limits)?;
         let (bound, chosen, track_s) = crate::run::prepare(plan, &inv)?;
         let run = crate::map_with_track(plan, &inv, &bound, chosen, track_s, three_maps(plan).into(), progress)?;
@@ -105,11 +108,7 @@ impl DemoJob {
             calibration: None,
             endpoints: None,
             map_from_odom: run.map_from_odom.as_ref().map(|(f, m)| (f.as_str(), *m)),
-            seconds: Seconds {
-                simulate: Some(simulate_s),
-                write_simulation: Some(write_s),
-                ..Seconds::of_log(&run.report)
-            },
+            seconds: Seconds { simulate: Some(simulate_s), ..Seconds::of_log(&run.report) },
         };
         let summary = finish(&run.engine, files, &export, record)?;
         Ok(DemoRun { summary, scores, other_maps })

@@ -45,24 +45,72 @@ pub fn write_bag(rec: &SimRecording, dir: &Path, overwrite: bool) -> Result<Writ
     let mut w = Rosbag2Writer::create_with(dir, Rosbag2WriterOptions { overwrite, ..Default::default() })?;
     let statics: Vec<&SimMessage> =
         rec.messages.iter().filter(|m| matches!(m, SimMessage::StaticTransform(_))).collect();
-    if let Some(first) = statics.first() {
-        let transforms = statics
-            .iter()
-            .filter_map(|m| match m {
-                SimMessage::StaticTransform(t) => Some(t.msg.clone()),
-                _ => None,
-            })
-            .collect();
-        w.write(first.stamp(), first.topic(), &OutMessage::Tf { is_static: true, transforms })?;
-    }
+    write_statics(&mut w, &statics)?;
     for m in rec.messages.iter().filter(|m| !matches!(m, SimMessage::StaticTransform(_))) {
         w.write(m.stamp(), m.topic(), &to_out_message(m))?;
     }
     w.finish()
 }
 
-/// The true occupancy as a map raster: occupied where an object covers the cell, free
-/// elsewhere inside the hall.
+/// The static transforms as one latched `/tf_static` message at the first one's stamp, as
+/// a robot's recorder keeps them, ahead of every other message.
+fn write_statics(w: &mut Rosbag2Writer, statics: &[&SimMessage]) -> Result<()> {
+    let Some(first) = statics.first() else { return Ok(()) };
+    let transforms = statics
+        .iter()
+        .filter_map(|m| match m {
+            SimMessage::StaticTransform(t) => Some(t.msg.clone()),
+            _ => None,
+        })
+        .collect();
+    w.write(first.stamp(), first.topic(), &OutMessage::Tf { is_static: true, transforms })
+}
+
+/// Why [`simulate_to`] wrote no simulation.
+#[derive(Debug, thiserror::Error)]
+pub enum SimulationError {
+    /// The simulator refused its scenario.
+    #[error("scenario: {0}")]
+    Scenario(#[from] crate::SimError),
+    /// A file could not be written (the error names it).
+    #[error(transparent)]
+    Write(#[from] fusemap_io::Error),
+}
+
+/// Runs `scenario` and writes it as [`write_simulation`] does, each message into the bag
+/// as the simulator makes it ([`crate::simulate_with`]) instead of holding the recording:
+/// a run holds two chunks of camera images, not every image (730 MiB for the production
+/// line's three minutes). The files are byte for byte those of [`crate::simulate`] then
+/// [`write_simulation`]. Returns the recording, without its messages, and the files.
+pub fn simulate_to(
+    scenario: &Scenario,
+    out: &Path,
+    resolution: f64,
+    overwrite: bool,
+    memory_bytes: u64,
+) -> std::result::Result<(SimRecording, SimulationFiles), SimulationError> {
+    scenario.validate().map_err(crate::SimError::Invalid)?;
+    let geometry = truth_geometry(out, resolution, &scenario.world.extent, 0, memory_bytes)?;
+    std::fs::create_dir_all(out).map_err(|e| fusemap_io::Error::io(out, e))?;
+    let dir = out.join("bag");
+    let mut w = Rosbag2Writer::create_with(&dir, Rosbag2WriterOptions { overwrite, ..Default::default() })?;
+    let statics = crate::static_transforms(scenario);
+    write_statics(&mut w, &statics.iter().collect::<Vec<_>>())?;
+    // The first failed write is kept and ends the writing; the simulator runs on (it cannot
+    // be stopped half-way) and its messages are dropped.
+    let mut failed = None;
+    let rec = crate::simulate_with(scenario, &mut |m| {
+        if failed.is_none() && !matches!(m, SimMessage::StaticTransform(_)) {
+            failed = w.write(m.stamp(), m.topic(), &to_out_message(&m)).err();
+        }
+    })?;
+    if let Some(e) = failed {
+        return Err(e.into());
+    }
+    let bag = w.finish()?;
+    let files = write_truth(&rec, out, geometry, bag)?;
+    Ok((rec, files))
+}
 pub fn truth_raster(rec: &SimRecording, geometry: GridGeometry) -> Result<Raster, TruthRasterError> {
     let t = rec.truth_occupancy(geometry)?;
     let params = OccupancyParams::default();
@@ -151,16 +199,26 @@ pub fn write_simulation(
     overwrite: bool,
     memory_bytes: u64,
 ) -> Result<SimulationFiles> {
-    let no_truth = |why: String| {
-        fusemap_io::Error::format(
-            &out.join("truth.yaml"),
-            fusemap_io::Location::File,
-            format!("no true map at resolution {resolution} m: {why}; give a coarser --resolution"),
-        )
-    };
+    let geometry = truth_geometry(out, resolution, &rec.extent, rec.held_bytes(), memory_bytes)?;
+    std::fs::create_dir_all(out).map_err(|e| fusemap_io::Error::io(out, e))?;
+    let bag = write_bag(rec, &out.join("bag"), overwrite)?;
+    write_truth(rec, out, geometry, bag)
+}
+
+/// The grid the truth is rastered on, checked before anything is written: the world's
+/// `extent` at `resolution` fits the truth rasters, and their bytes with the `held` bytes
+/// of the recording fit `memory_bytes`.
+fn truth_geometry(
+    out: &Path,
+    resolution: f64,
+    extent: &crate::Rect,
+    held: u64,
+    memory_bytes: u64,
+) -> Result<GridGeometry> {
+    let no_truth = |why: String| no_truth(out, resolution, why);
     let geometry = GridGeometry::centered(resolution).map_err(|e| no_truth(e.to_string()))?;
-    let cells = rec.truth_cells(geometry).map_err(|e| no_truth(e.to_string()))?;
-    let (truth, held) = (cells.saturating_mul(TRUTH_BYTES_PER_CELL as u128), rec.held_bytes());
+    let cells = crate::recording::truth_cells(extent, geometry).map_err(|e| no_truth(e.to_string()))?;
+    let truth = cells.saturating_mul(TRUTH_BYTES_PER_CELL as u128);
     if truth.saturating_add(held as u128) > memory_bytes as u128 {
         return Err(no_truth(format!(
             "its {cells} cells take {} MiB while written, and with the recording's {} MiB that is over the \
@@ -170,10 +228,23 @@ pub fn write_simulation(
             memory_bytes >> 20
         )));
     }
+    Ok(geometry)
+}
+
+/// The error of a truth that cannot be rastered at `resolution`, and why.
+fn no_truth(out: &Path, resolution: f64, why: String) -> fusemap_io::Error {
+    fusemap_io::Error::format(
+        &out.join("truth.yaml"),
+        fusemap_io::Location::File,
+        format!("no true map at resolution {resolution} m: {why}; give a coarser --resolution"),
+    )
+}
+
+/// The truth beside a written bag: the true map, the true classes and the true trajectory.
+fn write_truth(rec: &SimRecording, out: &Path, geometry: GridGeometry, bag: WrittenBag) -> Result<SimulationFiles> {
+    let no_truth = |why: String| no_truth(out, geometry.resolution(), why);
     let raster = truth_raster(rec, geometry).map_err(|e| no_truth(e.to_string()))?;
     let semantic = rec.truth_semantic(geometry).map_err(|e| no_truth(e.to_string()))?;
-    std::fs::create_dir_all(out).map_err(|e| fusemap_io::Error::io(out, e))?;
-    let bag = write_bag(rec, &out.join("bag"), overwrite)?;
     let truth_map = fusemap_io::map_server::write_map_server(&out.join("truth.yaml"), &raster)?;
     let truth_semantic = write_truth_semantic(&out.join("truth_semantic.yaml"), &semantic)?;
     let truth_trajectory = out.join("truth.tum");
@@ -241,6 +312,41 @@ mod tests {
         let top = &buf[..t.width];
         assert_eq!(top, &t.class_ids[(t.height - 1) * t.width..]);
         assert!(buf.contains(&3) && buf.contains(&4) && buf.contains(&5) && buf.contains(&2));
+    }
+
+    /// The streamed simulation writes the same files, byte for byte, as the recording held
+    /// whole and written after: over several chunks of camera frames, with a camera clock
+    /// that runs early (its first frames come before the `/tf_static` stamp).
+    #[test]
+    fn a_streamed_simulation_writes_the_same_files() {
+        let mut s = Scenario::default();
+        s.robot.duration_s = 20.0;
+        (s.camera.width, s.camera.height, s.camera.time_offset_s) = (64, 48, -0.04);
+        let dir = fusemap_io::testdata::temp_dir("sim-streamed");
+        let held = crate::simulate(&s).unwrap();
+        let frames = held.messages.iter().filter(|m| matches!(m, SimMessage::CameraInfo(_))).count() as u64;
+        assert!(frames > 2 * 4 * crate::camera::FRAMES_PER_THREAD_AND_CHUNK, "{frames} frames: several chunks");
+        let statics = held.messages.iter().find(|m| matches!(m, SimMessage::StaticTransform(_))).unwrap();
+        assert!(held.messages[0].stamp() < statics.stamp(), "a camera frame comes first");
+        write_simulation(&held, &dir.join("held"), 0.1, false, u64::MAX).unwrap();
+        let (rec, files) = simulate_to(&s, &dir.join("streamed"), 0.1, false, u64::MAX).unwrap();
+        assert!(rec.messages.is_empty());
+        assert_eq!(rec.truth_trajectory, held.truth_trajectory);
+        assert_eq!(rec.camera_truth.stamps, held.camera_truth.stamps);
+        assert_eq!(rec.camera_truth.backlit_floor_points, held.camera_truth.backlit_floor_points);
+        assert_eq!(files.bag.message_count, held.messages.len() as u64 - 3);
+        for f in ["bag/bag_0.mcap", "bag/metadata.yaml", "truth.pgm", "truth.yaml", "truth_semantic.png", "truth.tum"] {
+            let (a, b) = (
+                std::fs::read(dir.join("held").join(f)).unwrap(),
+                std::fs::read(dir.join("streamed").join(f)).unwrap(),
+            );
+            assert!(a == b, "{f} differs");
+        }
+        // A scenario the simulator refuses is refused before anything is written.
+        s.gnss.rate_hz = 0.0;
+        let e = simulate_to(&s, &dir.join("refused"), 0.1, false, u64::MAX).err().expect("refused");
+        assert!(matches!(e, SimulationError::Scenario(_)) && e.to_string().contains("gnss.rate_hz"), "{e}");
+        assert!(!dir.join("refused").exists());
     }
 
     /// A resolution the world cannot be rastered at is an error before anything is

@@ -110,14 +110,29 @@ pub enum SimError {
 pub const TRUTH_OUTPUT_RATE_HZ: f64 = 50.0;
 
 /// The `/tf_static` mounts of the lidar, the IMU and the GNSS antenna on the base.
-fn static_mounts(scenario: &Scenario, start: Stamp) -> Vec<SimMessage> {
+/// The scenario's `/tf_static` transforms, stamped at its start: the lidar's, the IMU's and
+/// the GNSS antenna's mounts, and the camera's when it is on.
+pub fn static_transforms(scenario: &Scenario) -> Vec<SimMessage> {
+    let start = Stamp(scenario.world.start_time_s.saturating_mul(1_000_000_000));
     let f = &scenario.frames;
-    [(&f.laser, &scenario.lidar.mount), (&f.imu_link, &scenario.imu.mount), (&f.gps, &scenario.gnss.mount)]
-        .into_iter()
-        .map(|(child, mount)| {
-            SimMessage::StaticTransform(SimStaticTransform::from_mount(start, "/tf_static", &f.base_link, child, mount))
-        })
-        .collect()
+    let mut out: Vec<SimMessage> =
+        [(&f.laser, &scenario.lidar.mount), (&f.imu_link, &scenario.imu.mount), (&f.gps, &scenario.gnss.mount)]
+            .into_iter()
+            .map(|(child, mount)| {
+                SimMessage::StaticTransform(SimStaticTransform::from_mount(
+                    start,
+                    "/tf_static",
+                    &f.base_link,
+                    child,
+                    mount,
+                ))
+            })
+            .collect();
+    if scenario.camera.enabled {
+        let mount = camera::mount_message(&scenario.camera, start, &f.base_link, &f.camera_optical);
+        out.push(SimMessage::StaticTransform(mount));
+    }
+    out
 }
 
 /// The true trajectory at [`TRUTH_OUTPUT_RATE_HZ`].
@@ -143,8 +158,19 @@ fn person_track(scenario: &Scenario, traj: &Trajectory, start: Stamp) -> Vec<(St
         .collect()
 }
 
-/// Runs the scenario.
+/// Runs the scenario: the recording, its messages in time order.
 pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
+    let mut messages = Vec::new();
+    let mut rec = simulate_with(scenario, &mut |m| messages.push(m))?;
+    rec.messages = messages;
+    Ok(rec)
+}
+
+/// Runs the scenario, handing every message to `sink` in time order as it is made instead
+/// of holding them: the camera's images, most of a recording's bytes, are rendered a
+/// chunk at a time while `sink` takes the last chunk. The messages, and their order, are
+/// those of [`simulate`]; the recording returned has none.
+pub fn simulate_with(scenario: &Scenario, sink: &mut dyn FnMut(SimMessage)) -> Result<SimRecording, SimError> {
     scenario.validate().map_err(SimError::Invalid)?;
     let datum = scenario.gnss.datum().map_err(SimError::Invalid)?;
     let start = Stamp(scenario.world.start_time_s.saturating_mul(1_000_000_000));
@@ -160,20 +186,16 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
     let camera_seed = seeds.next_u64();
     let f = &scenario.frames;
 
-    let mut messages = static_mounts(scenario, start);
+    let mut messages = static_transforms(scenario);
     let camera_run = camera::CameraRun {
         cfg: &scenario.camera,
         frame_id: &f.camera_optical,
-        base_link: &f.base_link,
         objects: &scenario.world.objects,
         caster: &caster,
         person: &scenario.person,
         traj: &traj,
         start,
     };
-    if scenario.camera.enabled {
-        messages.push(SimMessage::StaticTransform(camera_run.mount_message()));
-    }
     let (scans, lidar_stats) =
         lidar::simulate_scans(&scenario.lidar, &f.laser, &caster, &scenario.person, &traj, start, &mut rng_lidar);
     messages.extend(scans.into_iter().map(SimMessage::Scan));
@@ -190,16 +212,23 @@ pub fn simulate(scenario: &Scenario) -> Result<SimRecording, SimError> {
     messages.extend(imu.into_iter().map(|m| SimMessage::Imu(Box::new(m))));
     let gnss = gnss::simulate_gnss(&scenario.gnss, &datum, &f.gps, &traj, start, &mut rng_gnss);
     messages.extend(gnss.fixes.into_iter().map(SimMessage::Fix));
+    // Time order, ties in the order made (a stable sort); the camera's frames, made last
+    // and in time order, are merged in after the messages of their stamp.
+    messages.sort_by_key(|m| m.stamp());
+    let mut others = messages.into_iter().peekable();
     let camera_truth = if scenario.camera.enabled {
-        let (images, truth) = camera_run.simulate(camera_seed);
-        messages.extend(images);
-        truth
+        camera_run.stream(camera_seed, &mut |m| {
+            while let Some(earlier) = others.next_if(|o| o.stamp() <= m.stamp()) {
+                sink(earlier);
+            }
+            sink(m);
+        })
     } else {
         CameraTruth::default()
     };
-    messages.sort_by_key(|m| m.stamp());
+    others.for_each(&mut *sink);
     Ok(SimRecording {
-        messages,
+        messages: Vec::new(),
         truth_trajectory: truth_trajectory(&traj, start),
         injected_outliers: gnss.outliers,
         dropouts: gnss.dropouts,

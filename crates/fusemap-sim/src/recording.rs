@@ -132,8 +132,7 @@ impl SimRecording {
     /// Cells of the truth rasters at `geometry` (the world's extent), refused as
     /// [`SimRecording::truth_occupancy`] refuses them.
     pub fn truth_cells(&self, geometry: GridGeometry) -> Result<u128, TruthRasterError> {
-        let (_, w, h) = self.truth_extent(geometry)?;
-        Ok(w as u128 * h as u128)
+        truth_cells(&self.extent, geometry)
     }
 
     /// Bytes the recording's messages hold (their images and scans, and the vector of
@@ -151,17 +150,7 @@ impl SimRecording {
 
     /// The truth rasters' first cell, width and height at `geometry`.
     fn truth_extent(&self, geometry: GridGeometry) -> Result<(CellIndex, usize, usize), TruthRasterError> {
-        let e = &self.extent;
-        let (Some(lo), Some(hi)) =
-            (geometry.cell_of(Point2::new(e.min[0], e.min[1])), geometry.cell_of(Point2::new(e.max[0], e.max[1])))
-        else {
-            return Err(TruthRasterError::TooLarge { cells: u128::MAX });
-        };
-        let (w, h) = ((hi.x - lo.x + 1).max(1) as u128, (hi.y - lo.y + 1).max(1) as u128);
-        if w * h > MAX_TRUTH_CELLS as u128 {
-            return Err(TruthRasterError::TooLarge { cells: w * h });
-        }
-        Ok((lo, w as usize, h as usize))
+        truth_extent(&self.extent, geometry)
     }
 
     /// Walks every cell every object covers (as [`SimRecording::truth_occupancy`] defines
@@ -242,6 +231,27 @@ pub fn segment_meets_box(a: Point2, b: Point2, lo: Point2, hi: Point2) -> bool {
         }
     }
     t0 <= t1
+}
+
+/// Cells of the truth rasters over the world's `extent` at `geometry` (a scenario's, before
+/// it is run), refused as [`SimRecording::truth_occupancy`] refuses them.
+pub fn truth_cells(extent: &Rect, geometry: GridGeometry) -> Result<u128, TruthRasterError> {
+    let (_, w, h) = truth_extent(extent, geometry)?;
+    Ok(w as u128 * h as u128)
+}
+
+/// The truth rasters' first cell, width and height over the world's `extent` at `geometry`.
+fn truth_extent(e: &Rect, geometry: GridGeometry) -> Result<(CellIndex, usize, usize), TruthRasterError> {
+    let (Some(lo), Some(hi)) =
+        (geometry.cell_of(Point2::new(e.min[0], e.min[1])), geometry.cell_of(Point2::new(e.max[0], e.max[1])))
+    else {
+        return Err(TruthRasterError::TooLarge { cells: u128::MAX });
+    };
+    let (w, h) = ((hi.x - lo.x + 1).max(1) as u128, (hi.y - lo.y + 1).max(1) as u128);
+    if w * h > MAX_TRUTH_CELLS as u128 {
+        return Err(TruthRasterError::TooLarge { cells: w * h });
+    }
+    Ok((lo, w as usize, h as usize))
 }
 
 #[cfg(test)]

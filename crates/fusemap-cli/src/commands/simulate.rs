@@ -2,7 +2,8 @@
 //! a scenario file's world) recorded as a rosbag2 bag, with its ground truth beside it.
 
 use anyhow::{Context, Result};
-use fusemap_sim::{simulate, Scenario};
+use fusemap_sim::bag::SimulationError;
+use fusemap_sim::Scenario;
 use std::path::Path;
 
 /// Runs the simulator and writes `DIR/bag`, `DIR/truth.yaml` + `.pgm`,
@@ -15,11 +16,15 @@ pub fn run(scenario: Option<&Path>, out: &Path, resolution: f64, overwrite: bool
     if let Some(p) = scenario {
         fusemap_io::atomic::ensure_not_input(&out.join("bag"), &[p.to_path_buf()])?;
     }
-    let rec = simulate(&s).map_err(|e| anyhow::anyhow!("scenario: {e}"))?;
     // The memory budget of a run with default limits: `simulate` reads no config.
     let memory = fusemap_core::config::LimitsConfig::default().memory_bytes();
-    let files = fusemap_sim::bag::write_simulation(&rec, out, resolution, overwrite, memory)
-        .with_context(|| format!("writing the simulation to {}", out.display()))?;
+    let (rec, files) = match fusemap_sim::bag::simulate_to(&s, out, resolution, overwrite, memory) {
+        Ok(written) => written,
+        Err(SimulationError::Scenario(e)) => return Err(anyhow::anyhow!("scenario: {e}")),
+        Err(SimulationError::Write(e)) => {
+            return Err(e).with_context(|| format!("writing the simulation to {}", out.display()))
+        }
+    };
     println!("bag           {} ({} messages)", super::shown(&files.bag.dir), files.bag.message_count);
     for t in &files.bag.topics {
         println!("  {:<12}  {:<28} {}", t.name, t.type_name, t.message_count);

@@ -159,7 +159,7 @@ fn overview(s: &Value) -> String {
 
 /// Where the wall time went (`summary.json`'s `seconds`), phase by phase.
 fn phases(seconds: &Value) -> String {
-    const PHASES: [&str; 8] = ["simulate", "write_simulation", "read", "estimator", "slam", "map", "outputs", "other"];
+    const PHASES: [&str; 7] = ["simulate", "read", "estimator", "slam", "map", "outputs", "other"];
     let shown = PHASES.iter().filter(|k| seconds[**k].is_number());
     shown.map(|k| format!("{} {}", k.replace('_', " "), num(&seconds[*k]))).collect::<Vec<_>>().join(", ")
 }

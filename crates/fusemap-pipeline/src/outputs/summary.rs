@@ -67,12 +67,10 @@ pub struct Summary {
 /// the phases add up to `total`, the summary's `wall_time_s`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Seconds {
-    /// `fusemap demo`: the simulator (scans, images and pose sensors of the world).
+    /// `fusemap demo`: the simulator (scans, images and pose sensors of the world),
+    /// written as a rosbag2 bag as it runs.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulate: Option<f64>,
-    /// `fusemap demo`: the simulation written as a rosbag2 bag.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub write_simulation: Option<f64>,
     /// The first pass over the log: the pose sensors read and the scans inventoried.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub read: Option<f64>,
@@ -112,7 +110,7 @@ impl Seconds {
     /// Closes the account at `total` seconds, with `outputs` seconds of output: `other`
     /// is what the named phases leave.
     pub fn closed(mut self, outputs: f64, total: f64) -> Self {
-        let named = [self.simulate, self.write_simulation, self.read, self.estimator, self.slam, self.map];
+        let named = [self.simulate, self.read, self.estimator, self.slam, self.map];
         let named: f64 = named.iter().flatten().sum::<f64>() + outputs;
         (self.outputs, self.total, self.other) = (outputs, total, (total - named).max(0.0));
         self
@@ -122,7 +120,6 @@ impl Seconds {
     fn line(&self) -> String {
         let named = [
             ("simulate", self.simulate),
-            ("write simulation", self.write_simulation),
             ("read", self.read),
             ("estimator", self.estimator),
             ("slam", self.slam),

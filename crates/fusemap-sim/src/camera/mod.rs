@@ -253,12 +253,21 @@ pub(crate) fn encode_depth(depth: &[f32], enc: DepthEncoding) -> Vec<u8> {
     }
 }
 
+/// The static transform `base_link → camera_optical` of a camera `cfg`, stamped `start`.
+pub(crate) fn mount_message(cfg: &CameraConfig, start: Stamp, base_link: &str, frame_id: &str) -> SimStaticTransform {
+    let p = cfg.base_from_optical();
+    let transform = Transform { translation: p.translation.into(), rotation: p.rotation.into() };
+    SimStaticTransform::new(
+        "/tf_static",
+        TransformStamped { header: Header::new(start, base_link), child_frame_id: frame_id.into(), transform },
+    )
+}
+
 /// The camera's messages over the run (label, depth and info per frame, and its
 /// `/tf_static` mount) and what it truly did.
 pub(crate) struct CameraRun<'a> {
     pub cfg: &'a CameraConfig,
     pub frame_id: &'a str,
-    pub base_link: &'a str,
     pub objects: &'a [WorldObject],
     pub caster: &'a Caster,
     pub person: &'a PersonConfig,
@@ -267,54 +276,52 @@ pub(crate) struct CameraRun<'a> {
 }
 
 impl CameraRun<'_> {
-    /// The static transform `base_link → camera_optical`.
-    pub fn mount_message(&self) -> SimStaticTransform {
-        let p = self.cfg.base_from_optical();
-        let transform = Transform { translation: p.translation.into(), rotation: p.rotation.into() };
-        SimStaticTransform::new(
-            "/tf_static",
-            TransformStamped {
-                header: Header::new(self.start, self.base_link),
-                child_frame_id: self.frame_id.into(),
-                transform,
-            },
-        )
-    }
-
-    /// Every frame of the run, split over the machine's cores (frames are independent:
-    /// each has its own noise stream), then joined in time order.
-    pub fn simulate(&self, seed: u64) -> (Vec<SimMessage>, CameraTruth) {
+    /// Every frame of the run, handed to `emit` in time order as it is rendered. Frames
+    /// are rendered a chunk at a time, split over the machine's cores (frames are
+    /// independent: each has its own noise stream), and the next chunk is rendered while
+    /// `emit` takes the last: a run holds two chunks of images, not the whole recording,
+    /// and writing them overlaps the rendering. The frames are the same whatever the
+    /// chunks and the cores.
+    pub fn stream(&self, seed: u64, emit: &mut dyn FnMut(SimMessage)) -> CameraTruth {
         let mut frames = 0u64;
         while frames as f64 / self.cfg.rate_hz <= self.traj.duration() {
             frames += 1;
         }
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 4) as u64;
-        let chunk = frames.div_ceil(threads).max(1);
-        let parts: Vec<Part> = std::thread::scope(|scope| {
-            let handles: Vec<_> = (0..threads)
-                .map(|k| {
-                    let range = (k * chunk).min(frames)..((k + 1) * chunk).min(frames);
-                    scope.spawn(move || self.simulate_frames(seed, range))
-                })
-                .collect();
-            handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
-        });
+        let chunk = threads * FRAMES_PER_THREAD_AND_CHUNK;
         let mut truth = CameraTruth::default();
-        let mut messages = Vec::new();
         let mut sample = Vec::new();
-        for p in parts {
-            messages.extend(p.messages);
-            truth.stamps.extend(p.truth.stamps);
-            truth.backlit_frames += p.truth.backlit_frames;
-            truth.backlit_pixels += p.truth.backlit_pixels;
-            truth.salt_pixels += p.truth.salt_pixels;
-            truth.person_pixels += p.truth.person_pixels;
-            sample.extend(p.sample);
-            bottom_k(&mut sample, MAX_BACKLIT_POINTS);
+        let mut take = |parts: Vec<Part>, emit: &mut dyn FnMut(SimMessage)| {
+            for p in parts {
+                p.messages.into_iter().for_each(&mut *emit);
+                truth.stamps.extend(p.truth.stamps);
+                truth.backlit_frames += p.truth.backlit_frames;
+                truth.backlit_pixels += p.truth.backlit_pixels;
+                truth.salt_pixels += p.truth.salt_pixels;
+                truth.person_pixels += p.truth.person_pixels;
+                sample.extend(p.sample);
+                bottom_k(&mut sample, MAX_BACKLIT_POINTS);
+            }
+        };
+        let mut rendered: Vec<Part> = Vec::new();
+        for first in (0..frames).step_by(chunk as usize) {
+            let last = (first + chunk).min(frames);
+            let per_thread = (last - first).div_ceil(threads).max(1);
+            rendered = std::thread::scope(|scope| {
+                let handles: Vec<_> = (0..threads)
+                    .map(|k| {
+                        let range = (first + k * per_thread).min(last)..(first + (k + 1) * per_thread).min(last);
+                        scope.spawn(move || self.simulate_frames(seed, range))
+                    })
+                    .collect();
+                take(std::mem::take(&mut rendered), emit);
+                handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
+            });
         }
+        take(rendered, emit);
         sample.sort_unstable_by_key(|s| s.0);
         truth.backlit_floor_points = sample.into_iter().map(|s| s.1).collect();
-        (messages, truth)
+        truth
     }
 
     /// The frames `range` (frame `n` shows true time `n / rate_hz`).
@@ -407,6 +414,11 @@ impl CameraRun<'_> {
         part
     }
 }
+
+/// Frames each thread renders per chunk of [`CameraRun::stream`]: enough to keep the
+/// threads' start-up small against the work (a frame takes milliseconds), few enough that
+/// two chunks of images are a few tens of MiB.
+pub(crate) const FRAMES_PER_THREAD_AND_CHUNK: u64 = 24;
 
 /// What one thread rendered.
 #[derive(Default)]
