@@ -177,7 +177,7 @@ fn a_pass_maps_bit_identical_on_one_two_and_four_threads() {
     let m = model();
     let k = m.classes().len();
     let frames: Vec<_> = (0..6).map(|i| render(&m, 3.0 + 0.2 * i as f64, -0.3..0.3)).collect();
-    let on = |threads: usize| {
+    let on = |threads: usize, map_cells: Option<u64>| {
         let fine = || FusionGrid::new(GridGeometry::centered(0.05).unwrap(), OccupancyParams::default());
         let coarse = FusionGrid::new(GridGeometry::centered(0.1).unwrap(), OccupancyParams::default());
         let maps = MapSet::new("fused", SensorSelection::All, fine())
@@ -189,23 +189,35 @@ fn a_pass_maps_bit_identical_on_one_two_and_four_threads() {
         let laser = e.add_lidar("laser", LidarModel::new(LidarParams::default(), PlanarMount::default()));
         e.set_correlation(Correlation { groups: vec![vec![cam, laser]], window_ns: 50_000_000, rule: MergeRule::Max });
         e.set_dynamic(DynamicParams::default(), true);
+        if let Some(map_cells) = map_cells {
+            e.set_limits(&crate::config::LimitsConfig { map_cells, ..Default::default() });
+        }
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| {
+        // The first refusal (a map past `limits.map_cells`) ends the pass, as in a run.
+        let refused = pool.install(|| -> Result<(), String> {
             for (i, (labels, depth)) in frames.iter().enumerate() {
                 let (t, pose) = (Stamp(i as i64 * 100_000_000), Pose2::new(0.1 * i as f64, 0.05 * i as f64, 0.02));
                 let id = Some(ObservationId(i as u64));
-                e.insert_camera_frame(cam, id, t, labels, depth, pose).unwrap();
+                e.insert_camera_frame(cam, id, t, labels, depth, pose).map_err(|e| format!("frame {i}: {e}"))?;
                 let ranges = (0..181).map(|b| 2.5 + 0.01 * ((b * 7 + i) % 13) as f32).collect();
                 let scan = LaserScan { stamp: t, angle_min: -1.57, angle_increment: 0.01745, ranges };
-                e.insert_scan_observed(laser, ObservationId(i as u64), &scan, f32::NAN, f32::NAN, |_| pose).unwrap();
+                e.insert_scan_observed(laser, ObservationId(i as u64), &scan, f32::NAN, f32::NAN, |_| pose)
+                    .map_err(|e| format!("scan {i}: {e}"))?;
             }
+            Ok(())
         });
-        e.maps().iter().map(|m| fingerprint(m.grid(), k)).collect::<Vec<_>>()
+        (refused, e.maps().iter().map(|m| fingerprint(m.grid(), k)).collect::<Vec<_>>())
     };
-    let one = on(1);
-    assert_eq!(one.len(), 4);
+    let (refused, one) = on(1, None);
+    assert_eq!((refused, one.len()), (Ok(()), 4));
     assert!(one.iter().all(|m| !m.is_empty()));
     assert!(one[0] != one[1] && one[0] != one[2] && one[1] != one[2], "the maps differ from one another");
-    assert!(one == on(2), "2 threads");
-    assert!(one == on(4), "4 threads");
+    assert!(one == on(2, None).1, "2 threads");
+    assert!(one == on(4, None).1, "4 threads");
+    // A budget the pass outgrows part-way: the same refusal, at the same observation, with
+    // the same maps up to it.
+    let tight = on(1, Some(4 * 4096));
+    assert!(tight.0.as_ref().is_err_and(|e| e.contains("limits.map_cells")), "{:?}", tight.0);
+    assert!(tight == on(2, Some(4 * 4096)), "2 threads, over budget");
+    assert!(tight == on(4, Some(4 * 4096)), "4 threads, over budget");
 }
