@@ -6,6 +6,7 @@ use super::report::{CorrectionReport, FixRejection, GyroReport, OdometryReport, 
 use crate::geometry::{Point2, Pose2};
 use crate::time::Stamp;
 use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
 
 /// The quality of a GNSS fix, as the caller maps its receiver's status (NavSatFix
 /// `status`, NMEA GGA quality). Used for reporting; the weight of a fix is its covariance,
@@ -180,8 +181,12 @@ fn finite3(m: &Mat<3, 3>) -> bool {
 
 /// Sorts the inputs stably by stamp, drops non-finite values (counted) and replaces
 /// covariances that are not positive definite by the configuration's figures (counted).
-pub(crate) fn sort_inputs(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> (Sorted, InputCounts) {
-    let mut order: Vec<usize> = (0..inputs.len()).collect();
+pub(crate) fn sort_inputs(
+    inputs: &[EstimatorInput],
+    skip: &HashSet<usize>,
+    cfg: &EstimatorConfig,
+) -> (Sorted, InputCounts) {
+    let mut order: Vec<usize> = (0..inputs.len()).filter(|i| !skip.contains(i)).collect();
     order.sort_by_key(|&i| inputs[i].stamp());
     let mut s = Sorter {
         cfg,

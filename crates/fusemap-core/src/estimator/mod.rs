@@ -89,10 +89,8 @@ pub use sensor_models::{
 };
 pub use stale_orientation::{StaleOrientation, STALE_TURN_RAD};
 
-use crate::geometry::Pose2;
-use filter::{StepRecord, N};
-use linalg::Mat;
 use run::RunCounts;
+use std::collections::HashSet;
 use streams::{GyroTrack, OdometryTrack, SlipDetector};
 
 /// Estimates the `map_from_base` track from `inputs` (any order; sorted stably by stamp).
@@ -107,13 +105,28 @@ pub fn estimate(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> Result<Esti
     second_pass::estimate_with_hindsight(inputs, cfg)
 }
 
-/// One forward filter and backward smoother over `inputs`.
-pub(crate) fn estimate_once(inputs: &[EstimatorInput], cfg: &EstimatorConfig) -> Result<Estimate, EstimatorError> {
+/// One forward filter and backward smoother over `inputs`, but those whose index is in
+/// `skip` (without a copy of the others: the inputs of a long log are tens of MB).
+pub(crate) fn estimate_once(
+    inputs: &[EstimatorInput],
+    skip: &HashSet<usize>,
+    cfg: &EstimatorConfig,
+) -> Result<Estimate, EstimatorError> {
+    estimate_held(inputs, skip, cfg, smoother::HELD_RECORDS)
+}
+
+/// [`estimate_once`] with the smoother holding at most `held` records at once.
+pub(crate) fn estimate_held(
+    inputs: &[EstimatorInput],
+    skip: &HashSet<usize>,
+    cfg: &EstimatorConfig,
+    held: usize,
+) -> Result<Estimate, EstimatorError> {
     cfg.validate().map_err(|e| EstimatorError::Config(e.to_string()))?;
-    if inputs.is_empty() {
+    if (0..inputs.len()).all(|i| skip.contains(&i)) {
         return Err(EstimatorError::NoInputs);
     }
-    let (sorted, mut counts) = input::sort_inputs(inputs, cfg);
+    let (sorted, mut counts) = input::sort_inputs(inputs, skip, cfg);
     let fixes_received = counts.fixes.received;
     let Some(odo) = OdometryTrack::build(sorted.odometry, cfg, &mut counts.odometry) else {
         return Err(EstimatorError::NoOdometry {
@@ -145,21 +158,13 @@ pub(crate) fn estimate_once(inputs: &[EstimatorInput], cfg: &EstimatorConfig) ->
     };
     let fix_slip = slip_fixes::FixSlipCheck::new(&sorted.corrections, &odo, cfg);
     let sources = run::MotionSources { odo: &odo, gyro: gyro.as_ref(), slip: &slip, fix_slip: &fix_slip };
-    let out = run::run(&sources, &sorted.corrections, &init, cfg, &mut rc)?;
-    let smoothed = smoother::smooth(&out.records);
-    // The forward pass stops at a non-finite state; the smoother's gain (P Pₚ⁻¹) can still
-    // overflow where a correction claimed a variance of 10¹²² (found by fuzzing): an
-    // estimate never hands out a NaN pose.
-    if let Some((r, _)) =
-        out.records.iter().zip(&smoothed).find(|(_, (x, p))| !x.iter().all(|v| v.is_finite()) || !linalg::all_finite(p))
-    {
-        return Err(EstimatorError::Numerical { stamp: r.stamp.0 });
-    }
+    let forward = |keep, counts: &mut run::RunCounts| run::run(&sources, &sorted.corrections, &init, cfg, counts, keep);
+    let track = smoother::filter_and_smooth(forward, &mut rc, held)?;
 
-    let slip_stretches = slip_stretches(&odo, &out.slip, cfg.slip_merge_gap_s);
-    counts.odometry.slip_intervals = out.slip.iter().filter(|&&s| s).count();
+    let slip_stretches = slip_stretches(&odo, &track.slip, cfg.slip_merge_gap_s);
+    counts.odometry.slip_intervals = track.slip.iter().filter(|&&s| s).count();
     counts.gyro.steps_without_gyro = rc.steps_without_gyro;
-    let last = out.records.last().map(|r| (r.x, r.p)).unwrap_or((init.x, init.p));
+    let last = track.last;
     let report = EstimatorReport {
         fixes: rc.fixes,
         fixes_by_quality: rc.by_quality,
@@ -182,25 +187,9 @@ pub(crate) fn estimate_once(inputs: &[EstimatorInput], cfg: &EstimatorConfig) ->
         gate_resets: rc.gate_resets,
         gate_resets_refused: rc.gate_resets_refused,
         stationary_s: rc.stationary_s,
-        steps: out.records.len(),
+        steps: track.smoothed.len(),
     };
-    let filtered = out.records.iter().map(|r| sample(r, &r.x, &r.p)).collect();
-    let smoothed = out.records.iter().zip(&smoothed).map(|(r, (x, p))| sample(r, x, p)).collect();
-    Ok(Estimate { filtered, smoothed, report, max_gap_s: cfg.max_sample_gap_s })
-}
-
-fn sample(r: &StepRecord, x: &[f64; N], p: &Mat<N, N>) -> StateSample {
-    let mut covariance = [[0.0; 3]; 3];
-    for (i, row) in covariance.iter_mut().enumerate() {
-        row.copy_from_slice(&p[i][..3]);
-    }
-    StateSample {
-        stamp: r.stamp,
-        pose: Pose2::new(x[0], x[1], x[2]),
-        covariance,
-        gyro_bias: x[3],
-        odometry_scale: x[4],
-    }
+    Ok(Estimate { filtered: track.filtered, smoothed: track.smoothed, report, max_gap_s: cfg.max_sample_gap_s })
 }
 
 /// Merges slipping intervals closer than `merge_gap_s` into stretches.

@@ -16,6 +16,7 @@ use crate::geometry::Pose2;
 use crate::time::Stamp;
 
 /// What the forward pass counts.
+#[derive(Clone)]
 pub(crate) struct RunCounts {
     pub fixes: CorrectionReport,
     pub poses: CorrectionReport,
@@ -31,9 +32,12 @@ pub(crate) struct RunCounts {
 
 /// The forward pass's result.
 pub(crate) struct RunOutput {
+    /// The records of the steps the pass was asked to keep.
     pub records: Vec<StepRecord>,
     /// Per odometry interval: flagged as slipping.
     pub slip: Vec<bool>,
+    /// Steps of the whole pass.
+    pub steps: usize,
 }
 
 /// Time constant of the odometry speed held through a slip, seconds.
@@ -287,18 +291,21 @@ impl Filter<'_> {
     }
 }
 
-/// Runs the filter over the whole track.
+/// Runs the filter over the whole track, keeping the records of steps `keep` (step 0 is
+/// the start; see [`super::smoother::filter_and_smooth`]).
 pub(crate) fn run(
     motion: &MotionSources,
     corrections: &[(Stamp, Correction)],
     init: &Init,
     cfg: &EstimatorConfig,
     counts: &mut RunCounts,
+    keep: std::ops::Range<usize>,
 ) -> Result<RunOutput, EstimatorError> {
     let MotionSources { odo, gyro, slip, fix_slip } = *motion;
     let gates = gates(cfg)?;
     let (t0, t_last) = odo.span();
-    let mut records = Vec::with_capacity(odo.stamps.len() + corrections.len());
+    let mut records = Vec::with_capacity(keep.len().min(odo.stamps.len() + corrections.len()));
+    let mut steps = 0;
     let mut slips = vec![false; odo.intervals.len()];
     let mut f = Filter {
         x: init.x,
@@ -320,7 +327,10 @@ pub(crate) fn run(
         f.correct(corrections[j].0, &corrections[j].1);
         j += 1;
     }
-    records.push(StepRecord { stamp: t0, x: f.x, p: f.p, x_pred: init.x, p_pred: init.p, f: identity() });
+    if keep.contains(&steps) {
+        records.push(StepRecord { stamp: t0, x: f.x, p: f.p, x_pred: init.x, p_pred: init.p, f: identity() });
+    }
+    steps += 1;
     let mut held_speed = 0.0;
     let mut t_cur = t0;
     let mut odo_cur = odo.pose_at(t0);
@@ -345,7 +355,10 @@ pub(crate) fn run(
             if !all_finite(&f.p) || !f.x.iter().all(|v| v.is_finite()) {
                 return Err(EstimatorError::Numerical { stamp: t.0 });
             }
-            records.push(StepRecord { stamp: t, x: f.x, p: f.p, x_pred, p_pred, f: jac });
+            if keep.contains(&steps) {
+                records.push(StepRecord { stamp: t, x: f.x, p: f.p, x_pred, p_pred, f: jac });
+            }
+            steps += 1;
             t_cur = t;
             odo_cur = odo_t;
             if t == t_end {
@@ -357,7 +370,7 @@ pub(crate) fn run(
     for (stamp, c) in &corrections[j..] {
         count_outside(*stamp, c, f.counts);
     }
-    Ok(RunOutput { records, slip: slips })
+    Ok(RunOutput { records, slip: slips, steps })
 }
 
 /// Empty per-quality counters.

@@ -62,7 +62,7 @@ pub(crate) fn estimate_with_hindsight(
     inputs: &[EstimatorInput],
     cfg: &super::EstimatorConfig,
 ) -> Result<Estimate, super::EstimatorError> {
-    let first = super::estimate_once(inputs, cfg)?;
+    let first = super::estimate_once(inputs, &HashSet::new(), cfg)?;
     if !cfg.smoothed_fix_gate {
         return Ok(first);
     }
@@ -73,9 +73,7 @@ pub(crate) fn estimate_with_hindsight(
     // The first estimate is not needed any more: free it before the second is built.
     drop(first);
     let drop: HashSet<usize> = flagged.iter().map(|f| f.0).collect();
-    let kept: Vec<EstimatorInput> =
-        inputs.iter().enumerate().filter(|(i, _)| !drop.contains(i)).map(|(_, x)| x.clone()).collect();
-    let mut second = super::estimate_once(&kept, cfg)?;
+    let mut second = super::estimate_once(inputs, &drop, cfg)?;
     let r = &mut second.report;
     r.fixes.received += flagged.len();
     r.fixes.rejected_smoothed_gate += flagged.len();
