@@ -90,6 +90,8 @@ pub fn simulate_to(
     memory_bytes: u64,
 ) -> std::result::Result<(SimRecording, SimulationFiles), SimulationError> {
     scenario.validate().map_err(crate::SimError::Invalid)?;
+    // The truth is rastered after the run, when its messages are in the bag: nothing of the
+    // recording is held beside it.
     let geometry = truth_geometry(out, resolution, &scenario.world.extent, 0, memory_bytes)?;
     std::fs::create_dir_all(out).map_err(|e| fusemap_io::Error::io(out, e))?;
     let dir = out.join("bag");
@@ -111,6 +113,9 @@ pub fn simulate_to(
     let files = write_truth(&rec, out, geometry, bag)?;
     Ok((rec, files))
 }
+
+/// The true occupancy as a map raster: occupied where an object covers the cell, free
+/// elsewhere inside the hall.
 pub fn truth_raster(rec: &SimRecording, geometry: GridGeometry) -> Result<Raster, TruthRasterError> {
     let t = rec.truth_occupancy(geometry)?;
     let params = OccupancyParams::default();

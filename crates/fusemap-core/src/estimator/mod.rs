@@ -158,13 +158,15 @@ pub(crate) fn estimate_held(
     };
     let fix_slip = slip_fixes::FixSlipCheck::new(&sorted.corrections, &odo, cfg);
     let sources = run::MotionSources { odo: &odo, gyro: gyro.as_ref(), slip: &slip, fix_slip: &fix_slip };
-    let forward = |keep, counts: &mut run::RunCounts| run::run(&sources, &sorted.corrections, &init, cfg, counts, keep);
+    let forward = |keep, counts: &mut run::RunCounts, whole| {
+        run::run(&sources, &sorted.corrections, &init, cfg, counts, keep, whole)
+    };
     let track = smoother::filter_and_smooth(forward, &mut rc, held)?;
 
     let slip_stretches = slip_stretches(&odo, &track.slip, cfg.slip_merge_gap_s);
     counts.odometry.slip_intervals = track.slip.iter().filter(|&&s| s).count();
     counts.gyro.steps_without_gyro = rc.steps_without_gyro;
-    let last = track.last;
+    let last = track.last.unwrap_or((init.x, init.p));
     let report = EstimatorReport {
         fixes: rc.fixes,
         fixes_by_quality: rc.by_quality,

@@ -291,8 +291,9 @@ impl Filter<'_> {
     }
 }
 
-/// Runs the filter over the whole track, keeping the records of steps `keep` (step 0 is
-/// the start; see [`super::smoother::filter_and_smooth`]).
+/// Runs the filter over the whole track (up to the end of `keep` only, unless `whole`),
+/// keeping the records of steps `keep` (step 0 is the start; see
+/// [`super::smoother::filter_and_smooth`]).
 pub(crate) fn run(
     motion: &MotionSources,
     corrections: &[(Stamp, Correction)],
@@ -300,6 +301,7 @@ pub(crate) fn run(
     cfg: &EstimatorConfig,
     counts: &mut RunCounts,
     keep: std::ops::Range<usize>,
+    whole: bool,
 ) -> Result<RunOutput, EstimatorError> {
     let MotionSources { odo, gyro, slip, fix_slip } = *motion;
     let gates = gates(cfg)?;
@@ -359,6 +361,9 @@ pub(crate) fn run(
                 records.push(StepRecord { stamp: t, x: f.x, p: f.p, x_pred, p_pred, f: jac });
             }
             steps += 1;
+            if !whole && steps >= keep.end {
+                return Ok(RunOutput { records, slip: slips, steps });
+            }
             t_cur = t;
             odo_cur = odo_t;
             if t == t_end {

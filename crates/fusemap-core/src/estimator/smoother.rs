@@ -27,33 +27,34 @@ pub(crate) struct Track {
     pub filtered: Vec<StateSample>,
     pub smoothed: Vec<StateSample>,
     /// The filter's last state and covariance (what the log taught it: the gyro bias, the
-    /// odometry scale).
-    pub last: ([f64; N], Mat<N, N>),
+    /// odometry scale); `None` without a step (never: the start is one).
+    pub last: Option<([f64; N], Mat<N, N>)>,
     /// Per odometry interval: flagged as slipping.
     pub slip: Vec<bool>,
 }
 
-/// Runs the forward pass (`forward(keep, counts)`: the filter over the whole log, keeping
-/// the records of the steps in `keep`) and the smoother over its records, holding at most
-/// `held` records at once.
+/// Runs the forward pass (`forward(keep, counts, whole)`: the filter over the log,
+/// keeping the records of the steps in `keep`, to its end when `whole`, else up to the end
+/// of `keep`) and the smoother over its records, holding at most `held` records at once.
 ///
-/// The first pass counts into `counts` and keeps the first `held` records. A log of more
-/// steps is smoothed a segment at a time from its end, and the forward pass runs again for
-/// each segment but the first, keeping that segment's records (and counting into a
-/// scratch copy): the filter is deterministic, so they are the first pass's records to the
-/// bit, and the samples are those of one pass holding them all. Memory then grows with the
-/// log by a sample's 240 bytes a step instead of a record's 688; time by one forward pass
-/// (about 1 s an hour of 50 Hz odometry) per extra segment. This is checkpointing with
+/// The first pass runs whole, counts into `counts` and keeps the first `held` records. A
+/// log of more steps is smoothed a segment at a time from its end, and the forward pass
+/// runs again up to each segment but the first, keeping that segment's records (and
+/// counting into a scratch copy): the filter is deterministic, so they are the first
+/// pass's records to the bit, and the samples are those of one pass holding them all.
+/// Memory then grows with the log by a sample's 240 bytes a step instead of a record's
+/// 688; time by a partial forward pass per extra segment (a whole one takes about 0.5 s an
+/// hour of 50 Hz odometry), so quadratically in the log's length past `held` steps. This is checkpointing with
 /// recomputation, as in Griewank & Walther's reverse-mode differentiation, with the start
 /// of the log as the only checkpoint.
 pub(crate) fn filter_and_smooth(
-    forward: impl Fn(Range<usize>, &mut RunCounts) -> Result<RunOutput, EstimatorError>,
+    forward: impl Fn(Range<usize>, &mut RunCounts, bool) -> Result<RunOutput, EstimatorError>,
     counts: &mut RunCounts,
     held: usize,
 ) -> Result<Track, EstimatorError> {
     let scratch = counts.clone();
     let held = held.max(1);
-    let RunOutput { records: first, slip, steps } = forward(0..held, counts)?;
+    let RunOutput { records: first, slip, steps } = forward(0..held, counts, true)?;
     let segments: Vec<Range<usize>> = (0..steps).step_by(held).map(|a| a..(a + held).min(steps)).collect();
     let (mut filtered, mut smoothed) = (Vec::with_capacity(steps), Vec::with_capacity(steps));
     let mut last = None;
@@ -65,7 +66,7 @@ pub(crate) fn filter_and_smooth(
     for segment in segments.iter().rev() {
         let records = match segment.start {
             0 => first.take().unwrap_or_default(),
-            _ => forward(segment.clone(), &mut scratch.clone())?.records,
+            _ => forward(segment.clone(), &mut scratch.clone(), false)?.records,
         };
         debug_assert_eq!(records.len(), segment.len());
         let Some(end) = records.last() else { continue };
@@ -92,7 +93,6 @@ pub(crate) fn filter_and_smooth(
     }
     filtered.reverse();
     smoothed.reverse();
-    let last = last.ok_or(EstimatorError::Numerical { stamp: 0 })?;
     Ok(Track { filtered, smoothed, last, slip })
 }
 

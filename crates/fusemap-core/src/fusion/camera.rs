@@ -19,11 +19,12 @@
 //! camera's weak free evidence once (§3.4: the camera's free-space evidence is poor),
 //! except cells that received pixels themselves.
 
+use super::{InsertContext, MapEntry, MapSet};
 use crate::grid::{
     semantic, CellIndex, CellVisitor, DynamicUpdate, FusedUpdate, FusionGrid, FusionLayers, Group, InsertStats,
     LogOddsTable, MapTile,
 };
-use crate::measurement::Ray;
+use crate::measurement::{Ray, SensorKind};
 use crate::sensor::camera::{Band, CameraModel, CameraObservation};
 
 /// What one camera frame does to one cell, aggregated over its pixels.
@@ -165,6 +166,45 @@ impl FrameCells {
         stats.miss_updates += walk.miss_updates;
         stats
     }
+}
+
+/// Writes a projected frame `obs` of camera `model` into every map of `maps` that takes
+/// it, and returns each fed map's counts. The frame's cells are built once for each grid
+/// geometry and log-odds table among those maps (one in practice), and applied to that
+/// group's maps on the pool's threads (see [`MapSet::each_taking`]).
+pub(super) fn insert_frame(
+    maps: &mut MapSet,
+    cells: &mut FrameCells,
+    obs: &CameraObservation,
+    model: &CameraModel,
+    ctx: &InsertContext,
+) -> Vec<InsertStats> {
+    let takes = |m: &MapEntry| m.sensors().includes(obs.sensor, SensorKind::Camera);
+    let key = |m: &MapEntry| (*m.grid().geometry(), *m.grid().table());
+    let mut groups = Vec::new();
+    for m in maps.iter().filter(|m| takes(m)) {
+        if !groups.contains(&key(m)) {
+            groups.push(key(m));
+        }
+    }
+    let k = model.classes().len();
+    let (p_free, weight) = (model.params().p_free, model.params().occupancy_weight as f32);
+    let mut each = Vec::new();
+    for group in groups {
+        let Some(first) = maps.iter().find(|m| takes(m) && key(m) == group) else { continue };
+        cells.build(obs, model, first.grid());
+        let cells = &*cells;
+        each.extend(maps.each_taking(
+            |m| takes(m) && key(m) == group,
+            |m| {
+                let free = weight * m.grid().table().increment(p_free);
+                let s = cells.apply(m.grid_mut(), k, free, ctx.group, ctx.dynamic);
+                m.add_stats(&s);
+                s
+            },
+        ));
+    }
+    each
 }
 
 /// The camera's weak free evidence along its rays, on cells no pixel landed in.

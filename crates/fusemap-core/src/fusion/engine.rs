@@ -387,45 +387,8 @@ impl Engine {
         let slot = &mut self.sensors[sensor.0 as usize];
         slot.stats.pixels.add(&counts);
         let SensorModel::Camera(model) = &slot.model else { unreachable!("checked above") };
-        let k = model.classes().len();
-        let p_free = model.params().p_free;
-        let weight = model.params().occupancy_weight as f32;
-        let cells = &mut self.frame_cells;
-        let mut built = None;
-        for m in self.maps.iter().filter(|m| m.sensors().includes(sensor, SensorKind::Camera)) {
-            let on = (*m.grid().geometry(), *m.grid().table());
-            match built {
-                None => cells.build(&self.camera_scratch, model, m.grid()),
-                Some(b) if b == on => {}
-                // Maps of other geometries or log-odds tables: one after the other below.
-                Some(_) => {
-                    built = None;
-                    break;
-                }
-            }
-            built = Some(on);
-        }
-        let each = match built {
-            // The frame's cells are the same for every map: built once, applied to the maps
-            // on the pool's threads.
-            Some(_) => self.maps.each_taking(sensor, SensorKind::Camera, |m| {
-                let free = weight * m.grid().table().increment(p_free);
-                let s = cells.apply(m.grid_mut(), k, free, ctx.group, ctx.dynamic);
-                m.add_stats(&s);
-                s
-            }),
-            None => {
-                let mut each = Vec::new();
-                for m in self.maps.entries_mut().filter(|m| m.sensors().includes(sensor, SensorKind::Camera)) {
-                    cells.build(&self.camera_scratch, model, m.grid());
-                    let free = weight * m.grid().table().increment(p_free);
-                    let s = cells.apply(m.grid_mut(), k, free, ctx.group, ctx.dynamic);
-                    m.add_stats(&s);
-                    each.push(s);
-                }
-                each
-            }
-        };
+        let each =
+            super::camera::insert_frame(&mut self.maps, &mut self.frame_cells, &self.camera_scratch, model, &ctx);
         let mut total = InsertStats::default();
         each.iter().for_each(|s| total.add(s));
         let fed = each.len() as u64;

@@ -214,44 +214,46 @@ impl MapSet {
     /// Inserts one observation as a member of a correlation group and/or with the dynamic
     /// layer (see [`FusedUpdate`]).
     pub fn insert_fused(&mut self, kind: SensorKind, data: &RangeData, ctx: &InsertContext) -> (InsertStats, u64) {
-        let each = self.each_taking(data.sensor, kind, |m| {
-            let s = if ctx.group.is_none() && ctx.dynamic.is_none() {
-                // The plain occupancy update, monomorphised on its own (the common case:
-                // no correlated sensor, no camera).
-                m.grid.insert(data)
-            } else {
-                let params = m.grid.params();
-                let rule = (&params.pass_through, params.free_threshold);
-                let mut v =
-                    FusedUpdate::new(*m.grid.table(), data.evidence, rule, ctx.group, ctx.dynamic, ctx.route_hits);
-                let mut s = m.grid.insert_visited(&data.rays, &mut v);
-                v.finish();
-                s.cell_visits_attenuated += v.attenuated();
-                s.ghost_hits += v.ghost_hits();
-                s.routed_to_dynamic += v.routed;
-                s.dynamic_updates += v.routed;
+        let each = self.each_taking(
+            |m| m.sensors.includes(data.sensor, kind),
+            |m| {
+                let s = if ctx.group.is_none() && ctx.dynamic.is_none() {
+                    // The plain occupancy update, monomorphised on its own (the common case:
+                    // no correlated sensor, no camera).
+                    m.grid.insert(data)
+                } else {
+                    let params = m.grid.params();
+                    let rule = (&params.pass_through, params.free_threshold);
+                    let mut v =
+                        FusedUpdate::new(*m.grid.table(), data.evidence, rule, ctx.group, ctx.dynamic, ctx.route_hits);
+                    let mut s = m.grid.insert_visited(&data.rays, &mut v);
+                    v.finish();
+                    s.cell_visits_attenuated += v.attenuated();
+                    s.ghost_hits += v.ghost_hits();
+                    s.routed_to_dynamic += v.routed;
+                    s.dynamic_updates += v.routed;
+                    s
+                };
+                m.stats.add(&s);
                 s
-            };
-            m.stats.add(&s);
-            s
-        });
+            },
+        );
         let mut total = InsertStats::default();
         each.iter().for_each(|s| total.add(s));
         (total, each.len() as u64)
     }
 
-    /// Runs `f` on every map that takes an observation of `sensor`, of kind `kind`, and
-    /// returns its results in the maps' order. When several maps take it they are updated
-    /// on the pool's threads, one thread per map (see [`crate::parallel::map_all_mut`]): the
-    /// maps share no cell and each sees the observations in the same order, so every map
-    /// ends bit for bit as on one thread.
+    /// Runs `f` on every map for which `takes` is true (those that take an observation)
+    /// and returns its results in the maps' order. When several maps take it they are
+    /// updated on the pool's threads, one thread per map (see
+    /// [`crate::parallel::map_all_mut`]): the maps share no cell and each sees the
+    /// observations in the same order, so every map ends bit for bit as on one thread.
     pub(super) fn each_taking<R: Send>(
         &mut self,
-        sensor: SensorId,
-        kind: SensorKind,
+        takes: impl Fn(&MapEntry) -> bool,
         f: impl Fn(&mut MapEntry) -> R + Sync + Send,
     ) -> Vec<R> {
-        let mut taking: Vec<&mut MapEntry> = self.entries_mut().filter(|m| m.sensors.includes(sensor, kind)).collect();
+        let mut taking: Vec<&mut MapEntry> = self.entries_mut().filter(|m| takes(m)).collect();
         match taking.len() {
             0 | 1 => taking.into_iter().map(f).collect(),
             _ => crate::parallel::map_all_mut(&mut taking, |m| f(m)),

@@ -161,7 +161,7 @@ fn overview(s: &Value) -> String {
 fn phases(seconds: &Value) -> String {
     const PHASES: [&str; 7] = ["simulate", "read", "estimator", "slam", "map", "outputs", "other"];
     let shown = PHASES.iter().filter(|k| seconds[**k].is_number());
-    shown.map(|k| format!("{} {}", k.replace('_', " "), num(&seconds[*k]))).collect::<Vec<_>>().join(", ")
+    shown.map(|k| format!("{k} {}", num(&seconds[*k]))).collect::<Vec<_>>().join(", ")
 }
 
 /// A round length near a fifth of `width_m`.

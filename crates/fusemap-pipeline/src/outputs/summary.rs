@@ -75,7 +75,8 @@ pub struct Seconds {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub read: Option<f64>,
     /// The pose track from the pose sensors (the estimator's filter and smoother, or the
-    /// odometry as it is), SLAM not included.
+    /// odometry as it is): the track's seconds less SLAM's own (its run's report), so the
+    /// bookkeeping around SLAM's result counts here.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub estimator: Option<f64>,
     /// SLAM: scan matching, loop closure and the pose graph.
