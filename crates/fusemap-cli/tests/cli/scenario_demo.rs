@@ -2,7 +2,7 @@
 //! production line simulated, mapped lidar-only, camera-only and fused, scored and drawn —
 //! checked on the files a user gets.
 
-use crate::util::{assert_success, python_with, read_json, run, run_python, stdout, temp_dir};
+use crate::util::{assert_success, fusemap, python_with, read_json, run_python, stdout, temp_dir};
 
 const NUMPY_SCRIPT: &str = r#"
 import json, sys
@@ -25,7 +25,8 @@ print(json.dumps({
 fn the_scenario_demo_writes_three_scored_maps_and_their_layers() {
     let dir = temp_dir("scenario-demo");
     let out = dir.join("out");
-    let o = run(&["demo", "--out", out.to_str().unwrap()]);
+    // Two threads, so the three maps are updated in parallel (checked below against one).
+    let o = fusemap().env("RAYON_NUM_THREADS", "2").args(["demo", "--out", out.to_str().unwrap()]).output().unwrap();
     assert_success(&o);
     for f in [
         "map.npz",
@@ -97,6 +98,16 @@ fn the_scenario_demo_writes_three_scored_maps_and_their_layers() {
         assert_eq!(js["class_dtype"], "int16");
         assert_eq!(js["probs_shape"][2], 8);
         assert!(js["wall_cells"].as_u64().unwrap() > 1000, "{js}");
+    }
+
+    // On one thread (RAYON_NUM_THREADS=1: SLAM's joins and the maps of the pass one after
+    // the other) the demo writes the same maps, layers and trajectory, byte for byte.
+    let one = dir.join("one");
+    let o1 = fusemap().env("RAYON_NUM_THREADS", "1").args(["demo", "--out", one.to_str().unwrap()]).output().unwrap();
+    assert_success(&o1);
+    for f in ["map.npz", "lidar/map.npz", "camera/map.npz", "trajectory.tum", "semantic.png", "sim/bag/bag_0.mcap"] {
+        let (a, b) = (std::fs::read(out.join(f)).unwrap(), std::fs::read(one.join(f)).unwrap());
+        assert!(a == b, "{f} differs between 2 threads and 1");
     }
     std::fs::remove_dir_all(out.parent().unwrap()).unwrap();
 }
