@@ -226,7 +226,8 @@ impl MapSet {
                     let rule = (&params.pass_through, params.free_threshold);
                     let mut v =
                         FusedUpdate::new(*m.grid.table(), data.evidence, rule, ctx.group, ctx.dynamic, ctx.route_hits);
-                    let mut s = m.grid.insert_visited(&data.rays, &mut v);
+                    let obs = m.grid.begin_observation();
+                    let mut s = m.grid.walk_forked(obs, &data.rays, &mut v, crate::grid::waves_threshold());
                     v.finish();
                     s.cell_visits_attenuated += v.attenuated();
                     s.ghost_hits += v.ghost_hits();

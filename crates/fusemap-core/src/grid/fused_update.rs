@@ -3,7 +3,7 @@
 //! routing and clearing.
 
 use super::{
-    CellVisitor, DynamicUpdate, FusionLayers, Group, LogOddsTable, MapTile, OccupancyUpdate, PassThroughParams,
+    CellVisitor, DynamicUpdate, FusionLayers, Group, LogOddsTable, MapTile, OccupancyUpdate, PassThroughParams, RayFork,
 };
 use crate::measurement::Evidence;
 
@@ -131,5 +131,19 @@ impl CellVisitor<MapTile<FusionLayers>> for FusedUpdate {
     #[inline(always)]
     fn begin_ray(&mut self, cells: u64) {
         CellVisitor::<MapTile<FusionLayers>>::begin_ray(&mut self.occ, cells);
+    }
+}
+
+/// A ray's copy carries the pass-through state; the group merge and the dynamic layer keep
+/// theirs in the cells, which one thread at a time updates in ray order.
+impl RayFork<MapTile<FusionLayers>> for FusedUpdate {
+    fn fork(&self) -> Self {
+        Self { occ: RayFork::<MapTile<FusionLayers>>::fork(&self.occ), routed: 0, ghosts: 0, ..self.clone() }
+    }
+
+    fn join(&mut self, ray: &Self) {
+        RayFork::<MapTile<FusionLayers>>::join(&mut self.occ, &ray.occ);
+        self.routed += ray.routed;
+        self.ghosts += ray.ghosts;
     }
 }

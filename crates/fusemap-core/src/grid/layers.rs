@@ -19,7 +19,7 @@ use super::{LogOddsTable, Tile, UpdateMark, TILE_CELLS};
 /// The blocks of a map's layers beyond occupancy, one value per tile.
 ///
 /// `()` is the map with occupancy only.
-pub trait ExtraLayers {
+pub trait ExtraLayers: Send {
     /// The blocks of a tile that no layer has written yet.
     fn empty() -> Self;
 }

@@ -15,6 +15,7 @@ mod pass_through;
 mod raster;
 mod raycast;
 pub mod semantic;
+mod tile_waves;
 mod tiles;
 mod walk;
 
@@ -28,10 +29,11 @@ pub use geometry::{
 pub use layers::{ExtraLayers, MapTile, MarkedTile};
 pub use logodds::{LogOddsTable, OccupancyParams, Ternary};
 pub use mark::UpdateMark;
-pub use occupancy::{LayeredGrid, OccupancyGrid, OccupancyTile, OccupancyUpdate};
+pub use occupancy::{waves_threshold, LayeredGrid, OccupancyGrid, OccupancyTile, OccupancyUpdate};
 pub use overview::SparseTiles;
 pub use pass_through::PassThroughParams;
 pub use raster::{CellRaster, Raster};
 pub use raycast::{CellRay, Step};
+pub use tile_waves::{walk_observation_waves, RayFork, PARALLEL_MIN_CELLS};
 pub use tiles::{Tile, TileKeyHasher, TileMap};
 pub use walk::{walk_observation, CellVisitor, InsertStats, MAX_RAY_CELLS};

@@ -20,9 +20,9 @@
 //! [`MapTile`](super::MapTile).
 
 use super::{
-    walk_observation, CellBox, CellIndex, CellRaster, CellVisitor, ExtraLayers, GridGeometry, InsertStats,
-    LogOddsTable, MapTile, MarkedTile, OccupancyParams, PassThroughParams, Raster, Ternary, TileKey, TileMap,
-    TILE_SIZE,
+    walk_observation, walk_observation_waves, CellBox, CellIndex, CellRaster, CellVisitor, ExtraLayers, GridGeometry,
+    InsertStats, LogOddsTable, MapTile, MarkedTile, OccupancyParams, PassThroughParams, Raster, RayFork, Ternary,
+    TileKey, TileMap, PARALLEL_MIN_CELLS, TILE_SIZE,
 };
 #[cfg(test)]
 use super::{CellRay, TILE_CELLS};
@@ -243,6 +243,7 @@ impl<L> CellVisitor<MapTile<L>> for OccupancyUpdate {
 
 /// The occupancy update with the rule off: `pass_at` is the default (a plain miss), so a
 /// map without the rule runs exactly the walk it ran before the rule existed, at its cost.
+#[derive(Clone, Copy)]
 struct PlainUpdate(OccupancyUpdate);
 
 impl<L> CellVisitor<MapTile<L>> for PlainUpdate {
@@ -254,6 +255,37 @@ impl<L> CellVisitor<MapTile<L>> for PlainUpdate {
     #[inline(always)]
     fn pass(&mut self, tile: &mut MapTile<L>, offset: usize, fresh: bool) {
         CellVisitor::<MapTile<L>>::pass(&mut self.0, tile, offset, fresh);
+    }
+}
+
+impl<L: ExtraLayers> RayFork<MapTile<L>> for OccupancyUpdate {
+    fn fork(&self) -> Self {
+        Self { through: false, since: 0, hi: self.confident, d_cur: self.d_miss, attenuated: 0, ghost_hits: 0, ..*self }
+    }
+
+    fn join(&mut self, ray: &Self) {
+        let mut ray = *ray;
+        ray.finish();
+        self.attenuated += ray.attenuated;
+        self.ghost_hits += ray.ghost_hits;
+    }
+}
+
+impl<L: ExtraLayers> RayFork<MapTile<L>> for PlainUpdate {
+    fn fork(&self) -> Self {
+        Self(RayFork::<MapTile<L>>::fork(&self.0))
+    }
+
+    fn join(&mut self, _: &Self) {}
+}
+
+/// The size from which [`LayeredGrid::insert`] walks an observation in waves: never on a
+/// pool of one thread, where the waves would only add their hand-overs.
+pub fn waves_threshold() -> u64 {
+    if crate::parallel::threads() > 1 {
+        PARALLEL_MIN_CELLS
+    } else {
+        u64::MAX
     }
 }
 
@@ -342,9 +374,46 @@ impl<L: ExtraLayers> LayeredGrid<L> {
     }
 
     /// Inserts one observation into the occupancy layer (see the module docs for the
-    /// per-observation rules).
+    /// per-observation rules). A large observation from one sensor position is walked in
+    /// waves of tiles on the pool's threads, with the serial walk's result to the bit (see
+    /// [`walk_observation_waves`]).
     pub fn insert(&mut self, data: &RangeData) -> InsertStats {
-        self.insert_with(data, &mut ())
+        self.insert_in_waves(data, waves_threshold())
+    }
+
+    /// [`insert`](Self::insert) with the size from which an observation is walked in waves
+    /// (in cell visits; `u64::MAX`: never, 0: whenever its rays start in one tile).
+    pub fn insert_in_waves(&mut self, data: &RangeData, min_cells: u64) -> InsertStats {
+        let obs = self.begin_observation();
+        let update = OccupancyUpdate::new(self.table, data.evidence);
+        if self.params.pass_through.is_off() {
+            return self.walk_forked(obs, &data.rays, &mut PlainUpdate(update), min_cells);
+        }
+        let mut rule = update.with_pass_through(&self.params.pass_through, self.params.free_threshold);
+        let mut stats = self.walk_forked(obs, &data.rays, &mut rule, min_cells);
+        rule.finish();
+        stats.cell_visits_attenuated = rule.attenuated();
+        stats.ghost_hits = rule.ghost_hits();
+        stats
+    }
+
+    /// Walks `rays` as observation `obs` with `visitor`, in waves of tiles when the
+    /// observation has at least `min_cells` cell visits and its rays start in one tile,
+    /// else serially; the result is the same.
+    pub fn walk_forked<V: RayFork<MapTile<L>>>(
+        &mut self,
+        obs: u64,
+        rays: &[crate::measurement::Ray],
+        visitor: &mut V,
+        min_cells: u64,
+    ) -> InsertStats {
+        let (tiles, known) = (&mut self.tiles, &mut self.known);
+        if min_cells != u64::MAX {
+            if let Some(s) = walk_observation_waves(tiles, &self.geometry, obs, rays, known, visitor, min_cells) {
+                return s;
+            }
+        }
+        walk_observation(tiles, &self.geometry, obs, rays, known, visitor)
     }
 
     /// Inserts one observation into the occupancy layer and, in the same walk, into the

@@ -100,6 +100,36 @@ impl<T: Tile> TileMap<T> {
         self.index.get(&key).map(|&i| &*self.tiles[i as usize])
     }
 
+    /// The index of the tile at `key` in allocation order, if allocated.
+    #[inline]
+    pub(super) fn index_of(&self, key: TileKey) -> Option<usize> {
+        self.index.get(&key).map(|&i| i as usize)
+    }
+
+    /// The tile at allocation index `i`.
+    #[inline]
+    pub(super) fn tile_at_mut(&mut self, i: usize) -> &mut T {
+        &mut self.tiles[i]
+    }
+
+    /// The tiles at allocation indices `indices` (strictly increasing), each once.
+    pub(super) fn tiles_at_mut(&mut self, indices: impl Iterator<Item = usize>) -> Vec<&mut T> {
+        super::tile_waves::pick_mut(&mut self.tiles, indices).into_iter().map(|b| &mut **b).collect()
+    }
+
+    /// Adds `tile` at `key` (not yet allocated), whatever the budget: the caller counted it.
+    pub(super) fn adopt(&mut self, key: TileKey, tile: Box<T>) {
+        debug_assert!(!self.index.contains_key(&key), "a tile is adopted once");
+        self.index.insert(key, self.tiles.len() as u32);
+        self.keys.push(key);
+        self.tiles.push(tile);
+    }
+
+    /// Records that a write needed a tile past the budget.
+    pub(super) fn raise_over_budget(&mut self) {
+        self.over_budget = true;
+    }
+
     /// The tile at `key`, allocating an empty one if needed; past the budget, the scratch
     /// tile (see the type docs).
     #[inline]

@@ -223,44 +223,67 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
 
         // Walk inside one tile with a local offset; resolve a tile (one hash lookup)
         // only when the walk crosses into the next one.
-        let (sx, sy) = (walk.step_x(), walk.step_y() * TILE_SIZE as i64);
-        let mut tile = tiles.get_or_insert(ca.tile());
-        tile.mark().begin(obs);
-        let (mut lx, mut ly) = (ca.x & TILE_MASK, ca.y & TILE_MASK);
-        let mut offset = ca.offset_in_tile() as i64;
+        let end_hit = ray.hit.then(|| first_hit[i]);
+        let mut cell = ca;
         loop {
-            let fresh = tile.mark().test_and_set(offset as usize);
-            stats.miss_updates += fresh as u64;
-            // Before the step, the walk's own count says how many cells follow this one.
-            visitor.pass_at(tile, offset as usize, fresh, walk.cells_after());
-            match walk.step() {
-                Step::Done => {
-                    if ray.hit {
-                        visitor.end_hit(tile, offset as usize, first_hit[i]);
-                    }
-                    break;
-                }
-                Step::X => {
-                    lx += sx;
-                    offset += sx;
-                }
-                Step::Y => {
-                    ly += sy >> TILE_SHIFT;
-                    offset += sy;
-                }
-            }
-            if (lx | ly) & !TILE_MASK != 0 {
-                // Left the tile: `lx` or `ly` is -1 or TILE_SIZE.
-                let c = walk.cell();
-                tile = tiles.get_or_insert(c.tile());
-                tile.mark().begin(obs);
-                (lx, ly) = (c.x & TILE_MASK, c.y & TILE_MASK);
-                offset = c.offset_in_tile() as i64;
+            let tile = tiles.get_or_insert(cell.tile());
+            tile.mark().begin(obs);
+            match walk_in_tile(tile, &mut walk, visitor, end_hit, &mut stats.miss_updates) {
+                Some(next) => cell = next,
+                None => break,
             }
         }
     }
     *known = known_box;
     stats
+}
+
+/// Walks `walk` from its current cell through the cells of `tile` (the tile holding that
+/// cell, its mark begun for this observation), marking each and calling the visitor, until
+/// the walk steps out of the tile or ends. Returns the first cell outside the tile (the
+/// walk is at it, not yet visited), or `None` once the ray's last cell is done, its end
+/// hit applied when `end_hit` is `Some(first)`. Each fresh visit adds one to `misses`.
+///
+/// Inside a tile the cell's offset follows the walk's steps, so the tile is resolved (one
+/// hash lookup) only when the walk crosses into the next one.
+#[inline(always)]
+pub(super) fn walk_in_tile<T: MarkedTile, V: CellVisitor<T>>(
+    tile: &mut T,
+    walk: &mut CellRay,
+    visitor: &mut V,
+    end_hit: Option<bool>,
+    misses: &mut u64,
+) -> Option<CellIndex> {
+    let c = walk.cell();
+    let (sx, sy) = (walk.step_x(), walk.step_y() * TILE_SIZE as i64);
+    let (mut lx, mut ly) = (c.x & TILE_MASK, c.y & TILE_MASK);
+    let mut offset = c.offset_in_tile() as i64;
+    loop {
+        let fresh = tile.mark().test_and_set(offset as usize);
+        *misses += fresh as u64;
+        // Before the step, the walk's own count says how many cells follow this one.
+        visitor.pass_at(tile, offset as usize, fresh, walk.cells_after());
+        match walk.step() {
+            Step::Done => {
+                if let Some(first) = end_hit {
+                    visitor.end_hit(tile, offset as usize, first);
+                }
+                return None;
+            }
+            Step::X => {
+                lx += sx;
+                offset += sx;
+            }
+            Step::Y => {
+                ly += sy >> TILE_SHIFT;
+                offset += sy;
+            }
+        }
+        if (lx | ly) & !TILE_MASK != 0 {
+            // Left the tile: `lx` or `ly` is -1 or TILE_SIZE.
+            return Some(walk.cell());
+        }
+    }
 }
 
 #[inline(always)]
@@ -275,7 +298,7 @@ fn cell_of_units((u, v): (f64, f64)) -> Option<CellIndex> {
 /// beyond the index range, or longer than [`MAX_RAY_CELLS`]).
 #[inline(always)]
 #[allow(clippy::type_complexity)]
-fn checked(a: (f64, f64), b: (f64, f64)) -> Option<((f64, f64), (f64, f64), CellIndex, CellIndex)> {
+pub(super) fn checked(a: (f64, f64), b: (f64, f64)) -> Option<((f64, f64), (f64, f64), CellIndex, CellIndex)> {
     let ca = cell_of_units(a)?;
     let cb = cell_of_units(b)?;
     let n = ca.x.abs_diff(cb.x) + ca.y.abs_diff(cb.y);
