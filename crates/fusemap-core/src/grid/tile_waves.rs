@@ -235,18 +235,17 @@ fn wave<T: MarkedTile + Send, V: RayFork<T>>(
     step: u32,
     segments: &mut [Segment<V>],
 ) -> u64 {
-    // The wave's tiles, each with the number of its segments. Sorting small keys, not
-    // the segments, keeps the hand-over between waves cheap.
-    let mut order: Vec<(TileKey, u32)> = segments.iter().enumerate().map(|(i, s)| (s.key, i as u32)).collect();
-    order.sort_unstable();
+    // The wave's tiles in the order of their first ray, each with its segments' count;
+    // the segments are in ray order, so the first ray met is the tile's first touch.
     let mut runs: Vec<(Slot, usize)> = Vec::new();
-    for (n, &(key, i)) in order.iter().enumerate() {
-        if n == 0 || key != order[n - 1].0 {
-            runs.push((staging.slot(tiles, key, (1, segments[i as usize].ray, step)), 0));
-        }
-        let run = runs.len() - 1;
-        runs[run].1 += 1;
-        segments[i as usize].run = run as u32;
+    let mut run_of: HashMap<TileKey, u32, BuildHasherDefault<super::TileKeyHasher>> = HashMap::default();
+    for s in segments.iter_mut() {
+        let run = *run_of.entry(s.key).or_insert_with(|| {
+            runs.push((staging.slot(tiles, s.key, (1, s.ray, step)), 0));
+            runs.len() as u32 - 1
+        });
+        runs[run as usize].1 += 1;
+        s.run = run;
     }
     let mut throwaways: Vec<T> = runs.iter().filter(|r| matches!(r.0, Slot::Over)).map(|_| T::empty()).collect();
     let mut jobs: Vec<(&mut T, Vec<&mut Segment<V>>)> = disjoint_tiles(tiles, staging, &mut throwaways, &runs)
@@ -258,6 +257,9 @@ fn wave<T: MarkedTile + Send, V: RayFork<T>>(
     for s in segments.iter_mut() {
         jobs[s.run as usize].1.push(s);
     }
+    // The largest tiles first: the pool's threads take the small ones last, so that they
+    // finish the wave together (longest processing time first).
+    jobs.sort_by_key(|j| std::cmp::Reverse(j.1.len()));
     let misses = crate::parallel::map_all_mut(&mut jobs, |(tile, run)| {
         tile.mark().begin(obs);
         let mut misses = 0;
