@@ -202,3 +202,45 @@ fn the_fused_update_in_waves_gives_the_serial_layers() {
         assert!(pool(threads).install(|| run(0)) == serial, "{threads} threads");
     }
 }
+
+/// The benchmark's corridor (`a`, its 40 scans) and box world (`c`, its first 12 scans of
+/// 1,081 beams) through the lidar model as `fusemap map` maps them, the pass-through rule
+/// on: in waves on 1, 2 and 4 threads, and through the fusion engine (which walks in
+/// waves when its pool has two threads or more), the serial map to the bit.
+#[test]
+fn the_bench_workloads_in_waves_give_the_serial_maps() {
+    use crate::fusion::Engine;
+    use crate::geometry::PlanarMount;
+    use crate::sensor::{LidarModel, ReturnCounts};
+    for (name, scans) in [('a', 40), ('c', 12)] {
+        let w = crate::sim::workload_prefix(name, scans).unwrap();
+        let model = LidarModel::new(w.lidar, PlanarMount::default());
+        let mut data = Vec::new();
+        for (scan, pose) in w.run.scans.iter().zip(&w.run.poses) {
+            let mut d = RangeData::empty(SensorId(0), model.evidence());
+            model.scan_to_range_data(SensorId(0), scan, *pose, &mut d, &mut ReturnCounts::default());
+            data.push(d);
+        }
+        let grid = |min_cells: u64| {
+            let mut g = LayeredGrid::<()>::new(GridGeometry::centered(w.resolution).unwrap(), params(true));
+            let stats: Vec<InsertStats> = data.iter().map(|d| g.insert_in_waves(d, min_cells)).collect();
+            (snapshot(&g), stats)
+        };
+        let serial = grid(u64::MAX);
+        assert!(serial.1.iter().any(|s| s.cell_visits_attenuated > 0), "workload {name}: the rule never acted");
+        let engine = || {
+            let mut e = Engine::new(FusionGrid::new(GridGeometry::centered(w.resolution).unwrap(), params(true)));
+            let laser = e.add_lidar("laser", model);
+            for (scan, pose) in w.run.scans.iter().zip(&w.run.poses) {
+                e.insert_scan(laser, scan, *pose).unwrap();
+            }
+            (snapshot(e.grid()), e.stats().insert)
+        };
+        let serial_engine = pool(1).install(engine);
+        assert!(serial_engine.0 == serial.0, "workload {name}: the engine's map is not the grid's");
+        for threads in [1, 2, 4] {
+            assert!(pool(threads).install(|| grid(0)) == serial, "workload {name}, {threads} threads");
+            assert!(pool(threads).install(engine) == serial_engine, "workload {name}, engine, {threads} threads");
+        }
+    }
+}

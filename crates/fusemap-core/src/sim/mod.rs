@@ -12,5 +12,5 @@ mod world;
 pub use odometry_drift::OdometryErrorModel;
 pub use rng::SplitMix64;
 pub use scanner::{simulate_moving_scan, simulate_scan, ScannerSpec, SimulatedRun};
-pub use workloads::{workload, Workload, WORKLOADS};
+pub use workloads::{workload, workload_prefix, Workload, WORKLOADS};
 pub use world::{box_world, corridor, BoxWorld, Segment, World};

@@ -30,7 +30,13 @@ pub const WORKLOADS: [char; 3] = ['a', 'b', 'c'];
 
 /// Builds workload `name` (`'a'`, `'b'`, `'c'`); `None` for another name.
 pub fn workload(name: char) -> Option<Workload> {
-    let corridor_poses = |n: usize| (0..n).map(|i| Pose2::new(0.1 * (i % 40) as f64, 0.0, 0.0)).collect();
+    workload_prefix(name, usize::MAX)
+}
+
+/// Workload `name` with only its first `scans` scans (for tests: the same poses and
+/// scans as the whole workload's first ones, without simulating the rest).
+pub fn workload_prefix(name: char, scans: usize) -> Option<Workload> {
+    let corridor_poses = |n: usize| (0..n.min(scans)).map(|i| Pose2::new(0.1 * (i % 40) as f64, 0.0, 0.0)).collect();
     let mount = PlanarMount::default();
     match name {
         'a' | 'b' => {
@@ -51,7 +57,7 @@ pub fn workload(name: char) -> Option<Workload> {
             let b = box_world(19.5, 8, 12345);
             let mut rng = SplitMix64::new(12346);
             let mut poses = Vec::with_capacity(5000);
-            while poses.len() < 5000 {
+            while poses.len() < 5000.min(scans) {
                 let p = Point2::new(rng.uniform(-19.0, 19.0), rng.uniform(-19.0, 19.0));
                 let theta = rng.uniform(-std::f64::consts::PI, std::f64::consts::PI);
                 if b.is_free(p, 0.5) {
