@@ -257,6 +257,12 @@ impl Engine {
         self.apply_budget();
     }
 
+    /// Walks range observations of at least `min_cells` cell visits in waves of tiles on
+    /// the pool's threads (see [`MapSet::set_waves_min_cells`]); the maps are the same.
+    pub fn set_waves_min_cells(&mut self, min_cells: u64) {
+        self.maps.set_waves_min_cells(min_cells);
+    }
+
     /// Gives the maps a dynamic-object layer with `params`; `route_hits`: lidar hits on
     /// cells holding a dynamic object go there instead of the static layer.
     pub fn set_dynamic(&mut self, params: DynamicParams, route_hits: bool) {

@@ -125,12 +125,15 @@ impl MapEntry {
 pub struct MapSet {
     primary: MapEntry,
     others: Vec<MapEntry>,
+    /// From how many cell visits a range observation is walked in waves of tiles (see
+    /// [`crate::grid::walk_observation_waves`]); `None`: [`crate::grid::waves_threshold`].
+    waves_min_cells: Option<u64>,
 }
 
 impl MapSet {
     /// A set whose first (primary) map is `grid`, named `name`, taking `sensors`.
     pub fn new(name: impl Into<String>, sensors: SensorSelection, grid: FusionGrid) -> Self {
-        Self { primary: MapEntry::new(name.into(), sensors, grid), others: Vec::new() }
+        Self { primary: MapEntry::new(name.into(), sensors, grid), others: Vec::new(), waves_min_cells: None }
     }
 
     /// Adds a map and returns its index.
@@ -143,6 +146,14 @@ impl MapSet {
     pub fn with(mut self, name: impl Into<String>, sensors: SensorSelection, grid: FusionGrid) -> Self {
         self.add(name, sensors, grid);
         self
+    }
+
+    /// Walks range observations of at least `min_cells` cell visits in waves of tiles
+    /// (`u64::MAX`: never; 0: whenever their rays start in one tile); the maps are the same
+    /// either way. By default, from [`crate::grid::PARALLEL_MIN_CELLS`] on a pool of two
+    /// threads or more.
+    pub fn set_waves_min_cells(&mut self, min_cells: u64) {
+        self.waves_min_cells = Some(min_cells);
     }
 
     /// Number of maps (at least one).
@@ -214,20 +225,21 @@ impl MapSet {
     /// Inserts one observation as a member of a correlation group and/or with the dynamic
     /// layer (see [`FusedUpdate`]).
     pub fn insert_fused(&mut self, kind: SensorKind, data: &RangeData, ctx: &InsertContext) -> (InsertStats, u64) {
+        let waves = self.waves_min_cells.unwrap_or_else(crate::grid::waves_threshold);
         let each = self.each_taking(
             |m| m.sensors.includes(data.sensor, kind),
             |m| {
                 let s = if ctx.group.is_none() && ctx.dynamic.is_none() {
                     // The plain occupancy update, monomorphised on its own (the common case:
                     // no correlated sensor, no camera).
-                    m.grid.insert(data)
+                    m.grid.insert_in_waves(data, waves)
                 } else {
                     let params = m.grid.params();
                     let rule = (&params.pass_through, params.free_threshold);
                     let mut v =
                         FusedUpdate::new(*m.grid.table(), data.evidence, rule, ctx.group, ctx.dynamic, ctx.route_hits);
                     let obs = m.grid.begin_observation();
-                    let mut s = m.grid.walk_forked(obs, &data.rays, &mut v, crate::grid::waves_threshold());
+                    let mut s = m.grid.walk_forked(obs, &data.rays, &mut v, waves);
                     v.finish();
                     s.cell_visits_attenuated += v.attenuated();
                     s.ghost_hits += v.ghost_hits();
