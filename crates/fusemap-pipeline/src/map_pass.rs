@@ -188,23 +188,7 @@ pub fn map_with_track(
         Track::ScanLine(_) => placed,
         Track::Timed(t) => with_scan_poses(t.samples(), placed),
     };
-    let map_from_odom = match (&chosen.track, &chosen.odom_frame, trajectory.last()) {
-        // The log's own TF already places the odometry frame (a localiser's `map → odom`):
-        // a second parent would break the tree a player of both files builds.
-        (Track::Timed(_), Some(frame), Some(_))
-            if frame == MAP_FRAME || [frame.clone(), format!("/{frame}")].iter().any(|f| tree.parent(f).is_some()) =>
-        {
-            notes.push(format!(
-                "map.mcap has no /tf_static: the log's TF already gives `{frame}` a parent, or it is the map frame"
-            ));
-            None
-        }
-        // Without SLAM the odometry frame is the map frame.
-        (Track::Timed(t), Some(frame), Some(&(last, _))) => {
-            Some((frame.clone(), t.frame_correction_at(last).unwrap_or(Pose2::IDENTITY)))
-        }
-        _ => None,
-    };
+    let map_from_odom = map_from_odom(&chosen, &tree, &trajectory, &mut notes);
 
     let skipped = lidar_notes(&streams.lidars, cfg, &mut notes);
     if let Some(cut) = &inv.truncated {
@@ -231,6 +215,35 @@ pub fn map_with_track(
         endpoints,
         map_from_odom,
     })
+}
+
+/// The `map → odom` transform map.mcap's `/tf_static` gives, when the track is a timed one
+/// in an odometry frame: the frame correction at the last scan (identity without SLAM).
+/// `None` when the log's own TF already parents that frame (a localiser's `map → odom`: a
+/// second parent would break the tree a player of both files builds) or it is the map frame.
+fn map_from_odom(
+    chosen: &ChosenTrack,
+    tree: &FrameTree,
+    trajectory: &[(Stamp, Pose2)],
+    notes: &mut Vec<String>,
+) -> Option<(String, Pose2)> {
+    match (&chosen.track, &chosen.odom_frame, trajectory.last()) {
+        // The log's own TF already places the odometry frame (a localiser's `map → odom`):
+        // a second parent would break the tree a player of both files builds.
+        (Track::Timed(_), Some(frame), Some(_))
+            if frame == MAP_FRAME || [frame.clone(), format!("/{frame}")].iter().any(|f| tree.parent(f).is_some()) =>
+        {
+            notes.push(format!(
+                "map.mcap has no /tf_static: the log's TF already gives `{frame}` a parent, or it is the map frame"
+            ));
+            None
+        }
+        // Without SLAM the odometry frame is the map frame.
+        (Track::Timed(t), Some(frame), Some(&(last, _))) => {
+            Some((frame.clone(), t.frame_correction_at(last).unwrap_or(Pose2::IDENTITY)))
+        }
+        _ => None,
+    }
 }
 
 /// Opens the pass's streams as [`map_with_track`] does (each lidar's model and mount, each

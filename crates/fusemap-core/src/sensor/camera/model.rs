@@ -139,20 +139,8 @@ impl CameraModel {
         (depth_weight(self.cell_size_m, self.params.depth_sigma(d)) as f32).max(f32::MIN_POSITIVE)
     }
 
-    /// Projects one label + depth frame taken from `world_from_base` into `out` (its
-    /// points are cleared and its buffer reused; `stamp` and `sensor` are left for the
-    /// caller to set), and adds what became of each pixel to `counts`.
-    ///
-    /// Both images must have the pinhole's size, else an error naming all three sizes.
-    /// Bad pixels are counted, never an error (see [`PixelCounts`]).
-    pub fn project(
-        &self,
-        labels: &LabelImage,
-        depth: &DepthImage,
-        world_from_base: Pose2,
-        out: &mut CameraObservation,
-        counts: &mut PixelCounts,
-    ) -> Result<(), CameraError> {
+    /// Refuses a frame whose images are not the camera's size, or a pose that is not finite.
+    fn check_frame(&self, labels: &LabelImage, depth: &DepthImage, world_from_base: Pose2) -> Result<(), CameraError> {
         let (w, h) = (self.pinhole.width, self.pinhole.height);
         if (labels.width, labels.height) != (w, h)
             || (depth.width, depth.height) != (w, h)
@@ -169,6 +157,25 @@ impl CameraModel {
             let Pose2 { x, y, theta } = world_from_base;
             return Err(CameraError::Pose { x, y, theta });
         }
+        Ok(())
+    }
+
+    /// Projects one label + depth frame taken from `world_from_base` into `out` (its
+    /// points are cleared and its buffer reused; `stamp` and `sensor` are left for the
+    /// caller to set), and adds what became of each pixel to `counts`.
+    ///
+    /// Both images must have the pinhole's size, else an error naming all three sizes.
+    /// Bad pixels are counted, never an error (see [`PixelCounts`]).
+    pub fn project(
+        &self,
+        labels: &LabelImage,
+        depth: &DepthImage,
+        world_from_base: Pose2,
+        out: &mut CameraObservation,
+        counts: &mut PixelCounts,
+    ) -> Result<(), CameraError> {
+        self.check_frame(labels, depth, world_from_base)?;
+        let w = self.pinhole.width;
         out.points.clear();
         let (sin, cos) = world_from_base.theta.sin_cos();
         let (px, py) = (world_from_base.x, world_from_base.y);
