@@ -331,16 +331,6 @@ impl CameraRun<'_> {
         let mut sim = CameraSim::new(cfg, self.objects, self.caster, seed);
         let sample_seed = SplitMix64::new(seed ^ 0x5EED_BAC1_1175_0000).next_u64();
         let mut threshold = u64::MAX;
-        let k = cfg.k_matrix();
-        let (w, h) = (cfg.width, cfg.height);
-        let label_bytes = match cfg.label_encoding {
-            LabelEncoding::Mono8 => 1,
-            LabelEncoding::Mono16 => 2,
-        };
-        let depth_bytes = match cfg.depth_encoding {
-            DepthEncoding::Float32Metres => 4,
-            DepthEncoding::U16Millimetres => 2,
-        };
         let mut frame = NoisyFrame::default();
         for n in range {
             let t = n as f64 / cfg.rate_hz;
@@ -370,48 +360,64 @@ impl CameraRun<'_> {
                     threshold = bottom_k(&mut part.sample, MAX_BACKLIT_POINTS);
                 }
             }
-            let image = |topic: &str, encoding: &str, bytes: u32, data: Vec<u8>| {
-                SimImage::new(
-                    topic,
-                    Image {
-                        header: Header::new(stamp, self.frame_id),
-                        height: h,
-                        width: w,
-                        encoding: encoding.into(),
-                        is_bigendian: 0,
-                        step: w * bytes,
-                        data: data.into(),
-                    },
-                )
-            };
-            part.messages.push(SimMessage::Image(image(
-                &cfg.label_topic,
-                cfg.label_encoding.as_str(),
-                label_bytes,
-                encode_labels(&frame.labels, cfg.label_encoding),
-            )));
-            part.messages.push(SimMessage::Image(image(
-                &cfg.depth_topic,
-                cfg.depth_encoding.as_str(),
-                depth_bytes,
-                encode_depth(&frame.depth, cfg.depth_encoding),
-            )));
-            part.messages.push(SimMessage::CameraInfo(Box::new(SimCameraInfo::new(
-                &cfg.info_topic,
-                CameraInfo {
+            self.frame_messages(&frame, stamp, &mut part.messages);
+        }
+        part
+    }
+
+    /// The label image, the depth image and the camera info of one rendered frame.
+    fn frame_messages(&self, frame: &NoisyFrame, stamp: Stamp, out: &mut Vec<SimMessage>) {
+        let cfg = self.cfg;
+        let k = cfg.k_matrix();
+        let (w, h) = (cfg.width, cfg.height);
+        let label_bytes = match cfg.label_encoding {
+            LabelEncoding::Mono8 => 1,
+            LabelEncoding::Mono16 => 2,
+        };
+        let depth_bytes = match cfg.depth_encoding {
+            DepthEncoding::Float32Metres => 4,
+            DepthEncoding::U16Millimetres => 2,
+        };
+        let image = |topic: &str, encoding: &str, bytes: u32, data: Vec<u8>| {
+            SimImage::new(
+                topic,
+                Image {
                     header: Header::new(stamp, self.frame_id),
                     height: h,
                     width: w,
-                    distortion_model: "plumb_bob".into(),
-                    d: vec![0.0; 5],
-                    k,
-                    r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-                    p: [k[0], 0.0, k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0],
-                    ..CameraInfo::default()
+                    encoding: encoding.into(),
+                    is_bigendian: 0,
+                    step: w * bytes,
+                    data: data.into(),
                 },
-            ))));
-        }
-        part
+            )
+        };
+        out.push(SimMessage::Image(image(
+            &cfg.label_topic,
+            cfg.label_encoding.as_str(),
+            label_bytes,
+            encode_labels(&frame.labels, cfg.label_encoding),
+        )));
+        out.push(SimMessage::Image(image(
+            &cfg.depth_topic,
+            cfg.depth_encoding.as_str(),
+            depth_bytes,
+            encode_depth(&frame.depth, cfg.depth_encoding),
+        )));
+        out.push(SimMessage::CameraInfo(Box::new(SimCameraInfo::new(
+            &cfg.info_topic,
+            CameraInfo {
+                header: Header::new(stamp, self.frame_id),
+                height: h,
+                width: w,
+                distortion_model: "plumb_bob".into(),
+                d: vec![0.0; 5],
+                k,
+                r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                p: [k[0], 0.0, k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0],
+                ..CameraInfo::default()
+            },
+        ))));
     }
 }
 
