@@ -21,13 +21,13 @@
 //!
 //! Tiles that are new to the map are staged and added at the end in the order the serial
 //! walk would have allocated them (hits first, then by ray and by distance along it), so
-//! the map's tile order, its known box and every count are as serial. Past the tile budget
-//! the serial walk writes into one scratch tile and raises the flag; here each tile past
-//! it is a throwaway and the flag rises on the same observation (the map is refused then
-//! either way: its contents past the budget are not a map).
+//! the map's tile order, its known box and every count are as serial. An observation that
+//! could need more tiles than the map's budget has room for (as many as the tiles of its
+//! rays' bounding box) takes the serial walk, which alone decides what a map past its
+//! budget holds: which tiles it still gets, and the one scratch tile the rest share.
 //!
 //! Observations whose rays start in several tiles (a camera's rays, a de-skewed scan
-//! straddling a tile border) and small ones, where the waves would cost more than they
+//! straddling a tile border), those of more than `u32::MAX` rays, and small ones, where the waves would cost more than they
 //! save, take the serial walk. Cartographer and OctoMap insert a scan on one thread;
 //! OctoMap's OpenMP variant parallelises the ray casting but then merges cell sets,
 //! which gives up the clamped update order this keeps.
@@ -86,8 +86,6 @@ enum Slot {
     Map(usize),
     /// New, staged at this index.
     Staged(usize),
-    /// Past the tile budget: a throwaway.
-    Over,
 }
 
 /// Position of a tile's first touch in the serial walk: (pass, ray, tile step).
@@ -97,12 +95,11 @@ type FirstTouch = (u8, u32, u32);
 struct Staging<T> {
     index: HashMap<TileKey, usize, BuildHasherDefault<super::TileKeyHasher>>,
     tiles: Vec<(TileKey, Box<T>, FirstTouch)>,
-    over: bool,
 }
 
 impl<T: MarkedTile> Staging<T> {
     fn new() -> Self {
-        Self { index: HashMap::default(), tiles: Vec::new(), over: false }
+        Self { index: HashMap::default(), tiles: Vec::new() }
     }
 
     /// The slot of tile `key`, first touched (so far) at `touch`.
@@ -115,10 +112,8 @@ impl<T: MarkedTile> Staging<T> {
             *t = (*t).min(touch);
             return Slot::Staged(j);
         }
-        if map.len() + self.tiles.len() >= map.tile_budget() {
-            self.over = true;
-            return Slot::Over;
-        }
+        // The caller made sure the budget has room for every tile the rays can reach.
+        debug_assert!(map.len() + self.tiles.len() < map.tile_budget());
         self.index.insert(key, self.tiles.len());
         self.tiles.push((key, Box::new(T::empty()), touch));
         Slot::Staged(self.tiles.len() - 1)
@@ -130,17 +125,15 @@ impl<T: MarkedTile> Staging<T> {
         for (key, tile, _) in self.tiles {
             map.adopt(key, tile);
         }
-        if self.over {
-            map.raise_over_budget();
-        }
     }
 }
 
 /// Walks the rays of observation `obs` as [`walk_observation`](super::walk_observation)
 /// does, with the same result to the bit, in waves of tiles over the pool's threads (see
 /// the module docs). Returns `None`, having changed nothing, when the rays do not all
-/// start in one tile, or when they visit fewer than `min_cells` cells in all: the caller
-/// then takes the serial walk.
+/// start in one tile, when they visit fewer than `min_cells` cells in all, when they are
+/// more than `u32::MAX`, or when the tiles of their bounding box could outgrow the map's
+/// tile budget: the caller then takes the serial walk.
 pub fn walk_observation_waves<T: MarkedTile + Send, V: RayFork<T>>(
     tiles: &mut TileMap<T>,
     geometry: &GridGeometry,
@@ -155,14 +148,21 @@ pub fn walk_observation_waves<T: MarkedTile + Send, V: RayFork<T>>(
     let units = |p: crate::geometry::Point2| ((p.x - ox) * inv, (p.y - oy) * inv);
     let ends: Vec<_> = rays.iter().map(|r| checked(units(r.origin), units(r.end))).collect();
     let start = ends.iter().flatten().next()?.2.tile();
+    if rays.len() > u32::MAX as usize {
+        return None;
+    }
     let mut cells = 0u64;
+    let (mut lo, mut hi) = (start, start);
     for &(_, _, ca, cb) in ends.iter().flatten() {
         if ca.tile() != start {
             return None;
         }
         cells += ca.x.abs_diff(cb.x) + ca.y.abs_diff(cb.y) + 1;
+        let t = cb.tile();
+        (lo.x, lo.y, hi.x, hi.y) = (lo.x.min(t.x), lo.y.min(t.y), hi.x.max(t.x), hi.y.max(t.y));
     }
-    if cells < min_cells {
+    let box_tiles = (hi.x.abs_diff(lo.x) as u128 + 1) * (hi.y.abs_diff(lo.y) as u128 + 1);
+    if cells < min_cells || tiles.len() as u128 + box_tiles > tiles.tile_budget() as u128 {
         return None;
     }
 
@@ -211,14 +211,9 @@ pub fn walk_observation_waves<T: MarkedTile + Send, V: RayFork<T>>(
 
 /// Marks the end cell `c` of hit ray `ray` (pass 1) and says whether it was its first hit.
 fn mark_hit<T: MarkedTile>(tiles: &mut TileMap<T>, staging: &mut Staging<T>, obs: u64, c: CellIndex, ray: u32) -> bool {
-    let mut throwaway;
     let tile = match staging.slot(tiles, c.tile(), (0, ray, 0)) {
         Slot::Map(i) => tiles.tile_at_mut(i),
         Slot::Staged(j) => &mut *staging.tiles[j].1,
-        Slot::Over => {
-            throwaway = T::empty();
-            &mut throwaway
-        }
     };
     let mark = tile.mark();
     mark.begin(obs);
@@ -247,8 +242,7 @@ fn wave<T: MarkedTile + Send, V: RayFork<T>>(
         runs[run as usize].1 += 1;
         s.run = run;
     }
-    let mut throwaways: Vec<T> = runs.iter().filter(|r| matches!(r.0, Slot::Over)).map(|_| T::empty()).collect();
-    let mut jobs: Vec<(&mut T, Vec<&mut Segment<V>>)> = disjoint_tiles(tiles, staging, &mut throwaways, &runs)
+    let mut jobs: Vec<(&mut T, Vec<&mut Segment<V>>)> = disjoint_tiles(tiles, staging, &runs)
         .into_iter()
         .zip(&runs)
         .map(|(tile, r)| (tile, Vec::with_capacity(r.1)))
@@ -275,11 +269,10 @@ fn wave<T: MarkedTile + Send, V: RayFork<T>>(
 }
 
 /// One `&mut` per run's tile, in the runs' order: map tiles and staged tiles picked apart
-/// by index (each tile is one run's), throwaways for those past the budget.
+/// by index (each tile is one run's).
 fn disjoint_tiles<'a, T: MarkedTile>(
     tiles: &'a mut TileMap<T>,
     staging: &'a mut Staging<T>,
-    throwaways: &'a mut [T],
     runs: &[(Slot, usize)],
 ) -> Vec<&'a mut T> {
     let mut in_map: Vec<(usize, usize)> = Vec::new();
@@ -288,7 +281,6 @@ fn disjoint_tiles<'a, T: MarkedTile>(
         match *slot {
             Slot::Map(i) => in_map.push((i, r)),
             Slot::Staged(j) => staged.push((j, r)),
-            Slot::Over => {}
         }
     }
     in_map.sort_unstable();
@@ -301,10 +293,7 @@ fn disjoint_tiles<'a, T: MarkedTile>(
     for ((_, r), t) in staged.iter().zip(staged_tiles) {
         out[*r] = Some(&mut *t.1);
     }
-    let mut spare = throwaways.iter_mut();
-    out.into_iter()
-        .map(|t| t.unwrap_or_else(|| spare.next().expect("one throwaway per tile past the budget")))
-        .collect()
+    out.into_iter().map(|t| t.expect("every run has its tile")).collect()
 }
 
 /// `&mut` to the items at `indices` (strictly increasing) of `items`.

@@ -137,22 +137,53 @@ fn rays_from_several_tiles_and_small_observations_take_the_serial_walk() {
     g.insert(&data[0]);
 }
 
+/// Near its tile budget a map is walked serially (what a map past its budget holds is the
+/// serial walk's: which tiles it still gets, and the scratch tile the rest share), so the
+/// refusal comes on the same observation with the same maps and counts up to it.
 #[test]
-fn past_the_tile_budget_the_waves_refuse_on_the_same_observation_as_the_serial_walk() {
-    let data = scans(12);
-    for budget in [1, 20, 60] {
-        let first_over = |min_cells: u64| {
+fn near_the_tile_budget_the_waves_give_way_to_the_serial_walk() {
+    // The room moves 6 m a scan, so the map keeps growing: the first scans are walked in
+    // waves while the budget has room for their bounding box (130 tiles), the rest not.
+    let mut data = scans(12);
+    for (k, d) in data.iter_mut().enumerate() {
+        for r in &mut d.rays {
+            r.origin.x += 6.0 * k as f64;
+            r.end.x += 6.0 * k as f64;
+        }
+    }
+    for budget in [1, 20, 90, 200, 300] {
+        let run = |min_cells: u64| {
             let mut g = LayeredGrid::<()>::new(GridGeometry::centered(0.05).unwrap(), params(true));
             g.set_tile_budget(budget);
-            let at = data.iter().position(|d| {
-                g.insert_in_waves(d, min_cells);
-                g.over_budget()
-            });
-            (at, g.tile_count())
+            let mut stats = Vec::new();
+            for d in &data {
+                stats.push(g.insert_in_waves(d, min_cells));
+                if g.over_budget() {
+                    break;
+                }
+            }
+            (snapshot(&g), stats)
         };
-        let serial = first_over(u64::MAX);
-        assert!(serial.0.is_some(), "budget {budget} is not reached");
-        assert_eq!(pool(2).install(|| first_over(0)), serial, "budget {budget}");
+        let serial = run(u64::MAX);
+        assert!(serial.0 .2, "budget {budget} is not reached");
+        assert!(pool(2).install(|| run(0)) == serial, "budget {budget}");
+    }
+    // The rule itself: room for the tiles of the rays' bounding box, or the serial walk.
+    let geometry = GridGeometry::centered(0.05).unwrap();
+    let rays = &data[0].rays;
+    let tile = |p: Point2| geometry.cell_of(p).unwrap().tile();
+    let ends: Vec<TileKey> = rays.iter().filter(|r| r.end.x.is_finite()).map(|r| tile(r.end)).collect();
+    let span = |f: fn(&TileKey) -> i64| {
+        let (lo, hi) = (ends.iter().map(f).min().unwrap(), ends.iter().map(f).max().unwrap());
+        (hi - lo + 1) as usize
+    };
+    let box_tiles = span(|t| t.x) * span(|t| t.y);
+    for (budget, waves) in [(box_tiles - 1, false), (box_tiles, true)] {
+        let mut tiles: TileMap<crate::grid::MapTile<()>> = TileMap::new();
+        tiles.set_tile_budget(budget);
+        let mut v = OccupancyUpdate::new(*LayeredGrid::<()>::new(geometry, params(true)).table(), data[0].evidence);
+        let walked = walk_observation_waves(&mut tiles, &geometry, 1, rays, &mut None, &mut v, 0);
+        assert_eq!(walked.is_some(), waves, "budget {budget}, box {box_tiles}");
     }
 }
 
@@ -205,8 +236,9 @@ fn the_fused_update_in_waves_gives_the_serial_layers() {
 
 /// The benchmark's corridor (`a`, its 40 scans) and box world (`c`, its first 12 scans of
 /// 1,081 beams) through the lidar model as `fusemap map` maps them, the pass-through rule
-/// on: in waves on 1, 2 and 4 threads, and through the fusion engine (which walks in
-/// waves when its pool has two threads or more), the serial map to the bit.
+/// on: in waves on 1, 2 and 4 threads, and through the fusion engine, the serial map to
+/// the bit (the engine walks `c`'s scans in waves on two threads or more; `a`'s are below
+/// its threshold).
 #[test]
 fn the_bench_workloads_in_waves_give_the_serial_maps() {
     use crate::fusion::Engine;

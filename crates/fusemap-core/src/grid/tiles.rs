@@ -117,17 +117,12 @@ impl<T: Tile> TileMap<T> {
         super::tile_waves::pick_mut(&mut self.tiles, indices).into_iter().map(|b| &mut **b).collect()
     }
 
-    /// Adds `tile` at `key` (not yet allocated), whatever the budget: the caller counted it.
+    /// Adds `tile` at `key` (not yet allocated); the caller made sure the budget has room.
     pub(super) fn adopt(&mut self, key: TileKey, tile: Box<T>) {
         debug_assert!(!self.index.contains_key(&key), "a tile is adopted once");
         self.index.insert(key, self.tiles.len() as u32);
         self.keys.push(key);
         self.tiles.push(tile);
-    }
-
-    /// Records that a write needed a tile past the budget.
-    pub(super) fn raise_over_budget(&mut self) {
-        self.over_budget = true;
     }
 
     /// The tile at `key`, allocating an empty one if needed; past the budget, the scratch
