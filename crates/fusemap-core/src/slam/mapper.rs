@@ -482,7 +482,11 @@ impl Slam {
             let origin = self.submaps.all()[s].local_pose.translation();
             self.loops.footprints[s].add(Point2::new(local.x - origin.x, local.y - origin.y), path_m);
         }
-        self.nodes.push(Node { stamp, local, track, graph: g, points: hits, search_points, submaps: into, path_m });
+        // A node is kept for the whole log: its points without the spare room their
+        // collection left (up to half of it on a filtered scan).
+        let mut points = hits;
+        points.shrink_to_fit();
+        self.nodes.push(Node { stamp, local, track, graph: g, points, search_points, submaps: into, path_m });
         self.report.nodes += 1;
         self.attach_fixes(stamp, self.nodes.len() - 1);
         self.report.submaps = self.submaps.all().len();
