@@ -27,10 +27,11 @@
 //! budget holds: which tiles it still gets, and the one scratch tile the rest share.
 //!
 //! Observations whose rays start in several tiles (a camera's rays, a de-skewed scan
-//! straddling a tile border), those of more than `u32::MAX` rays, and small ones, where the waves would cost more than they
-//! save, take the serial walk. Cartographer and OctoMap insert a scan on one thread;
-//! OctoMap's OpenMP variant parallelises the ray casting but then merges cell sets,
-//! which gives up the clamped update order this keeps.
+//! straddling a tile border), those of more than `u32::MAX` rays, and small ones, where
+//! the waves would cost more than they save, take the serial walk. Cartographer inserts a
+//! scan on one thread; OctoMap's OpenMP build casts a scan's rays on several threads and
+//! merges their cells into sets before one update per cell, which works because it has no
+//! per-ray state (such as the pass-through rule's) that depends on the cells before.
 
 use super::walk::{checked, walk_in_tile};
 use super::{CellBox, CellIndex, CellRay, CellVisitor, GridGeometry, InsertStats, MarkedTile, TileKey, TileMap};
