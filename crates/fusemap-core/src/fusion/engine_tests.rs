@@ -172,3 +172,40 @@ mod observed {
         assert!(e.lidar_model(camera).is_none() && e.lidar_model(lidar).is_some());
     }
 }
+
+/// The engine walks a large scan in waves of tiles when its pool has two threads or more
+/// (`grid::tile_waves`): the first 12 scans of the bench's box world (1,081 beams, about
+/// 800,000 cell visits each, the pass-through rule on) give the one-thread map to the bit,
+/// its tiles in the same order, and the same counts, on 2 and 4 threads.
+#[cfg(feature = "parallel")]
+#[test]
+fn scans_in_waves_give_the_serial_map() {
+    use crate::sensor::LidarModel;
+    let w = crate::sim::workload_prefix('c', 12).unwrap();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let params =
+                OccupancyParams { pass_through: crate::grid::PassThroughParams::default(), ..Default::default() };
+            let mut e = Engine::new(FusionGrid::new(GridGeometry::centered(w.resolution).unwrap(), params));
+            let laser = e.add_lidar("laser", LidarModel::new(w.lidar, PlanarMount::default()));
+            for (scan, pose) in w.run.scans.iter().zip(&w.run.poses) {
+                e.insert_scan(laser, scan, *pose).unwrap();
+            }
+            let cells: Vec<(crate::grid::TileKey, Vec<Option<u32>>)> = e
+                .grid()
+                .tiles()
+                .map(|(k, t)| (k, (0..crate::grid::TILE_CELLS).map(|o| t.log_odds(o).map(f32::to_bits)).collect()))
+                .collect();
+            (cells, e.grid().known_box(), e.stats().insert)
+        })
+    };
+    let one = run(1);
+    assert!(
+        one.2.cell_visits > 12 * crate::grid::PARALLEL_MIN_CELLS && one.2.cell_visits_attenuated > 0,
+        "{:?}",
+        one.2
+    );
+    assert!(run(2) == one, "2 threads");
+    assert!(run(4) == one, "4 threads");
+}

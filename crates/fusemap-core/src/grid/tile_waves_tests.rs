@@ -236,12 +236,10 @@ fn the_fused_update_in_waves_gives_the_serial_layers() {
 
 /// The benchmark's corridor (`a`, its 40 scans) and box world (`c`, its first 12 scans of
 /// 1,081 beams) through the lidar model as `fusemap map` maps them, the pass-through rule
-/// on: in waves on 1, 2 and 4 threads, and through the fusion engine, the serial map to
-/// the bit (the engine walks `c`'s scans in waves on two threads or more; `a`'s are below
-/// its threshold).
+/// on: in waves on 1, 2 and 4 threads, the serial map to the bit (the fusion engine's own
+/// test is `fusion::engine_tests::scans_in_waves_give_the_serial_map`).
 #[test]
 fn the_bench_workloads_in_waves_give_the_serial_maps() {
-    use crate::fusion::Engine;
     use crate::geometry::PlanarMount;
     use crate::sensor::{LidarModel, ReturnCounts};
     for (name, scans) in [('a', 40), ('c', 12)] {
@@ -260,19 +258,8 @@ fn the_bench_workloads_in_waves_give_the_serial_maps() {
         };
         let serial = grid(u64::MAX);
         assert!(serial.1.iter().any(|s| s.cell_visits_attenuated > 0), "workload {name}: the rule never acted");
-        let engine = || {
-            let mut e = Engine::new(FusionGrid::new(GridGeometry::centered(w.resolution).unwrap(), params(true)));
-            let laser = e.add_lidar("laser", model);
-            for (scan, pose) in w.run.scans.iter().zip(&w.run.poses) {
-                e.insert_scan(laser, scan, *pose).unwrap();
-            }
-            (snapshot(e.grid()), e.stats().insert)
-        };
-        let serial_engine = pool(1).install(engine);
-        assert!(serial_engine.0 == serial.0, "workload {name}: the engine's map is not the grid's");
         for threads in [1, 2, 4] {
             assert!(pool(threads).install(|| grid(0)) == serial, "workload {name}, {threads} threads");
-            assert!(pool(threads).install(engine) == serial_engine, "workload {name}, engine, {threads} threads");
         }
     }
 }
