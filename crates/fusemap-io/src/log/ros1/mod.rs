@@ -310,66 +310,10 @@ impl<R: Read> BagReader<R> {
         match header.op {
             Some(record::OP_CHUNK) => {
                 let (compression, size) = match (header.compression, header.size) {
-                    (Some(c), Some(s)) => (c, s),
+                    (Some(c), Some(s)) => (c.to_vec(), s),
                     _ => return Err(self.error_at(head.offset, "chunk record lacks its `compression` or `size` field")),
                 };
-                // Chunks lie before the index section the bag header points at: one that claims
-                // to reach past it has a corrupt length, which is damage, not a cut file.
-                if self.index_pos != 0 && head.data_offset + u64::from(head.data_len) > self.index_pos {
-                    let what = format!(
-                        "chunk claims {} bytes of data, reaching past the index section at byte {}: its length is corrupt",
-                        head.data_len, self.index_pos
-                    );
-                    return Err(self.error_at(head.offset, what));
-                }
-                let limit = self.decoder.options.max_decompressed_bytes;
-                if u64::from(size) > limit {
-                    // Refused on its word, before a byte is read or inflated.
-                    let what = format!(
-                        "chunk says it holds {size} uncompressed bytes, over the limit of {limit} bytes \
-                         (limits.decompressed_mib raises it)"
-                    );
-                    return Err(self.error_at(head.offset, &what));
-                }
-                self.chunk.next = 0;
-                self.chunk.record_offset = head.offset;
-                self.chunk.data_offset = None;
-                let chunk = &mut self.chunk.data;
-                if compression == b"none" {
-                    let got = read_into(&mut self.input, head.data_len, chunk)
-                        .map_err(|e| Error::io(&self.decoder.path, e))?;
-                    if got < head.data_len as usize {
-                        chunk.clear();
-                        return Err(self.truncated_data(&head, got as u64));
-                    }
-                    self.chunk.data_offset = Some(head.data_offset);
-                    record::check_size(chunk.len(), size)
-                } else if compression == b"bz2" || compression == b"lz4" {
-                    let got = read_into(&mut self.input, head.data_len, &mut self.data_buf)
-                        .map_err(|e| Error::io(&self.decoder.path, e))?;
-                    if got < head.data_len as usize {
-                        chunk.clear();
-                        return Err(self.truncated_data(&head, got as u64));
-                    }
-                    self.compressed_chunks += 1;
-                    let ready = match &mut self.prefetch {
-                        Some(p) if self.compressed_chunks.is_multiple_of(2) => p.take(head.offset),
-                        _ => None,
-                    };
-                    match ready {
-                        Some(data) if data.len() == size as usize => {
-                            *chunk = data;
-                            Ok(())
-                        }
-                        _ => record::decompress(compression, &self.data_buf, size, chunk),
-                    }
-                } else {
-                    Err(record::unsupported_compression(compression))
-                }
-                .map_err(|m| {
-                    self.chunk.data.clear();
-                    container_error(&self.decoder.path, place, m)
-                })?;
+                self.read_chunk(&head, place, &compression, size)?;
                 Ok(Step::Continue)
             }
             Some(op @ (record::OP_INDEX_DATA | record::OP_CHUNK_INFO)) => {
@@ -391,6 +335,69 @@ impl<R: Read> BagReader<R> {
             Some(op) => Err(self.error_at(head.offset, format!("unknown record op 0x{op:02x}"))),
             None => Err(self.error_at(head.offset, "record header has no `op` field")),
         }
+    }
+
+    /// Reads the chunk record at `head` (its `compression` and uncompressed `size` from its
+    /// header) into the chunk buffer, inflating it when compressed; a prefetched chunk is
+    /// taken when one is ready.
+    fn read_chunk(&mut self, head: &Head, place: Place, compression: &[u8], size: u32) -> Result<()> {
+        // Chunks lie before the index section the bag header points at: one that claims
+        // to reach past it has a corrupt length, which is damage, not a cut file.
+        if self.index_pos != 0 && head.data_offset + u64::from(head.data_len) > self.index_pos {
+            let what = format!(
+                "chunk claims {} bytes of data, reaching past the index section at byte {}: its length is corrupt",
+                head.data_len, self.index_pos
+            );
+            return Err(self.error_at(head.offset, what));
+        }
+        let limit = self.decoder.options.max_decompressed_bytes;
+        if u64::from(size) > limit {
+            // Refused on its word, before a byte is read or inflated.
+            let what = format!(
+                "chunk says it holds {size} uncompressed bytes, over the limit of {limit} bytes \
+                 (limits.decompressed_mib raises it)"
+            );
+            return Err(self.error_at(head.offset, &what));
+        }
+        self.chunk.next = 0;
+        self.chunk.record_offset = head.offset;
+        self.chunk.data_offset = None;
+        let chunk = &mut self.chunk.data;
+        if compression == b"none" {
+            let got = read_into(&mut self.input, head.data_len, chunk).map_err(|e| Error::io(&self.decoder.path, e))?;
+            if got < head.data_len as usize {
+                chunk.clear();
+                return Err(self.truncated_data(head, got as u64));
+            }
+            self.chunk.data_offset = Some(head.data_offset);
+            record::check_size(chunk.len(), size)
+        } else if compression == b"bz2" || compression == b"lz4" {
+            let got = read_into(&mut self.input, head.data_len, &mut self.data_buf)
+                .map_err(|e| Error::io(&self.decoder.path, e))?;
+            if got < head.data_len as usize {
+                chunk.clear();
+                return Err(self.truncated_data(head, got as u64));
+            }
+            self.compressed_chunks += 1;
+            let ready = match &mut self.prefetch {
+                Some(p) if self.compressed_chunks.is_multiple_of(2) => p.take(head.offset),
+                _ => None,
+            };
+            match ready {
+                Some(data) if data.len() == size as usize => {
+                    *chunk = data;
+                    Ok(())
+                }
+                _ => record::decompress(compression, &self.data_buf, size, chunk),
+            }
+        } else {
+            Err(record::unsupported_compression(compression))
+        }
+        .map_err(|m| {
+            self.chunk.data.clear();
+            container_error(&self.decoder.path, place, m)
+        })?;
+        Ok(())
     }
 
     /// The end of the file at a record boundary: clean unless the bag header promised
