@@ -108,9 +108,10 @@ pub fn search_candidates(linear_window_m: f64, angular_window_rad: f64, resoluti
     (2.0 * n_lin + 1.0).powi(2) * (2.0 * n_ang + 1.0)
 }
 
-/// The heading step at which a point `range` metres away moves by one cell of `r`.
+/// The heading step at which a point `range` metres away moves by one cell of `r`, at
+/// least 10⁻⁴ rad.
 fn angular_step(r: f64, range: f64) -> f64 {
-    (1.0 - r * r / (2.0 * range * range)).clamp(-1.0, 1.0).acos().max(1e-4)
+    super::global_match::angular_step(r, range).max(1e-4)
 }
 
 /// The correlative search: the best pose of the window around `predicted`.

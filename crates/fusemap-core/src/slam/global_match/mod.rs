@@ -114,8 +114,10 @@ pub fn levels_for(linear_window_m: f64, resolution: f64, max: usize) -> usize {
     (1 + (2.0 * w / 6.0).log2().ceil().max(0.0) as usize).clamp(1, max.max(1))
 }
 
-/// The angular step of eq. (7) for a scan reaching `d_max` on a grid of cell `r`.
-fn angular_step(r: f64, d_max: f64) -> f64 {
+/// The angular step of eq. (7) for a scan reaching `d_max` on a grid of cell `r` (Hess et
+/// al. 2016): the heading change that moves the farthest point by one cell. The local
+/// matcher steps its headings by the same rule.
+pub(crate) fn angular_step(r: f64, d_max: f64) -> f64 {
     let d = d_max.max(r);
     (1.0 - r * r / (2.0 * d * d)).clamp(-1.0, 1.0).acos()
 }
