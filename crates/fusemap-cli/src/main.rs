@@ -177,6 +177,10 @@ enum Command {
         /// on the first 250 scans of workload c).
         #[arg(long, requires = "scanfile")]
         max_scans: Option<usize>,
+        /// Walk scans of at least N cell visits in waves of tiles on the pool's threads
+        /// (default: 100,000 with two threads or more; 0: every scan); the map is the same.
+        #[arg(long, value_name = "N")]
+        waves_min_cells: Option<u64>,
         /// One JSON object per line per workload instead of a table.
         #[arg(long)]
         json: bool,
@@ -210,8 +214,8 @@ fn main() {
         Command::SlamBench { shared, config, logs, drift, distinct_stamps, json } => {
             commands::slam_bench::run(&shared, config.as_deref(), &logs, &drift, distinct_stamps, json)
         }
-        Command::Bench { workload, scanfile, max_scans, json } => {
-            commands::bench::run(workload, scanfile.as_deref(), max_scans, json)
+        Command::Bench { workload, scanfile, max_scans, waves_min_cells, json } => {
+            commands::bench::run(workload, scanfile.as_deref(), max_scans, waves_min_cells, json)
         }
     };
     if let Err(e) = result {

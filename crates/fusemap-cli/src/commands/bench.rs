@@ -101,8 +101,9 @@ pub fn run_camera(name: char) -> Result<BenchRow> {
     Ok(BenchRow::new(name.to_string(), description, &engine, pixels, simulate_s, insert_s))
 }
 
-/// Runs workload `name` in this process.
-pub fn run_one(name: char) -> Result<BenchRow> {
+/// Runs workload `name` in this process, walking scans of at least `waves` cell visits
+/// in waves of tiles (`None`: the engine's default).
+pub fn run_one(name: char, waves: Option<u64>) -> Result<BenchRow> {
     if CAMERA_WORKLOADS.contains(&name) {
         return run_camera(name);
     }
@@ -114,6 +115,9 @@ pub fn run_one(name: char) -> Result<BenchRow> {
     let params = OccupancyParams { pass_through: PassThroughParams::default(), ..OccupancyParams::default() };
     let grid = FusionGrid::new(GridGeometry::centered(w.resolution)?, params);
     let mut engine = Engine::new(grid);
+    if let Some(n) = waves {
+        engine.set_waves_min_cells(n);
+    }
     let laser = engine.add_lidar("laser", LidarModel::new(w.lidar, PlanarMount::default()));
     let t1 = Instant::now();
     for (scan, pose) in w.run.scans.iter().zip(&w.run.poses) {
@@ -126,8 +130,8 @@ pub fn run_one(name: char) -> Result<BenchRow> {
 
 /// Maps the scans of a `SCAN2D01` scan file (the baselines' input) in this process, on
 /// the file's grid alignment and range limits, so that fusemap and the baselines insert
-/// exactly the same beams.
-pub fn run_scanfile(path: &std::path::Path, max_scans: Option<usize>) -> Result<BenchRow> {
+/// exactly the same beams; `waves` as for [`run_one`].
+pub fn run_scanfile(path: &std::path::Path, max_scans: Option<usize>, waves: Option<u64>) -> Result<BenchRow> {
     let t0 = Instant::now();
     let mut f = fusemap_io::scanfile::read_scanfile(path)?;
     if let Some(n) = max_scans {
@@ -144,6 +148,9 @@ pub fn run_scanfile(path: &std::path::Path, max_scans: Option<usize>) -> Result<
     let simulate_s = t0.elapsed().as_secs_f64();
     let geometry = GridGeometry::new(f.resolution, fusemap_core::geometry::Point2::new(f.origin[0], f.origin[1]))?;
     let mut engine = Engine::new(FusionGrid::new(geometry, OccupancyParams::default()));
+    if let Some(n) = waves {
+        engine.set_waves_min_cells(n);
+    }
     let params =
         fusemap_core::sensor::LidarParams { min_range: f.range_min, max_range: f.range_max, ..Default::default() };
     let laser = engine.add_lidar("laser", LidarModel::new(params, PlanarMount::default()));
@@ -185,19 +192,22 @@ pub fn run(
     which: Option<char>,
     scanfile: Option<&std::path::Path>,
     max_scans: Option<usize>,
+    waves: Option<u64>,
     json: bool,
 ) -> Result<()> {
     let rows = match (which, scanfile) {
-        (_, Some(path)) => vec![run_scanfile(path, max_scans)?],
-        (Some(w), None) => vec![run_one(w)?],
+        (_, Some(path)) => vec![run_scanfile(path, max_scans, waves)?],
+        (Some(w), None) => vec![run_one(w, waves)?],
         (None, None) => {
             let exe = std::env::current_exe().context("cannot find the fusemap executable to run workloads")?;
             let mut rows = Vec::new();
             for w in WORKLOADS.into_iter().chain(CAMERA_WORKLOADS) {
-                let out = std::process::Command::new(&exe)
-                    .args(["bench", "--json", "--workload", &w.to_string()])
-                    .output()
-                    .with_context(|| format!("running workload {w}"))?;
+                let mut child = std::process::Command::new(&exe);
+                child.args(["bench", "--json", "--workload", &w.to_string()]);
+                if let Some(n) = waves {
+                    child.args(["--waves-min-cells", &n.to_string()]);
+                }
+                let out = child.output().with_context(|| format!("running workload {w}"))?;
                 if !out.status.success() {
                     bail!("workload {w} failed: {}", String::from_utf8_lossy(&out.stderr).trim());
                 }
