@@ -126,20 +126,26 @@ impl<T: Tile> TileMap<T> {
     }
 
     /// The tile at `key`, allocating an empty one if needed; past the budget, the scratch
-    /// tile (see the type docs).
-    #[inline]
+    /// tile (see the type docs). The lookup inlines into the walks; the allocation, once
+    /// per tile in a map's life, does not.
+    #[inline(always)]
     pub fn get_or_insert(&mut self, key: TileKey) -> &mut T {
-        let i = match self.index.get(&key) {
-            Some(&i) => i as usize,
-            None if self.tiles.len() >= self.budget => return self.scratch_tile(),
-            None => {
-                let i = self.tiles.len();
-                self.tiles.push(Box::new(T::empty()));
-                self.keys.push(key);
-                self.index.insert(key, i as u32);
-                i
-            }
-        };
+        match self.index.get(&key) {
+            Some(&i) => &mut self.tiles[i as usize],
+            None => self.allocate(key),
+        }
+    }
+
+    /// A new empty tile at `key` (not yet allocated); past the budget, the scratch tile.
+    #[inline(never)]
+    fn allocate(&mut self, key: TileKey) -> &mut T {
+        if self.tiles.len() >= self.budget {
+            return self.scratch_tile();
+        }
+        let i = self.tiles.len();
+        self.tiles.push(Box::new(T::empty()));
+        self.keys.push(key);
+        self.index.insert(key, i as u32);
         &mut self.tiles[i]
     }
 
