@@ -33,7 +33,7 @@
 //! merges their cells into sets before one update per cell, which works because it has no
 //! per-ray state (such as the pass-through rule's) that depends on the cells before.
 
-use super::walk::{checked, walk_in_tile};
+use super::walk::{ray_ends, walk_in_tile};
 use super::{CellBox, CellIndex, CellRay, CellVisitor, GridGeometry, InsertStats, MarkedTile, TileKey, TileMap};
 use crate::measurement::Ray;
 use std::collections::HashMap;
@@ -144,10 +144,7 @@ pub fn walk_observation_waves<T: MarkedTile + Send, V: RayFork<T>>(
     visitor: &mut V,
     min_cells: u64,
 ) -> Option<InsertStats> {
-    let (ox, oy) = (geometry.origin().x, geometry.origin().y);
-    let inv = 1.0 / geometry.resolution();
-    let units = |p: crate::geometry::Point2| ((p.x - ox) * inv, (p.y - oy) * inv);
-    let ends: Vec<_> = rays.iter().map(|r| checked(units(r.origin), units(r.end))).collect();
+    let ends: Vec<_> = rays.iter().map(ray_ends(geometry)).collect();
     let start = ends.iter().flatten().next()?.2.tile();
     if rays.len() > u32::MAX as usize {
         return None;

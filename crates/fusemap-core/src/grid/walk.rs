@@ -181,9 +181,7 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
     known: &mut Option<CellBox>,
     visitor: &mut V,
 ) -> InsertStats {
-    let (ox, oy) = (geometry.origin().x, geometry.origin().y);
-    let inv = 1.0 / geometry.resolution();
-    let units = |p: crate::geometry::Point2| ((p.x - ox) * inv, (p.y - oy) * inv);
+    let ends = ray_ends(geometry);
     let mut stats = InsertStats::default();
 
     // Pass 1: hits. Each end cell is marked, so the walks of pass 2 never give it a miss;
@@ -191,7 +189,7 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
     // known, with whether it is the cell's first hit of the observation.
     let mut first_hit = vec![false; rays.len()];
     for (i, ray) in rays.iter().enumerate().filter(|(_, r)| r.hit) {
-        let Some((_, _, _, c)) = checked(units(ray.origin), units(ray.end)) else {
+        let Some((_, _, _, c)) = ends(ray) else {
             continue;
         };
         let tile = tiles.get_or_insert(c.tile());
@@ -205,7 +203,7 @@ pub fn walk_observation<T: MarkedTile, V: CellVisitor<T>>(
     // Pass 2: walk every ray from its origin to its end.
     let mut known_box = *known;
     for (i, ray) in rays.iter().enumerate() {
-        let Some((a, b, ca, cb)) = checked(units(ray.origin), units(ray.end)) else {
+        let Some((a, b, ca, cb)) = ends(ray) else {
             stats.rays_rejected += 1;
             continue;
         };
@@ -286,6 +284,19 @@ pub(super) fn walk_in_tile<T: MarkedTile, V: CellVisitor<T>>(
     }
 }
 
+/// The ends of a ray in cell units with their cells, or `None` when it must not be
+/// walked ([`checked`]): the conversion every walk uses (the inverse resolution, once).
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+pub(super) fn ray_ends(
+    geometry: &GridGeometry,
+) -> impl Fn(&Ray) -> Option<((f64, f64), (f64, f64), CellIndex, CellIndex)> {
+    let (ox, oy) = (geometry.origin().x, geometry.origin().y);
+    let inv = 1.0 / geometry.resolution();
+    let units = move |p: crate::geometry::Point2| ((p.x - ox) * inv, (p.y - oy) * inv);
+    move |ray: &Ray| checked(units(ray.origin), units(ray.end))
+}
+
 #[inline(always)]
 fn cell_of_units((u, v): (f64, f64)) -> Option<CellIndex> {
     const LIMIT: f64 = 4.611_686_018_427_388e18;
@@ -298,7 +309,7 @@ fn cell_of_units((u, v): (f64, f64)) -> Option<CellIndex> {
 /// beyond the index range, or longer than [`MAX_RAY_CELLS`]).
 #[inline(always)]
 #[allow(clippy::type_complexity)]
-pub(super) fn checked(a: (f64, f64), b: (f64, f64)) -> Option<((f64, f64), (f64, f64), CellIndex, CellIndex)> {
+fn checked(a: (f64, f64), b: (f64, f64)) -> Option<((f64, f64), (f64, f64), CellIndex, CellIndex)> {
     let ca = cell_of_units(a)?;
     let cb = cell_of_units(b)?;
     let n = ca.x.abs_diff(cb.x) + ca.y.abs_diff(cb.y);
