@@ -180,6 +180,13 @@ impl ProbabilityGrid {
         self.marked = Vec::new();
     }
 
+    /// A frozen grid of `cells` over `limits` (row-major, as [`values`](Self::values)
+    /// gives them): a finished field unpacked (`packed_grid.rs`).
+    pub(crate) fn frozen(resolution: f64, limits: CellLimits, cells: Vec<u16>) -> Self {
+        assert_eq!(cells.len(), limits.width * limits.height, "cells fill the limits");
+        Self { resolution, limits, cells, marked: Vec::new(), mirror: None }
+    }
+
     /// The probability of cell `(x, y)`; [`P_MIN`] when unknown or outside.
     #[inline]
     pub fn probability(&self, x: i64, y: i64) -> f32 {

@@ -8,14 +8,30 @@
 //! dropped past the budget; a dropped one is rebuilt from its submap when a search needs
 //! it again. The rebuilt grids are the same bytes, so the search's results do not depend
 //! on the budget; only the time does.
+//!
+//! A finished submap's field is kept packed (`packed_grid.rs`); the cache holds it
+//! unpacked beside its grids, for the refinement that follows a search.
 
 use super::global_match::PrecomputedGrids;
 use super::grid::ProbabilityGrid;
 use std::collections::VecDeque;
 
-/// Precomputed grids by submap index, least recently used dropped past a byte budget.
+/// A submap's field, unpacked, and its precomputed grids.
+struct Held {
+    field: ProbabilityGrid,
+    grids: PrecomputedGrids,
+}
+
+impl Held {
+    fn bytes(&self) -> usize {
+        self.field.bytes() + self.grids.memory_bytes()
+    }
+}
+
+/// Unpacked fields and their precomputed grids by submap index, least recently used
+/// dropped past a byte budget.
 pub struct GridCache {
-    grids: Vec<Option<PrecomputedGrids>>,
+    grids: Vec<Option<Held>>,
     /// Submaps holding grids, least recently used first.
     recent: VecDeque<usize>,
     bytes: usize,
@@ -44,15 +60,20 @@ impl GridCache {
         self.grids.push(None);
     }
 
-    /// Builds the grids of every submap of `needed` not held (in parallel), makes them the
-    /// most recently used, and drops the least recently used others past the budget: every
-    /// one of `needed` can then be [`peek`](Self::peek)ed, however small the budget.
-    pub fn prepare<'a>(&mut self, needed: &[usize], grid_of: impl Fn(usize) -> &'a ProbabilityGrid + Sync) {
+    /// Unpacks the field (`field_of`) and builds the grids of every submap of `needed` not
+    /// held (in parallel), makes them the most recently used, and drops the least recently
+    /// used others past the budget: every one of `needed` can then be
+    /// [`peek`](Self::peek)ed, however small the budget.
+    pub fn prepare(&mut self, needed: &[usize], field_of: impl Fn(usize) -> ProbabilityGrid + Sync) {
         let missing: Vec<usize> = needed.iter().copied().filter(|&s| self.grids[s].is_none()).collect();
         let depth = self.depth;
-        let built = crate::parallel::map_all(&missing, |&s| PrecomputedGrids::new(grid_of(s), depth));
+        let built = crate::parallel::map_all(&missing, |&s| {
+            let field = field_of(s);
+            let grids = PrecomputedGrids::new(&field, depth);
+            Held { field, grids }
+        });
         for (s, g) in missing.into_iter().zip(built) {
-            self.bytes += g.memory_bytes();
+            self.bytes += g.bytes();
             self.grids[s] = Some(g);
             self.built += 1;
         }
@@ -72,14 +93,14 @@ impl GridCache {
             }
             self.recent.remove(k);
             if let Some(g) = self.grids[old].take() {
-                self.bytes -= g.memory_bytes();
+                self.bytes -= g.bytes();
             }
         }
     }
 
-    /// The grids of submap `s`, if held.
-    pub fn peek(&self, s: usize) -> Option<&PrecomputedGrids> {
-        self.grids.get(s)?.as_ref()
+    /// The field of submap `s` and its grids, if held.
+    pub fn peek(&self, s: usize) -> Option<(&ProbabilityGrid, &PrecomputedGrids)> {
+        self.grids.get(s)?.as_ref().map(|h| (&h.field, &h.grids))
     }
 }
 
@@ -94,18 +115,21 @@ mod tests {
         let (hit, miss) = (UpdateTable::new(0.55), UpdateTable::new(0.49));
         let pts: Vec<Point2> = (0..50).map(|i| Point2::new(k as f64 + 0.1 * i as f64, 3.0)).collect();
         g.insert(Point2::new(k as f64, 0.0), &pts, &[], &hit, &miss);
+        g.freeze();
         g
     }
 
     #[test]
     fn the_budget_drops_the_least_recently_used_and_rebuilds_the_same_grids() {
         let grids: Vec<ProbabilityGrid> = (0..4).map(grid).collect();
-        let one = PrecomputedGrids::new(&grids[0], 4).memory_bytes();
+        // A field and its grids (the fields here are all the same size).
+        let one = PrecomputedGrids::new(&grids[0], 4).memory_bytes() + grids[0].bytes();
         let mut c = GridCache::new(2 * one + one / 2, 4);
         (0..4).for_each(|_| c.add_submap());
-        let of = |s: usize| &grids[s];
+        let of = |s: usize| grids[s].clone();
         c.prepare(&[0], of);
-        let first = c.peek(0).unwrap().memory_bytes();
+        let first = c.peek(0).unwrap().1.memory_bytes();
+        assert_eq!(c.peek(0).unwrap().0.values(), grids[0].values());
         c.prepare(&[1], of);
         c.prepare(&[0], of); // 0 is now more recent than 1
         c.prepare(&[2], of); // over budget: 1 goes
@@ -117,7 +141,7 @@ mod tests {
         assert_eq!(c.built, 3, "0 was kept");
         c.prepare(&[1], of);
         assert_eq!(c.built, 4, "1 was dropped and is rebuilt");
-        assert_eq!(c.peek(0).unwrap().memory_bytes(), first);
+        assert_eq!(c.peek(0).unwrap().1.memory_bytes(), first);
         // A batch keeps every grid it needs, whatever the budget.
         let mut tiny = GridCache::new(0, 4);
         (0..3).for_each(|_| tiny.add_submap());

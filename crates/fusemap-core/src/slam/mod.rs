@@ -7,6 +7,7 @@
 //! | its smooth (bicubic) interpolation | `interpolation.rs` |
 //! | correlative search + Gauss–Newton refinement + information | `local_match.rs` |
 //! | two active submaps, finished ones kept | `submap.rs` |
+//! | a finished submap's field, packed | `packed_grid.rs` |
 //! | branch-and-bound loop-closure search | `global_match.rs` |
 //! | its precomputed grids within a memory budget | `grid_cache.rs` |
 //! | which pairs are searched, in parallel batches, and which matches are kept | `loop_closure.rs` |
@@ -30,6 +31,7 @@ mod mapper;
 mod node_edges;
 mod odometry;
 mod optimisation;
+mod packed_grid;
 mod params;
 pub mod pose_graph;
 mod report;

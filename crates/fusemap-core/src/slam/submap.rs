@@ -14,10 +14,12 @@
 //!
 //! Each submap keeps two grids: its occupancy (a probability grid, updated in odds space)
 //! and the likelihood field derived from it (`field.rs`), which is what every matcher reads.
-//! A finished submap keeps only the field.
+//! A finished submap keeps only the field, packed (`packed_grid.rs`): loop closure unpacks
+//! it when a search needs it.
 
 use super::field::{self, Crossing, FieldKernel};
 use super::grid::{ProbabilityGrid, UpdateTable};
+use super::packed_grid::PackedGrid;
 use crate::geometry::{Point2, Pose2};
 use crate::parallel::join;
 
@@ -27,8 +29,11 @@ pub struct Submap {
     /// Its frame in the local SLAM frame: the position of its first scan, axes of the
     /// local frame (the grid is axis-aligned in the local frame).
     pub local_pose: Pose2,
-    /// The likelihood field scans are matched against, cells in local-frame coordinates.
+    /// The likelihood field scans are matched against, cells in local-frame coordinates
+    /// (emptied when the submap is finished: see `packed`).
     pub grid: ProbabilityGrid,
+    /// The finished submap's field, packed.
+    pub packed: Option<PackedGrid>,
     /// The occupancy the field is derived from (emptied when the submap is finished).
     pub occupancy: ProbabilityGrid,
     /// Scans inserted.
@@ -155,6 +160,7 @@ impl Submaps {
                 local_pose: Pose2::new(pose.x, pose.y, 0.0),
                 grid: ProbabilityGrid::new(self.resolution),
                 occupancy: ProbabilityGrid::new(self.resolution),
+                packed: None,
                 scans: 0,
                 finished: false,
             });
@@ -195,13 +201,22 @@ impl Submaps {
         (into, finished)
     }
 
-    /// Submap `i` takes no more scans: its field is frozen and its occupancy dropped.
+    /// Submap `i` takes no more scans: its field is frozen and packed, its occupancy
+    /// dropped.
     fn finish(&mut self, i: usize) {
         let s = &mut self.all[i];
         s.finished = true;
         s.grid.freeze();
+        let packed = PackedGrid::pack(&s.grid);
+        self.finished_bytes += packed.bytes();
+        s.packed = Some(packed);
+        s.grid = ProbabilityGrid::new(self.resolution);
         s.occupancy = ProbabilityGrid::new(self.resolution);
-        self.finished_bytes += s.grid.bytes() + s.occupancy.bytes();
+    }
+
+    /// The field of finished submap `i`, unpacked.
+    pub fn finished_field(&self, i: usize) -> ProbabilityGrid {
+        self.all[i].packed.as_ref().expect("only a finished submap's field is unpacked").unpack()
     }
 
     /// A copy of finished submap `i`, appended (tests of the loop search's cost over very

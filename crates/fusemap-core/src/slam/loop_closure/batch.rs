@@ -31,8 +31,8 @@ impl Slam {
         let mut needed: Vec<usize> = planned.iter().map(|p| p.pair.submap).collect();
         needed.sort_unstable();
         needed.dedup();
-        let submaps = self.submaps.all();
-        self.grids.prepare(&needed, |s| &submaps[s].grid);
+        let submaps = &self.submaps;
+        self.grids.prepare(&needed, |s| submaps.finished_field(s));
         let (grids, nodes) = (&self.grids, &self.nodes);
         let local = LocalMatchParams { degeneracy_ratio: self.p.loop_closure_degeneracy_ratio, ..self.p.local };
         let local = &local;
@@ -42,14 +42,13 @@ impl Slam {
         order.sort_by(|&a, &b| work[b].total_cmp(&work[a]).then(a.cmp(&b)));
         let mut ran: Vec<(usize, Outcome)> = map_all(&order, |&k| {
             let pl = &planned[k];
-            let sm = &submaps[pl.pair.submap];
             let node = &nodes[pl.pair.node];
-            let pre = grids.peek(pl.pair.submap).expect("prepared above");
+            let (field, pre) = grids.peek(pl.pair.submap).expect("prepared above");
             let out = search_branch_and_bound(pre, &node.search_points, pl.initial, &pl.search);
             let found = out.found.map(|f| {
-                let pose = refine(&sm.grid, &node.points, f.pose, f.pose, local);
-                let score = mean_probability(&sm.grid, &node.points, pose);
-                (pose, score, match_information(&sm.grid, &node.points, pose, local).1)
+                let pose = refine(field, &node.points, f.pose, f.pose, local);
+                let score = mean_probability(field, &node.points, pose);
+                (pose, score, match_information(field, &node.points, pose, local).1)
             });
             (k, Outcome { found, best_score: out.best_score, on_edge: out.on_edge })
         });
