@@ -3,43 +3,83 @@
 //! A finished submap is only read again when a loop-closure search picks it, and then
 //! through the grid cache (`grid_cache.rs`), which unpacks it next to its branch-and-bound
 //! grids. Held as plain 16-bit cells, the finished fields grew with the log: 371 MB of the
-//! 1.2 GB peak of a 60-minute simulated run. Most of a field is unknown (`0`) or far from
-//! any wall (`P_MIN`), long runs that LZ4 shrinks by an order of magnitude and unpacks
-//! at gigabytes a second. Packing is lossless: the unpacked grid is the frozen grid, cell
-//! for cell, so every search reads what it read before.
+//! 1.2 GB peak of a 60-minute simulated run.
+//!
+//! A likelihood field is zero (unknown, read as `P_MIN`) everywhere but within 3σ of a
+//! wall (`field.rs`), so it is kept as runs: the zeros counted, the cells near walls
+//! copied. Unpacking is then an allocation of zeroed cells and a copy of the rest, which
+//! matters because the cache unpacks a submap each time it rebuilds its grids (about
+//! twenty times a submap on that run). Packing is lossless: the unpacked grid is the
+//! frozen grid, cell for cell, so every search reads what it read before.
 
 use super::grid::{CellLimits, ProbabilityGrid};
 
-/// A frozen [`ProbabilityGrid`], its cells LZ4-compressed.
+/// Zeros shorter than this stay among the copied cells: a run costs as much as this many
+/// cells.
+const MIN_ZERO_RUN: usize = 4;
+
+/// A frozen [`ProbabilityGrid`], its zeros counted and its other cells copied.
 #[derive(Clone, Debug)]
 pub struct PackedGrid {
     resolution: f64,
     limits: CellLimits,
-    /// The cells as little-endian `u16`, LZ4 block with the size prepended.
-    packed: Vec<u8>,
+    /// `(zeros, copied)`: that many zero cells, then that many cells from `cells`, in
+    /// row-major order; the cells after the last run are zero.
+    runs: Vec<(u32, u32)>,
+    /// The copied cells, in order.
+    cells: Vec<u16>,
 }
 
 impl PackedGrid {
     /// Packs a frozen grid (one with no `f32` mirror and no marks).
     pub fn pack(grid: &ProbabilityGrid) -> Self {
         debug_assert!(grid.probabilities().is_none(), "only a frozen grid is packed");
-        let bytes: Vec<u8> = grid.values().iter().flat_map(|v| v.to_le_bytes()).collect();
-        let mut packed = lz4_flex::compress_prepend_size(&bytes);
-        packed.shrink_to_fit();
-        Self { resolution: grid.resolution(), limits: grid.limits(), packed }
+        let v = grid.values();
+        let (mut runs, mut cells) = (Vec::new(), Vec::new());
+        let mut i = 0;
+        while i < v.len() {
+            let zeros = v[i..].iter().take_while(|&&c| c == 0).count();
+            let start = i + zeros;
+            if start == v.len() {
+                break;
+            }
+            // Copy up to the next run of at least MIN_ZERO_RUN zeros (or the end).
+            let mut end = start;
+            while end < v.len() {
+                let z = v[end..].iter().take(MIN_ZERO_RUN).take_while(|&&c| c == 0).count();
+                if z == MIN_ZERO_RUN || end + z == v.len() {
+                    break;
+                }
+                end += z.max(1);
+            }
+            // A grid holds at most 2^26 cells (`MAX_GRID_CELLS`), so the counts fit.
+            runs.push((zeros as u32, (end - start) as u32));
+            cells.extend_from_slice(&v[start..end]);
+            i = end;
+        }
+        runs.shrink_to_fit();
+        cells.shrink_to_fit();
+        Self { resolution: grid.resolution(), limits: grid.limits(), runs, cells }
     }
 
     /// The grid it was packed from, cell for cell.
     pub fn unpack(&self) -> ProbabilityGrid {
-        // Packed here from a whole grid, so the block is always well formed.
-        let bytes = lz4_flex::decompress_size_prepended(&self.packed).expect("a packed grid unpacks");
-        let cells: Vec<u16> = bytes.chunks_exact(2).map(|b| u16::from_le_bytes([b[0], b[1]])).collect();
-        ProbabilityGrid::frozen(self.resolution, self.limits, cells)
+        let mut out = vec![0u16; self.limits.width * self.limits.height];
+        let (mut at, mut from) = (0, 0);
+        for &(zeros, copied) in &self.runs {
+            at += zeros as usize;
+            let n = copied as usize;
+            out[at..at + n].copy_from_slice(&self.cells[from..from + n]);
+            (at, from) = (at + n, from + n);
+        }
+        ProbabilityGrid::frozen(self.resolution, self.limits, out)
     }
 
     /// Bytes held.
     pub fn bytes(&self) -> usize {
-        self.packed.capacity() + std::mem::size_of::<Self>()
+        self.runs.capacity() * std::mem::size_of::<(u32, u32)>()
+            + self.cells.capacity() * std::mem::size_of::<u16>()
+            + std::mem::size_of::<Self>()
     }
 }
 
@@ -47,7 +87,9 @@ impl PackedGrid {
 mod tests {
     use super::*;
     use crate::geometry::Point2;
+    use crate::grid::CellIndex;
     use crate::slam::grid::UpdateTable;
+    use proptest::prelude::*;
 
     #[test]
     fn a_field_unpacks_to_the_frozen_grid_and_packs_small() {
@@ -55,20 +97,39 @@ mod tests {
         let (hit, miss) = (UpdateTable::new(0.55), UpdateTable::new(0.49));
         let hits: Vec<Point2> =
             (0..360).map(|i| (i as f64).to_radians()).map(|a| Point2::new(8.0 * a.cos(), 5.0 * a.sin())).collect();
+        let mut field = ProbabilityGrid::new(0.05);
+        let kernel = crate::slam::field::FieldKernel::new(0.1, 0.05);
+        let mut crossings = Vec::new();
         for _ in 0..3 {
-            g.insert(Point2::new(0.0, 0.0), &hits, &[], &hit, &miss);
+            crossings.clear();
+            g.insert_tracking(Point2::new(0.0, 0.0), &hits, &[], &hit, &miss, &mut crossings);
+            crate::slam::field::update(&mut field, &kernel, &crossings, |x, y| g.probability(x, y) > 0.5);
         }
-        g.freeze();
-        let p = PackedGrid::pack(&g);
+        field.freeze();
+        let p = PackedGrid::pack(&field);
         let u = p.unpack();
-        assert_eq!((u.resolution(), u.limits(), u.values()), (g.resolution(), g.limits(), g.values()));
-        assert_eq!(u.bytes(), g.bytes());
+        assert_eq!((u.resolution(), u.limits(), u.values()), (field.resolution(), field.limits(), field.values()));
+        assert_eq!(u.bytes(), field.bytes());
         assert!(u.probabilities().is_none());
-        // An ellipse of walls in a 16 × 10 m box: mostly free and unknown cells.
-        assert!(p.bytes() * 4 < g.bytes(), "{} packed of {}", p.bytes(), g.bytes());
+        // An ellipse of walls in a 16 × 10 m box: the field is zero but near them.
+        assert!(p.bytes() * 4 < field.bytes(), "{} packed of {}", p.bytes(), field.bytes());
         // An empty grid too.
         let mut e = ProbabilityGrid::new(0.1);
         e.freeze();
         assert_eq!(PackedGrid::pack(&e).unpack().values().len(), 0);
+    }
+
+    proptest! {
+        /// Any cells, runs of zeros of every length included, come back as they went in.
+        #[test]
+        fn any_cells_unpack_to_themselves(cells in prop::collection::vec(prop_oneof![Just(0u16), Just(0u16), 1u16..40], 0..300), width in 1usize..20) {
+            let height = cells.len() / width;
+            let cells = cells[..width * height].to_vec();
+            let limits = CellLimits { min: CellIndex::new(-3, 7), width, height };
+            let g = ProbabilityGrid::frozen(0.05, limits, cells.clone());
+            let u = PackedGrid::pack(&g).unpack();
+            prop_assert_eq!(u.values(), &cells[..]);
+            prop_assert_eq!(u.limits(), limits);
+        }
     }
 }
