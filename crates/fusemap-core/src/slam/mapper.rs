@@ -90,10 +90,19 @@ pub(super) struct Node {
     pub(super) track: Option<Pose2>,
     pub(super) graph: usize,
     pub(super) points: Vec<Point2>,
-    pub(super) search_points: Vec<Point2>,
+    /// Which of `points` the loop-closure search matches (indices: a node is kept for the
+    /// whole log, and copies of the points were 35 MB of an hour's nodes).
+    pub(super) search: Vec<u32>,
     pub(super) submaps: Vec<usize>,
     /// Travel of the local trajectory up to this node, metres.
     pub(super) path_m: f64,
+}
+
+impl Node {
+    /// The points the loop-closure search matches.
+    pub(super) fn search_points(&self) -> Vec<Point2> {
+        self.search.iter().map(|&i| self.points[i as usize]).collect()
+    }
 }
 
 /// The SLAM state over one log. Feed scans in time order with [`add_scan`](Self::add_scan),
@@ -466,17 +475,19 @@ impl Slam {
         // The global search's cost grows with the farthest point (its angular step), so
         // it looks at the returns within `loop_closure_max_range_m`.
         let r2 = self.p.loop_closure_max_range_m * self.p.loop_closure_max_range_m;
-        let near: Vec<Point2> = hits
-            .iter()
-            .filter(|q| {
+        // (A scan is held to `limits.beams`; points past index 2³² − 1 would not be
+        // searched.)
+        let near: Vec<u32> = (0..u32::try_from(hits.len()).unwrap_or(u32::MAX))
+            .filter(|&i| {
+                let q = hits[i as usize];
                 let (dx, dy) = (q.x - origin.x, q.y - origin.y);
                 dx * dx + dy * dy <= r2
             })
-            .copied()
             .collect();
         // … and at most `loop_closure_max_points` of them, evenly spread over the scan.
         let stride = near.len().div_ceil(self.p.loop_closure_max_points.max(1)).max(1);
-        let search_points = near.into_iter().step_by(stride).collect();
+        let mut search: Vec<u32> = near.into_iter().step_by(stride).collect();
+        search.shrink_to_fit();
         let path_m = self.nodes.last().map_or(0.0, |n| n.path_m + n.local.translation().distance(local.translation()));
         for &s in &into {
             let origin = self.submaps.all()[s].local_pose.translation();
@@ -486,7 +497,7 @@ impl Slam {
         // collection left (up to half of it on a filtered scan).
         let mut points = hits;
         points.shrink_to_fit();
-        self.nodes.push(Node { stamp, local, track, graph: g, points, search_points, submaps: into, path_m });
+        self.nodes.push(Node { stamp, local, track, graph: g, points, search, submaps: into, path_m });
         self.report.nodes += 1;
         self.attach_fixes(stamp, self.nodes.len() - 1);
         self.report.submaps = self.submaps.all().len();

@@ -44,7 +44,7 @@ impl Slam {
             let pl = &planned[k];
             let node = &nodes[pl.pair.node];
             let (field, pre) = grids.peek(pl.pair.submap).expect("prepared above");
-            let out = search_branch_and_bound(pre, &node.search_points, pl.initial, &pl.search);
+            let out = search_branch_and_bound(pre, &node.search_points(), pl.initial, &pl.search);
             let found = out.found.map(|f| {
                 let pose = refine(field, &node.points, f.pose, f.pose, local);
                 let score = mean_probability(field, &node.points, pose);
@@ -79,7 +79,7 @@ impl Slam {
             .into_iter()
             .filter_map(|p| self.plan(p))
             .map(|pl| {
-                let points = self.nodes[pl.pair.node].search_points.len();
+                let points = self.nodes[pl.pair.node].search.len();
                 let w = search_work(
                     &pl.search,
                     self.p.resolution,
