@@ -46,9 +46,10 @@ impl Slam {
             let (field, pre) = grids.peek(pl.pair.submap).expect("prepared above");
             let out = search_branch_and_bound(pre, &node.search_points(), pl.initial, &pl.search);
             let found = out.found.map(|f| {
-                let pose = refine(field, &node.points, f.pose, f.pose, local);
-                let score = mean_probability(field, &node.points, pose);
-                (pose, score, match_information(field, &node.points, pose, local).1)
+                let points = node.points();
+                let pose = refine(field, &points, f.pose, f.pose, local);
+                let score = mean_probability(field, &points, pose);
+                (pose, score, match_information(field, &points, pose, local).1)
             });
             (k, Outcome { found, best_score: out.best_score, on_edge: out.on_edge })
         });
