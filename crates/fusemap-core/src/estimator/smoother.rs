@@ -39,8 +39,8 @@ pub(crate) struct Track {
 ///
 /// The first pass runs whole, counts into `counts` and keeps the first `held` records. A
 /// log of more steps is smoothed a segment at a time from its end, and the forward pass
-/// runs again up to each segment but the first, keeping that segment's records (and
-/// counting into a scratch copy): the filter is deterministic, so they are the first
+/// runs again up to each segment, keeping that segment's records (and counting into a
+/// scratch copy): the filter is deterministic, so they are the first
 /// pass's records to the bit, and the samples are those of one pass holding them all.
 /// Memory then grows with the log by a sample's 240 bytes a step instead of a record's
 /// 688; time by a partial forward pass per extra segment (a whole one takes about 0.5 s an
@@ -62,11 +62,14 @@ pub(crate) fn filter_and_smooth(
     let mut after: Option<(StepRecord, [f64; N], Mat<N, N>)> = None;
     // The earliest step whose smoothed state is not finite.
     let mut bad = None;
-    let mut first = Some(first);
+    // Held through the whole backward pass only when it is the only segment; otherwise
+    // the first segment is computed again at the end, so that one segment's records are
+    // held at a time, not two (45 MB more at the default `held`).
+    let mut first = (segments.len() == 1).then_some(first);
     for segment in segments.iter().rev() {
-        let records = match segment.start {
-            0 => first.take().unwrap_or_default(),
-            _ => forward(segment.clone(), &mut scratch.clone(), false)?.records,
+        let records = match first.take() {
+            Some(records) => records,
+            None => forward(segment.clone(), &mut scratch.clone(), false)?.records,
         };
         debug_assert_eq!(records.len(), segment.len());
         let Some(end) = records.last() else { continue };
