@@ -43,7 +43,7 @@ pub(crate) struct Track {
 /// scratch copy): the filter is deterministic, so they are the first
 /// pass's records to the bit, and the samples are those of one pass holding them all.
 /// Memory then grows with the log by a sample's 240 bytes a step instead of a record's
-/// 688; time by a partial forward pass per extra segment (a whole one takes about 0.5 s an
+/// 688; time by a partial forward pass per segment (a whole one takes about 0.5 s an
 /// hour of 50 Hz odometry), so quadratically in the log's length past `held` steps. This is checkpointing with
 /// recomputation, as in Griewank & Walther's reverse-mode differentiation, with the start
 /// of the log as the only checkpoint.

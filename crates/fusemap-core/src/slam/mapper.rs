@@ -89,9 +89,9 @@ pub(super) struct Node {
     pub(super) local: Pose2,
     pub(super) track: Option<Pose2>,
     pub(super) graph: usize,
-    /// The scan's returns in the base frame, for the loop-closure refinement: in `f32`, to
-    /// 4 µm within 64 m of the base, for a node is kept for the whole log (its points were
-    /// 168 MB of an hour's simulated run in `f64`).
+    /// The scan's returns in the base frame, for the loop-closure refinement, in `f32` (to
+    /// 4 µm within 64 m of the base): a node is kept for the whole log, and in `f64` its
+    /// points were 168 MB of an hour's simulated run.
     pub(super) points: Vec<[f32; 2]>,
     /// Which of `points` the loop-closure search matches (indices: a node is kept for the
     /// whole log, and copies of the points were 35 MB of an hour's nodes).
