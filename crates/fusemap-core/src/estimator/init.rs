@@ -259,6 +259,14 @@ fn first_state(
     Init { x: [position.x, position.y, phi, 0.0, 1.0], p, info }
 }
 
+/// A source of the start heading, found at a stamp: an absolute pose (`[x, y, yaw]` and the
+/// yaw's variance), an IMU heading (yaw and variance), or the course over ground.
+enum Source<'a> {
+    Pose([f64; 3], f64),
+    Heading(f64, f64),
+    Course(&'a CourseFit),
+}
+
 /// Finds the heading (and position) at the first odometry stamp.
 pub(crate) fn initialise(
     odo: &OdometryTrack,
@@ -278,11 +286,6 @@ pub(crate) fn initialise(
     let course = course_over_ground(odo, &dr, &good_fixes, cfg);
 
     // The earliest source wins.
-    enum Source<'a> {
-        Pose([f64; 3], f64),
-        Heading(f64, f64),
-        Course(&'a CourseFit),
-    }
     let candidates = [
         first_pose.map(|(t, z, var)| (t, Source::Pose(z, var))),
         first_heading.map(|(t, yaw, var)| (t, Source::Heading(yaw, var))),

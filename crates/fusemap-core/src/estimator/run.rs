@@ -243,6 +243,21 @@ struct Drive<'a> {
 }
 
 impl Filter<'_> {
+    /// Counts the corrections before the track's start `t0` as outside it and applies
+    /// those at `t0`; returns the index of the first correction after it.
+    fn start(&mut self, corrections: &[(Stamp, Correction)], t0: Stamp) -> usize {
+        let mut j = 0;
+        while j < corrections.len() && corrections[j].0 < t0 {
+            count_outside(corrections[j].0, &corrections[j].1, self.counts);
+            j += 1;
+        }
+        while j < corrections.len() && corrections[j].0 == t0 {
+            self.correct(corrections[j].0, &corrections[j].1);
+            j += 1;
+        }
+        j
+    }
+
     /// Predicts over `dt` seconds of `drive` moving by `inc` (odometry) and `gyro_angle`
     /// (the gyro's integral, with its variance), and while standing still corrects with
     /// the gyro's zero rate. Returns the prediction and its Jacobian.
@@ -320,15 +335,7 @@ pub(crate) fn run(
         driven_since_fix_m: f64::INFINITY,
         reset_refused: false,
     };
-    let mut j = 0;
-    while j < corrections.len() && corrections[j].0 < t0 {
-        count_outside(corrections[j].0, &corrections[j].1, f.counts);
-        j += 1;
-    }
-    while j < corrections.len() && corrections[j].0 == t0 {
-        f.correct(corrections[j].0, &corrections[j].1);
-        j += 1;
-    }
+    let mut j = f.start(corrections, t0);
     if keep.contains(&steps) {
         records.push(StepRecord { stamp: t0, x: f.x, p: f.p, x_pred: init.x, p_pred: init.p, f: identity() });
     }

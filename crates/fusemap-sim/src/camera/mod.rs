@@ -206,25 +206,31 @@ impl<'a> CameraSim<'a> {
                 out.depth.push(f32::NAN);
             }
         }
-        // Salt: the gaps between salted pixels are geometric (one draw per salted pixel
-        // instead of one per pixel).
-        let p = cfg.label_noise_probability;
+        self.salt(out);
+    }
+
+    /// Salt: a share `label_noise_probability` of the labels set to random classes. The
+    /// gaps between salted pixels are geometric (one draw per salted pixel instead of one
+    /// per pixel).
+    fn salt(&mut self, out: &mut NoisyFrame) {
+        let p = self.cfg.label_noise_probability;
         out.salted = 0;
-        if p > 0.0 {
-            let mut i = 0usize;
-            loop {
-                let gap = if p >= 1.0 { 0.0 } else { ((1.0 - self.rng.next_f64()).ln() / (1.0 - p).ln()).floor() };
-                if gap >= out.labels.len() as f64 {
-                    break;
-                }
-                i += gap as usize;
-                if i >= out.labels.len() {
-                    break;
-                }
-                out.labels[i] = 1 + (self.rng.next_u64() % 6) as u16;
-                out.salted += 1;
-                i += 1;
+        if p <= 0.0 {
+            return;
+        }
+        let mut i = 0usize;
+        loop {
+            let gap = if p >= 1.0 { 0.0 } else { ((1.0 - self.rng.next_f64()).ln() / (1.0 - p).ln()).floor() };
+            if gap >= out.labels.len() as f64 {
+                break;
             }
+            i += gap as usize;
+            if i >= out.labels.len() {
+                break;
+            }
+            out.labels[i] = 1 + (self.rng.next_u64() % 6) as u16;
+            out.salted += 1;
+            i += 1;
         }
     }
 }
