@@ -209,7 +209,7 @@ impl<'a> ScanFeed<'a> {
         })
     }
 
-    /// Feeds one scan to SLAM; an error once SLAM's grids hold more than
+    /// Feeds one scan to SLAM; an error once SLAM's grids and nodes hold more than
     /// `limits.memory_mib`.
     fn feed(&mut self, t: Stamp, scan: ScanMessage) -> Result<(), PipelineError> {
         // A repeated message is one scan, as in the mapping pass.
@@ -238,13 +238,14 @@ impl<'a> ScanFeed<'a> {
         if matches!(self.track, Track::ScanLine(_)) && outcome != ScanOutcome::Refused {
             self.lines.push(pose.map(|p| (scan.scan.stamp, p)));
         }
-        let bytes = self.slam.grid_bytes();
+        let bytes = self.slam.held_bytes();
         if bytes as u64 > self.memory_bytes {
             return Err(PipelineError::Refused(format!(
-                "SLAM's grids reached limits.memory_mib = {} MiB ({} submaps and the loop search's grids, {bytes} bytes) at the scan stamped {:.6} s; \
+                "SLAM reached limits.memory_mib = {} MiB ({} submaps, the loop search's grids and {} nodes' points, {bytes} bytes) at the scan stamped {:.6} s; \
                  raise limits.memory_mib, lower slam.loop_closure_grid_cache_mib, coarsen slam.resolution_m, or shorten slam.max_range_m",
                 self.memory_bytes >> 20,
                 self.slam.report().submaps,
+                self.slam.report().nodes,
                 t.as_secs_f64()
             )));
         }

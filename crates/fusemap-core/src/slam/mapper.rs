@@ -136,6 +136,8 @@ pub struct Slam {
     last_stamp: Stamp,
     /// The most bytes the submaps' grids have held at once.
     submap_peak_bytes: usize,
+    /// Bytes held by the nodes (their points, search indices and submap lists).
+    node_bytes: usize,
     /// The last two scans' stamps and local poses (the constant-velocity prediction).
     pub(super) recent: [Option<(Stamp, Pose2)>; 2],
     pub(super) global_from_local: Pose2,
@@ -212,6 +214,7 @@ impl Slam {
             last: None,
             last_stamp: Stamp(0),
             submap_peak_bytes: 0,
+            node_bytes: 0,
             recent: [None, None],
             global_from_local: Pose2::IDENTITY,
             typical_score: None,
@@ -250,9 +253,10 @@ impl Slam {
         self.fixes.attach(upto, before, after, in_track_frame, &mut self.graph, &self.p, &mut self.report);
     }
 
-    /// Bytes held by the submaps' grids and the loop search's branch-and-bound grids.
-    pub fn grid_bytes(&self) -> usize {
-        self.submaps.bytes() + self.grids.bytes()
+    /// Bytes held by the submaps' grids, the loop search's branch-and-bound grids and the
+    /// nodes' points (what grows with the log: `limits.memory_mib` holds SLAM to it).
+    pub fn held_bytes(&self) -> usize {
+        self.submaps.bytes() + self.grids.bytes() + self.node_bytes
     }
 
     /// Adds the next scan (stamps non-decreasing).
@@ -507,6 +511,10 @@ impl Slam {
         }
         // A node is kept for the whole log: its points without spare room.
         let points: Vec<[f32; 2]> = hits.iter().map(|p| [p.x as f32, p.y as f32]).collect();
+        self.node_bytes += std::mem::size_of::<Node>()
+            + points.capacity() * std::mem::size_of::<[f32; 2]>()
+            + search.capacity() * std::mem::size_of::<u32>()
+            + into.capacity() * std::mem::size_of::<usize>();
         self.nodes.push(Node { stamp, local, track, graph: g, points, search, submaps: into, path_m });
         self.report.nodes += 1;
         self.attach_fixes(stamp, self.nodes.len() - 1);

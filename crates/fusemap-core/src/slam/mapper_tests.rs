@@ -398,3 +398,24 @@ fn injected_false_closures_do_not_bend_the_trajectory() {
         assert!(moved <= 0.05, "{share}: {injected} wrong closures moved the trajectory by {moved:.3} m RMS");
     }
 }
+
+#[test]
+fn the_nodes_points_count_in_the_bytes_slam_holds() {
+    // Once around the room: every node's points (8 bytes each in f32) are in
+    // `held_bytes`, beside the submaps' and the loop search's grids.
+    let truth = ring_poses(1);
+    let track: Vec<Option<Pose2>> = truth.iter().map(|p| Some(*p)).collect();
+    let mut checked = 0;
+    run_observed(SlamParams::default(), &truth, &track, 360, |slam, _| {
+        let points: usize = slam.nodes.iter().map(|n| n.points.len()).sum();
+        let grids = slam.submaps.bytes() + slam.grids.bytes();
+        assert!(
+            slam.held_bytes() >= grids + 8 * points,
+            "{} held, {grids} in grids, {points} points",
+            slam.held_bytes()
+        );
+        assert!(slam.held_bytes() <= grids + 8 * points + 200 * slam.nodes.len() + 4 * points);
+        checked += usize::from(!slam.nodes.is_empty());
+    });
+    assert!(checked > 100, "{checked} scans with nodes");
+}
