@@ -14,7 +14,8 @@
 //! point per heading; so an active grid keeps a mirror of its cells as `f32`
 //! probabilities, updated with the cells each scan changes, which the matchers add up with
 //! vector instructions. [`ProbabilityGrid::freeze`] drops the mirror when the submap is
-//! finished (loop closure reads its own precomputed grids).
+//! finished (loop closure reads its own precomputed grids, and the field unpacked beside
+//! them).
 
 use super::field::Crossing;
 use crate::geometry::Point2;

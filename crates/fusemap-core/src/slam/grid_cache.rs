@@ -50,7 +50,7 @@ impl GridCache {
         Self { grids: Vec::new(), recent: VecDeque::new(), bytes: 0, budget, depth, built: 0, peak_bytes: 0 }
     }
 
-    /// Bytes of the grids held now.
+    /// Bytes of the fields and grids held now.
     pub fn bytes(&self) -> usize {
         self.bytes
     }

@@ -254,7 +254,8 @@ impl Slam {
     }
 
     /// Bytes held by the submaps' grids, the loop search's branch-and-bound grids and the
-    /// nodes' points (what grows with the log: `limits.memory_mib` holds SLAM to it).
+    /// nodes' points, what `limits.memory_mib` holds SLAM to (the scans' records and the
+    /// pose graph, a few hundred bytes a scan, are left out).
     pub fn held_bytes(&self) -> usize {
         self.submaps.bytes() + self.grids.bytes() + self.node_bytes
     }

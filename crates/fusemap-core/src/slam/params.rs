@@ -81,8 +81,9 @@ pub struct SlamParams {
     pub loop_closure_max_range_m: f64,
     /// … and at most this many of them (evenly spread).
     pub loop_closure_max_points: usize,
-    /// Memory for the finished submaps' branch-and-bound grids, MiB: past it the least
-    /// recently searched are dropped and rebuilt when needed (same results, more time).
+    /// Memory for the finished submaps' branch-and-bound grids and their unpacked fields,
+    /// MiB: past it the least recently searched are dropped and rebuilt when needed (same
+    /// results, more time).
     pub loop_closure_grid_cache_mib: usize,
     /// Only submaps whose centre is within this distance of the node are searched, metres.
     pub loop_closure_max_distance_m: f64,

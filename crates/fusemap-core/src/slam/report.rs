@@ -92,7 +92,7 @@ pub struct SlamReport {
     /// Branch-and-bound grids built for finished submaps (first builds and rebuilds after
     /// the memory budget dropped them).
     pub grids_built: u64,
-    /// The most bytes of branch-and-bound grids held at once.
+    /// The most bytes of branch-and-bound grids (and their unpacked fields) held at once.
     pub grids_peak_bytes: usize,
     /// The most bytes the submaps' grids held at once.
     pub submap_peak_bytes: usize,

@@ -73,7 +73,7 @@ pub struct Submaps {
     /// Farthest a scan may be from an active submap's start, metres (see
     /// [`insert`](Self::insert)).
     reach_m: f64,
-    /// Bytes held by the finished submaps' grids.
+    /// Bytes held by the finished submaps' packed fields.
     finished_bytes: usize,
 }
 

@@ -215,22 +215,21 @@ impl<'a> CameraSim<'a> {
     fn salt(&mut self, out: &mut NoisyFrame) {
         let p = self.cfg.label_noise_probability;
         out.salted = 0;
-        if p <= 0.0 {
-            return;
-        }
-        let mut i = 0usize;
-        loop {
-            let gap = if p >= 1.0 { 0.0 } else { ((1.0 - self.rng.next_f64()).ln() / (1.0 - p).ln()).floor() };
-            if gap >= out.labels.len() as f64 {
-                break;
+        if p > 0.0 {
+            let mut i = 0usize;
+            loop {
+                let gap = if p >= 1.0 { 0.0 } else { ((1.0 - self.rng.next_f64()).ln() / (1.0 - p).ln()).floor() };
+                if gap >= out.labels.len() as f64 {
+                    break;
+                }
+                i += gap as usize;
+                if i >= out.labels.len() {
+                    break;
+                }
+                out.labels[i] = 1 + (self.rng.next_u64() % 6) as u16;
+                out.salted += 1;
+                i += 1;
             }
-            i += gap as usize;
-            if i >= out.labels.len() {
-                break;
-            }
-            out.labels[i] = 1 + (self.rng.next_u64() % 6) as u16;
-            out.salted += 1;
-            i += 1;
         }
     }
 }
