@@ -4,12 +4,13 @@
 
 #![no_main]
 
-use fusemap_io::log::ros2::cdr::{decode_cdr, CdrDecode, CDR_LE};
+use fusemap_io::log::ros2::cdr::{decode_cdr, CDR_LE};
+use fusemap_io::log::ros2::msgs::wire::RosMsg;
 use fusemap_io::log::ros2::msgs::{nav_msgs, sensor_msgs, tf2_msgs};
 use fusemap_io::log::ros2::{decode_known, KnownType};
 use libfuzzer_sys::fuzz_target;
 
-fn check<T: CdrDecode>(payload: &[u8], kind: KnownType) {
+fn check<T: RosMsg>(payload: &[u8], kind: KnownType) {
     let typed = decode_cdr::<T>(payload);
     let converted = decode_known(kind, "/fuzz", None, payload);
     assert_eq!(typed.is_ok(), converted.is_ok(), "{kind:?}");

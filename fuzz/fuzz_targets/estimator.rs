@@ -54,14 +54,15 @@ fuzz_target!(|data: &[u8]| {
             0 => EstimatorInput::Odometry {
                 stamp,
                 pose: Pose2::new(b.f64(), b.f64(), b.f64()),
-                covariance: (b.u8() % 2 == 0).then(|| [[b.var(), 0.0, 0.0], [0.0, b.var(), 0.0], [0.0, 0.0, b.var()]]),
+                covariance: (b.u8() % 2 == 0)
+                    .then(|| [[b.var(), 0.0, 0.0], [0.0, b.var(), 0.0], [0.0, 0.0, b.var()]].into()),
             },
             1 => EstimatorInput::Gyro { stamp, yaw_rate: b.f64(), variance: (b.u8() % 2 == 0).then(|| b.var()) },
             2 => EstimatorInput::Heading { stamp, yaw: b.f64(), variance: b.var() },
             3 => EstimatorInput::Position {
                 stamp,
                 enu: [b.f64(), b.f64()],
-                covariance: [[b.var(), 0.0], [0.0, b.var()]],
+                covariance: [[b.var(), 0.0], [0.0, b.var()]].into(),
                 antenna: Point2::new(b.f64() / 100.0, b.f64() / 100.0),
                 quality: [FixQuality::RtkFixed, FixQuality::Fix, FixQuality::Sbas, FixQuality::Unknown]
                     [usize::from(b.u8() % 4)],
@@ -69,7 +70,7 @@ fuzz_target!(|data: &[u8]| {
             _ => EstimatorInput::Pose {
                 stamp,
                 pose: Pose2::new(b.f64(), b.f64(), b.f64()),
-                covariance: [[b.var(), 0.0, 0.0], [0.0, b.var(), 0.0], [0.0, 0.0, b.var()]],
+                covariance: [[b.var(), 0.0, 0.0], [0.0, b.var(), 0.0], [0.0, 0.0, b.var()]].into(),
             },
         };
         inputs.push(input);

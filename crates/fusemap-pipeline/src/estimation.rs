@@ -33,6 +33,7 @@ use fusemap_core::estimator::{
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{quaternion_yaw, Pose2, Pose3};
 use fusemap_core::time::{plausible_samples, Stamp};
+use std::sync::Arc;
 
 /// The estimator's inputs from `inv`.
 pub struct Inputs {
@@ -89,7 +90,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                     all.config.fallback_pose_sigma_rad = v;
                 }
                 for m in &inv.poses[&s.topic] {
-                    let cov = planar_covariance(&m.covariance).unwrap_or([[0.0; 3]; 3]);
+                    let cov = planar_covariance(&m.covariance).unwrap_or([[0.0; 3]; 3]).into();
                     let (stamp, pose) = (s.stamp(m.stamp), m.pose2());
                     all.inputs.push(EstimatorInput::Pose { stamp, pose, covariance: cov });
                 }
@@ -124,13 +125,13 @@ fn odometry_inputs(s: &BoundSensor, inv: &Inventory, cfg: &LogConfig, all: &mut 
         all.notes.push(glitch_note(&format!("odometry `{}`", s.topic), glitches, cfg));
     }
     all.odometry_glitches += glitches;
-    let mut prev: Option<([[f64; 3]; 3], f64)> = None;
+    let mut prev: Option<(&[[f64; 3]; 3], f64)> = None;
     for (m, _) in msgs.iter().zip(&keep).filter(|(_, k)| **k) {
-        let covariance = match (m.covariance, prev) {
-            (Some(c), Some((p, yaw))) => odometry_increment_covariance(&c, &p, yaw),
+        let covariance = match (m.covariance.as_deref(), prev) {
+            (Some(c), Some((p, yaw))) => odometry_increment_covariance(c, p, yaw).map(Arc::new),
             _ => None,
         };
-        prev = m.covariance.map(|c| (c, m.pose.theta));
+        prev = m.covariance.as_deref().map(|c| (c, m.pose.theta));
         all.inputs.push(EstimatorInput::Odometry { stamp: s.stamp(m.stamp), pose: m.pose, covariance });
     }
 }

@@ -9,6 +9,7 @@
 //! plus one merge window of scans, whatever the number of scans.
 
 use fusemap_core::config::LimitsConfig;
+use fusemap_core::estimator::share_repeated;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::time::{plausible_samples, MotionLimits, Stamp};
 use fusemap_io::log::{
@@ -17,6 +18,7 @@ use fusemap_io::log::{
 };
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// What the first pass learnt about one scan topic.
@@ -206,8 +208,9 @@ pub struct CameraInfoTopic {
 }
 
 /// One odometry message as the pipeline keeps it: what the pose track and the estimator
-/// need, not the whole message (a ten-minute log at 50 Hz is 30,000 of these).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// need, not the whole message (a ten-minute log at 50 Hz is 30,000 of these). Covariances
+/// are shared with the previous sample when equal ([`share_repeated`]).
+#[derive(Clone, Debug, PartialEq)]
 pub struct OdomSample {
     /// Header stamp.
     pub stamp: Stamp,
@@ -216,11 +219,12 @@ pub struct OdomSample {
     /// `odom_from_base` (NaN when the quaternion was zero or not finite).
     pub pose: Pose2,
     /// The (x, y, yaw) block of the message's pose covariance, when usable.
-    pub covariance: Option<[[f64; 3]; 3]>,
+    pub covariance: Option<Arc<[[f64; 3]; 3]>>,
 }
 
-/// One IMU message as the pipeline keeps it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// One IMU message as the pipeline keeps it (an hour at 100 Hz is 360,000 of these; the
+/// rate covariance is shared with the previous sample when equal).
+#[derive(Clone, Debug, PartialEq)]
 pub struct ImuSample {
     /// Header stamp.
     pub stamp: Stamp,
@@ -230,7 +234,7 @@ pub struct ImuSample {
     pub angular_velocity: [f64; 3],
     /// `angular_velocity_covariance`, row-major in the IMU's frame; `[0] = -1` means the
     /// message carries no rate (sensor_msgs/Imu).
-    pub rate_covariance: [f64; 9],
+    pub rate_covariance: Arc<[f64; 9]>,
     /// The orientation and `orientation_covariance[8]` (yaw variance), when the message
     /// provides one (REP 145).
     pub orientation: Option<([f64; 4], f64)>,
@@ -250,24 +254,23 @@ pub fn planar_covariance(c: &[f64; 36]) -> Option<[[f64; 3]; 3]> {
     ok.then_some(m)
 }
 
-impl From<&OdomMessage> for OdomSample {
-    fn from(m: &OdomMessage) -> Self {
-        Self {
-            stamp: m.stamp,
-            receive_stamp: m.receive_stamp,
-            pose: m.pose,
-            covariance: planar_covariance(&m.pose_covariance),
-        }
+impl OdomSample {
+    /// The sample of `m`, its covariance shared with `previous`'s when equal.
+    pub fn new(m: &OdomMessage, previous: Option<&OdomSample>) -> Self {
+        let covariance = planar_covariance(&m.pose_covariance)
+            .map(|c| share_repeated(previous.and_then(|p| p.covariance.as_ref()), c));
+        Self { stamp: m.stamp, receive_stamp: m.receive_stamp, pose: m.pose, covariance }
     }
 }
 
-impl From<&ImuMessage> for ImuSample {
-    fn from(m: &ImuMessage) -> Self {
+impl ImuSample {
+    /// The sample of `m`, its rate covariance shared with `previous`'s when equal.
+    pub fn new(m: &ImuMessage, previous: Option<&ImuSample>) -> Self {
         Self {
             stamp: m.stamp,
             receive_stamp: m.receive_stamp,
             angular_velocity: m.angular_velocity,
-            rate_covariance: m.angular_velocity_covariance,
+            rate_covariance: share_repeated(previous.map(|p| &p.rate_covariance), m.angular_velocity_covariance),
             orientation: m.has_orientation().then_some((m.orientation, m.orientation_covariance[8])),
         }
     }
@@ -381,11 +384,13 @@ impl Inventory {
                 LogMessage::Scan(s) => inv.scans.entry(s.topic.clone()).or_default().add(s),
                 LogMessage::Odometry(o) => {
                     inv.frames.entry(o.topic.clone()).or_insert_with(|| o.frame_id.clone());
-                    inv.odom.entry(o.topic.clone()).or_default().push(OdomSample::from(&o));
+                    let samples = inv.odom.entry(o.topic.clone()).or_default();
+                    samples.push(OdomSample::new(&o, samples.last()));
                 }
                 LogMessage::Imu(i) => {
                     inv.frames.entry(i.topic.clone()).or_insert_with(|| i.frame_id.clone());
-                    inv.imu.entry(i.topic.clone()).or_default().push(ImuSample::from(&i));
+                    let samples = inv.imu.entry(i.topic.clone()).or_default();
+                    samples.push(ImuSample::new(&i, samples.last()));
                 }
                 LogMessage::Gnss(g) => inv.gnss.entry(g.topic.clone()).or_default().push(g),
                 LogMessage::Pose(p) => inv.poses.entry(p.topic.clone()).or_default().push(p),

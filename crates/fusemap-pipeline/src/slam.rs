@@ -316,7 +316,7 @@ fn fixes(
             EstimatorInput::Position { stamp, enu, covariance, antenna, quality } => Some(PositionFix {
                 stamp,
                 position: Point2::new(enu[0], enu[1]),
-                covariance,
+                covariance: *covariance,
                 antenna,
                 correlation_time_s: match quality {
                     FixQuality::RtkFixed if covariance[0][0].max(covariance[1][1]) <= rtk_var => {

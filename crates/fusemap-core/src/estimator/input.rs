@@ -7,6 +7,7 @@ use crate::geometry::{Point2, Pose2};
 use crate::time::Stamp;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
+use std::sync::Arc;
 
 /// The quality of a GNSS fix, as the caller maps its receiver's status (NavSatFix
 /// `status`, NMEA GGA quality). Used for reporting; the weight of a fix is its covariance,
@@ -46,7 +47,9 @@ pub enum EstimatorInput {
         /// Covariance of (x, y, yaw), read as the covariance of the increment since the
         /// previous message in the base frame at that message (ROS drivers differ; when it
         /// is absent or not positive definite the configuration's noise model is used).
-        covariance: Option<[[f64; 3]; 3]>,
+        /// Shared: a driver repeats one matrix in message after message, and an hour's
+        /// log holds a few hundred thousand of these inputs.
+        covariance: Option<Arc<[[f64; 3]; 3]>>,
     },
     /// Gyro z rate.
     Gyro {
@@ -73,8 +76,8 @@ pub enum EstimatorInput {
         stamp: Stamp,
         /// Antenna position, metres.
         enu: [f64; 2],
-        /// Covariance, m² (already floored per fix status by the caller).
-        covariance: [[f64; 2]; 2],
+        /// Covariance, m² (already floored per fix status by the caller); shared, as above.
+        covariance: Arc<[[f64; 2]; 2]>,
         /// The antenna in the base frame (`base_from_antenna` translation).
         antenna: Point2,
         /// Reported fix quality.
@@ -86,8 +89,8 @@ pub enum EstimatorInput {
         stamp: Stamp,
         /// `map_from_base`.
         pose: Pose2,
-        /// Covariance of (x, y, yaw).
-        covariance: [[f64; 3]; 3],
+        /// Covariance of (x, y, yaw); shared, as above.
+        covariance: Arc<[[f64; 3]; 3]>,
     },
 }
 
@@ -104,6 +107,16 @@ impl EstimatorInput {
     }
 }
 
+/// `value`, shared with `previous` when the two are equal: a driver repeats one covariance
+/// in message after message, and an hour's log holds hundreds of thousands of messages, so
+/// the inputs and the first pass keep one copy of a run of equal matrices.
+pub fn share_repeated<T: PartialEq>(previous: Option<&Arc<T>>, value: T) -> Arc<T> {
+    match previous {
+        Some(p) if **p == value => Arc::clone(p),
+        _ => Arc::new(value),
+    }
+}
+
 /// A validated correction.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Correction {
@@ -116,7 +129,7 @@ pub(crate) enum Correction {
 pub(crate) struct RawOdometry {
     pub stamps: Vec<Stamp>,
     pub poses: Vec<Pose2>,
-    pub covariances: Vec<Option<Mat<3, 3>>>,
+    pub covariances: Vec<Option<Arc<Mat<3, 3>>>>,
 }
 
 /// Gyro samples (finite, strictly increasing stamps) with their variances.
@@ -207,14 +220,14 @@ pub(crate) fn sort_inputs(
             count_insane(&inputs[i], &mut s.counts);
             continue;
         }
-        match inputs[i] {
-            EstimatorInput::Odometry { stamp, pose, covariance } => s.odometry(stamp, pose, covariance),
-            EstimatorInput::Gyro { stamp, yaw_rate, variance } => s.gyro(stamp, yaw_rate, variance),
-            EstimatorInput::Heading { stamp, yaw, variance } => s.heading(stamp, yaw, variance),
-            EstimatorInput::Position { stamp, enu, covariance, antenna, quality } => {
-                s.position(stamp, enu, covariance, antenna, quality)
+        match &inputs[i] {
+            EstimatorInput::Odometry { stamp, pose, covariance } => s.odometry(*stamp, *pose, covariance.as_ref()),
+            &EstimatorInput::Gyro { stamp, yaw_rate, variance } => s.gyro(stamp, yaw_rate, variance),
+            &EstimatorInput::Heading { stamp, yaw, variance } => s.heading(stamp, yaw, variance),
+            &EstimatorInput::Position { stamp, enu, ref covariance, antenna, quality } => {
+                s.position(stamp, enu, **covariance, antenna, quality)
             }
-            EstimatorInput::Pose { stamp, pose, covariance } => s.pose(stamp, pose, covariance),
+            EstimatorInput::Pose { stamp, pose, covariance } => s.pose(*stamp, *pose, **covariance),
         }
     }
     let Sorter { mut counts, odometry, gyro, corrections, .. } = s;
@@ -235,7 +248,7 @@ struct Sorter<'a> {
 impl Sorter<'_> {
     /// An odometry pose: a position, at a new stamp; its covariance where it is usable
     /// and asked for.
-    fn odometry(&mut self, stamp: Stamp, pose: Pose2, covariance: Option<[[f64; 3]; 3]>) {
+    fn odometry(&mut self, stamp: Stamp, pose: Pose2, covariance: Option<&Arc<[[f64; 3]; 3]>>) {
         let counts = &mut self.counts.odometry;
         counts.received += 1;
         if !pose.is_position() {
@@ -248,8 +261,8 @@ impl Sorter<'_> {
         }
         let cov = match covariance {
             Some(c) if self.cfg.use_odometry_covariance => {
-                if finite3(&c) && is_spd(&c) {
-                    Some(c)
+                if finite3(c) && is_spd(c) {
+                    Some(Arc::clone(c))
                 } else {
                     counts.covariance_fallbacks += 1;
                     None
@@ -352,6 +365,26 @@ mod tests {
     use crate::estimator::estimate;
     use crate::time::PoseTrack;
 
+    #[test]
+    fn equal_matrices_in_a_row_share_one_copy() {
+        let a = share_repeated(None, [[1.0, 0.0], [0.0, 1.0]]);
+        let b = share_repeated(Some(&a), [[1.0, 0.0], [0.0, 1.0]]);
+        assert!(Arc::ptr_eq(&a, &b));
+        let c = share_repeated(Some(&b), [[2.0, 0.0], [0.0, 1.0]]);
+        assert!(!Arc::ptr_eq(&b, &c));
+        assert_eq!(*c, [[2.0, 0.0], [0.0, 1.0]]);
+        // NaN equals nothing: never shared, never lost.
+        let n = share_repeated(None, f64::NAN);
+        assert!(!Arc::ptr_eq(&n, &share_repeated(Some(&n), f64::NAN)));
+    }
+
+    /// An hour's log gives the estimator hundreds of thousands of inputs: the matrices are
+    /// shared, not inline, so an input stays small.
+    #[test]
+    fn an_input_is_at_most_56_bytes() {
+        assert!(std::mem::size_of::<EstimatorInput>() <= 56, "{}", std::mem::size_of::<EstimatorInput>());
+    }
+
     /// Found by the estimator fuzz target: a heading claiming a variance of 10¹²² and an
     /// absolute pose 10¹²² m out made the smoother hand out NaN poses.
     #[test]
@@ -365,7 +398,7 @@ mod tests {
         inputs.push(EstimatorInput::Heading { stamp: Stamp(1_995_000_000), yaw: 0.0, variance: 2.6e122 });
         let r = [[0.23, 0.0, 0.0], [0.0, 0.23, 0.0], [0.0, 0.0, 0.27]];
         let pose = Pose2::new(2.6e122, 32.5, 0.0);
-        inputs.push(EstimatorInput::Pose { stamp: Stamp(2_395_000_000), pose, covariance: r });
+        inputs.push(EstimatorInput::Pose { stamp: Stamp(2_395_000_000), pose, covariance: r.into() });
         if let Ok(e) = estimate(&inputs, &EstimatorConfig::default()) {
             assert!(e.samples().iter().all(|(_, p)| p.is_finite()));
             assert_eq!(e.report.poses.rejected_not_finite, 1, "the pose 10¹²² m out is no pose");

@@ -243,7 +243,7 @@ fn non_finite_inputs_are_counted_not_fatal() {
     inputs.push(EstimatorInput::Odometry {
         stamp: Stamp(30_000_000),
         pose: Pose2::new(0.03, 0.0, 0.0),
-        covariance: Some([[nan; 3]; 3]),
+        covariance: Some([[nan; 3]; 3].into()),
     });
     for i in 0..400 {
         let rate = if i == 7 { nan } else { 0.0 };
@@ -255,7 +255,7 @@ fn non_finite_inputs_are_counted_not_fatal() {
     let fix = |t: i64, enu: [f64; 2], cov: f64| EstimatorInput::Position {
         stamp: Stamp(t),
         enu,
-        covariance: [[cov, 0.0], [0.0, cov]],
+        covariance: [[cov, 0.0], [0.0, cov]].into(),
         antenna: Point2::default(),
         quality: FixQuality::Unknown,
     };
@@ -266,12 +266,12 @@ fn non_finite_inputs_are_counted_not_fatal() {
     inputs.push(EstimatorInput::Pose {
         stamp: Stamp(3_000_000_000),
         pose: Pose2::new(0.6, 0.0, nan),
-        covariance: [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]],
+        covariance: [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]].into(),
     });
     inputs.push(EstimatorInput::Pose {
         stamp: Stamp(3_100_000_000),
         pose: Pose2::new(0.62, 0.0, 0.0),
-        covariance: [[nan; 3]; 3],
+        covariance: [[nan; 3]; 3].into(),
     });
     let est = estimate(&inputs, &EstimatorConfig::default()).unwrap();
     let r = &est.report;
@@ -304,7 +304,7 @@ fn refusals_are_explicit() {
         inputs.push(EstimatorInput::Position {
             stamp: Stamp(i * 200_000_000),
             enu: [0.2 * i as f64, 0.0],
-            covariance: [[1e-4, 0.0], [0.0, 1e-4]],
+            covariance: [[1e-4, 0.0], [0.0, 1e-4]].into(),
             antenna: Point2::default(),
             quality: FixQuality::RtkFixed,
         });
@@ -409,7 +409,7 @@ fn imprecise_fixes_still_initialise_the_heading() {
         if let EstimatorInput::Position { enu, covariance, quality, .. } = input {
             enu[0] += 0.8 * gaussian(&mut rng);
             enu[1] += 0.8 * gaussian(&mut rng);
-            *covariance = [[1.0, 0.0], [0.0, 1.0]];
+            *covariance = [[1.0, 0.0], [0.0, 1.0]].into();
             *quality = FixQuality::Fix;
         }
     }
@@ -455,7 +455,7 @@ fn odometry_covariance_from_the_messages_is_used() {
     let mut drive = simulate(&DriveSpec::standard(7));
     for input in &mut drive.inputs {
         if let EstimatorInput::Odometry { covariance, .. } = input {
-            *covariance = Some([[1e-5, 0.0, 0.0], [0.0, 1e-5, 0.0], [0.0, 0.0, 1e-5]]);
+            *covariance = Some([[1e-5, 0.0, 0.0], [0.0, 1e-5, 0.0], [0.0, 0.0, 1e-5]].into());
         }
     }
     let est = estimate(&drive.inputs, &EstimatorConfig::default()).unwrap();

@@ -30,7 +30,7 @@ pub(crate) fn flagged_fixes(
     let rejected: HashSet<Stamp> = first.report.rejected_fixes.iter().map(|r| r.stamp).collect();
     let mut out = Vec::new();
     for (index, i) in inputs.iter().enumerate() {
-        let EstimatorInput::Position { stamp, enu, covariance, antenna, .. } = *i else { continue };
+        let &EstimatorInput::Position { stamp, enu, ref covariance, antenna, .. } = i else { continue };
         if rejected.contains(&stamp) {
             continue;
         }
@@ -38,7 +38,7 @@ pub(crate) fn flagged_fixes(
         let x = [pose.x, pose.y, pose.theta, 0.0, 1.0];
         let (nu, h) = models::position(&x, enu, antenna);
         // S = H P Hᵀ + R over the pose block.
-        let mut s = covariance;
+        let mut s = **covariance;
         for (r, s_row) in s.iter_mut().enumerate() {
             for (c, v) in s_row.iter_mut().enumerate() {
                 for a in 0..3 {

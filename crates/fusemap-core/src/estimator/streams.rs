@@ -50,7 +50,7 @@ impl OdometryTrack {
             let dt = raw.stamps[i].secs_since(raw.stamps[i - 1]);
             let d = delta.x.hypot(delta.y);
             let gap = dt > cfg.max_odometry_gap_s;
-            let mut cov = raw.covariances[i].unwrap_or_else(|| {
+            let mut cov = raw.covariances[i].as_deref().copied().unwrap_or_else(|| {
                 let vt =
                     cfg.odometry_translation_noise.powi(2) * d + cfg.odometry_translation_noise_per_sqrt_s.powi(2) * dt;
                 let vr = cfg.odometry_rotation_noise_per_rad.powi(2) * delta.theta.abs()

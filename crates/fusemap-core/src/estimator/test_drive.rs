@@ -209,7 +209,7 @@ pub(crate) fn simulate(spec: &DriveSpec) -> Drive {
             inputs.push(EstimatorInput::Position {
                 stamp: stamp(i),
                 enu: [antenna.x + err[0], antenna.y + err[1]],
-                covariance: [[sigma * sigma, 0.0], [0.0, sigma * sigma]],
+                covariance: [[sigma * sigma, 0.0], [0.0, sigma * sigma]].into(),
                 antenna: spec.antenna,
                 quality,
             });
