@@ -104,7 +104,7 @@ const FLAT: f64 = 1e-3;
 /// points' mount rotation centre applied by `cost`.
 struct Scorer<'a> {
     frames: Vec<(&'a CameraSample, usize)>,
-    pose_at: &'a dyn Fn(Stamp) -> Option<Pose2>,
+    pose_at: &'a (dyn Fn(Stamp) -> Option<Pose2> + Sync),
     field: &'a DistanceField,
     centre: Point2,
     points: usize,
@@ -135,14 +135,13 @@ impl Scorer<'_> {
     }
 
     /// The costs over `values` of one parameter, the other fixed: `(value, block sums)`.
-    fn curve(&self, values: &[f64], at: impl Fn(f64) -> (f64, f64)) -> Vec<(f64, Vec<f64>)> {
-        values
-            .iter()
-            .map(|&v| {
-                let (dt, eps) = at(v);
-                (v, self.blocks(dt, eps))
-            })
-            .collect()
+    /// The values are scored on every thread, each by one thread and collected in order,
+    /// so the curve is the same whatever the thread count.
+    fn curve(&self, values: &[f64], at: impl Fn(f64) -> (f64, f64) + Sync + Send) -> Vec<(f64, Vec<f64>)> {
+        crate::parallel::map_all(values, |&v| {
+            let (dt, eps) = at(v);
+            (v, self.blocks(dt, eps))
+        })
     }
 
     /// `√(mean)` of a total.
@@ -218,7 +217,7 @@ fn flat(curve: &[(f64, Vec<f64>)]) -> bool {
 pub fn camera_against_map(
     samples: &[CameraSample],
     centre: Point2,
-    pose_at: &dyn Fn(Stamp) -> Option<Pose2>,
+    pose_at: &(dyn Fn(Stamp) -> Option<Pose2> + Sync),
     field: &DistanceField,
     search: &CameraSearch,
 ) -> Result<CameraLidarFit, String> {
@@ -364,6 +363,21 @@ mod tests {
         assert!((yaw.value + 3f64.to_radians()).abs() < 0.1f64.to_radians(), "{yaw:?}");
         assert!(fit.cost_after_m < 0.2 * fit.cost_before_m, "{fit:?}");
         assert!(fit.clock_curve.windows(2).all(|w| w[0][0] < w[1][0]));
+    }
+
+    /// The curves are scored on every thread: the fit is the same to the bit on one.
+    #[cfg(feature = "parallel")]
+    #[test]
+    fn the_fit_is_the_same_on_one_thread_and_on_two() {
+        let field = room();
+        let centre = Point2::new(0.3, 0.0);
+        let (samples, at) = frames(0.5, 0.04, 3f64.to_radians(), centre);
+        let fit = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let f = pool.install(|| camera_against_map(&samples, centre, &at, &field, &CameraSearch::default()));
+            format!("{:?}", f.unwrap())
+        };
+        assert_eq!(fit(1), fit(2));
     }
 
     #[test]

@@ -14,7 +14,7 @@ use fusemap_sim::{simulate, Scenario, SimRecording};
 use std::sync::OnceLock;
 
 struct Fixture {
-    rec: SimRecording,
+    rec: &'static SimRecording,
     run: MapRun,
     scores: Vec<MapScore>,
 }
@@ -41,13 +41,11 @@ fn scores_of(rec: &SimRecording, run: &MapRun, plan: &fusemap_core::config::Plan
 fn fixture() -> &'static Fixture {
     static F: OnceLock<Fixture> = OnceLock::new();
     F.get_or_init(|| {
-        let rec = simulate(&Scenario::default()).expect("the default scenario simulates");
-        let dir = fusemap_io::testdata::temp_dir("camera-scenario");
-        let bag = dir.join("bag");
-        fusemap_sim::bag::write_bag(&rec, &bag, true).expect("the bag is written");
+        // The test binary's one simulation of the default line and its bag.
+        let rec = crate::validation::recording();
         let plan = production_line_plan().unwrap();
-        let run = map(&bag, &plan, three_maps(&plan));
-        let scores = scores_of(&rec, &run, &plan);
+        let run = map(crate::validation::bag(), &plan, three_maps(&plan));
+        let scores = scores_of(rec, &run, &plan);
         for s in &scores {
             eprintln!("{}", serde_json::to_string(s).unwrap());
         }

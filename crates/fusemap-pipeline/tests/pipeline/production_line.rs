@@ -20,26 +20,23 @@ use fusemap_pipeline::recording::Inventory;
 use fusemap_pipeline::run::{prepare, prepare_track, topics_by_kind};
 use fusemap_pipeline::track::{ChosenTrack, Track};
 use fusemap_pipeline::{estimation, map_with_track, sensors};
-use fusemap_sim::{simulate, Scenario, SimRecording};
+use fusemap_sim::SimRecording;
 use std::collections::HashSet;
 use std::sync::OnceLock;
 
 struct Fixture {
-    rec: SimRecording,
+    rec: &'static SimRecording,
     inv: Inventory,
     plan: Plan,
 }
 
-/// One simulated run for every test of this file (it takes a second to make).
+/// One simulated run for every test of this file: the test binary's one simulation of the
+/// default production line and its bag ([`crate::validation::recording`]).
 fn fixture() -> &'static Fixture {
     static F: OnceLock<Fixture> = OnceLock::new();
     F.get_or_init(|| {
-        let scenario = Scenario::default();
-        let rec = simulate(&scenario).expect("the default scenario simulates");
-        let dir = fusemap_io::testdata::fixture_dir(env!("CARGO_TARGET_TMPDIR"), "production-line");
-        let bag = dir.join("bag");
-        fusemap_sim::bag::write_bag(&rec, &bag, true).expect("the bag is written");
-        let inv = Inventory::read(&bag).expect("the bag reads back");
+        let rec = crate::validation::recording();
+        let inv = Inventory::read(crate::validation::bag()).expect("the bag reads back");
         let mut cfg = Config::default();
         // The map frame of the simulator: ENU at its datum.
         let d = &rec.datum;
