@@ -62,13 +62,23 @@ pub struct DistanceField {
     /// World position of the centre of cell (row 0, column 0).
     first_centre: Point2,
     max_m: f64,
-    /// Per cell, the index of its nearest face cell (`u32::MAX` only before a face exists).
-    nearest: Vec<u32>,
-    /// Per cell, its surface point (faces only; others unused).
-    surface: Vec<Point2>,
-    /// Per face cell, the wall's direction through it (unit), when the faces around it
-    /// lie on a line; `None` at a corner or an isolated face.
-    along: Vec<Option<Point2>>,
+    /// Cell `i`'s candidate pieces are `candidates[starts[i]..starts[i + 1]]`: the pieces
+    /// of the faces nearest it and its eight neighbours, each once. Listed when the field
+    /// is built, so that [`DistanceField::at`], called for every point at every step of a
+    /// calibration's searches, reads one short list instead of nine cells.
+    starts: Vec<usize>,
+    /// Indices into `pieces`.
+    candidates: Vec<u32>,
+    /// One per face.
+    pieces: Vec<Piece>,
+}
+
+/// A face's piece of wall: its surface point, and the wall's direction through it (unit)
+/// when the faces around it lie on a line (`None` at a corner or an isolated face).
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    surface: Point2,
+    along: Option<Point2>,
 }
 
 /// Faces within this many cells of a face fit its wall's direction.
@@ -157,8 +167,15 @@ impl DistanceField {
                 }
             })
             .collect();
-        let along = (0..w * h).map(|i| if faces[i] { direction(w, h, i, &faces, &surface) } else { None }).collect();
-        Some(Self { width: w, height: h, resolution: res, first_centre, max_m, nearest, surface, along })
+        // Pieces numbered in cell order, one per face.
+        let mut piece_of = vec![u32::MAX; w * h];
+        let mut pieces = Vec::new();
+        for i in (0..w * h).filter(|&i| faces[i]) {
+            piece_of[i] = pieces.len() as u32;
+            pieces.push(Piece { surface: surface[i], along: direction(w, h, i, &faces, &surface) });
+        }
+        let (starts, candidates) = candidate_lists(w, h, &nearest, &piece_of);
+        Some(Self { width: w, height: h, resolution: res, first_centre, max_m, starts, candidates, pieces })
     }
 
     /// The truncation distance, metres.
@@ -172,36 +189,54 @@ impl DistanceField {
     /// on it, as in point-to-line ICP; a corner: its surface point); `max_m` outside the
     /// raster or farther.
     pub fn at(&self, p: Point2) -> f64 {
-        let u = ((p.x - self.first_centre.x) / self.resolution).round();
-        let v = ((p.y - self.first_centre.y) / self.resolution).round();
+        // The nearest cell centre, ⌊x + ½⌋ on the cell grid (truncation is the floor once
+        // the range is checked; it spares a call to libm's `round` per point).
+        let u = (p.x - self.first_centre.x) / self.resolution + 0.5;
+        let v = (p.y - self.first_centre.y) / self.resolution + 0.5;
         if !(u >= 0.0 && v >= 0.0 && u < self.width as f64 && v < self.height as f64) {
             return self.max_m;
         }
-        let (i, j) = (u as usize, v as usize);
+        let cell = v as usize * self.width + u as usize;
         let mut best = self.max_m * self.max_m;
-        // Neighbouring cells mostly share their nearest face: each face is scored once
-        // (the least over the same set, so the same result; a calibration calls this for
-        // every point at every step of its searches).
-        let (mut seen, mut n) = ([u32::MAX; 9], 0);
-        for jj in j.saturating_sub(1)..(j + 2).min(self.height) {
-            for ii in i.saturating_sub(1)..(i + 2).min(self.width) {
-                let f = self.nearest[jj * self.width + ii];
-                if f != u32::MAX && !seen[..n].contains(&f) {
-                    (seen[n], n) = (f, n + 1);
-                    best = best.min(self.piece_distance2(f as usize, p));
-                }
-            }
+        for &c in &self.candidates[self.starts[cell]..self.starts[cell + 1]] {
+            best = best.min(self.piece_distance2(&self.pieces[c as usize], p));
         }
         best.sqrt()
     }
 }
 
+/// For every cell, the pieces of the faces nearest it and its eight neighbours, each once
+/// (neighbouring cells mostly share their nearest face), as `(starts, candidates)`.
+fn candidate_lists(w: usize, h: usize, nearest: &[u32], piece_of: &[u32]) -> (Vec<usize>, Vec<u32>) {
+    let mut starts = Vec::with_capacity(w * h + 1);
+    let mut candidates = Vec::with_capacity(w * h);
+    starts.push(0);
+    for j in 0..h {
+        for i in 0..w {
+            let first = candidates.len();
+            for jj in j.saturating_sub(1)..(j + 2).min(h) {
+                for ii in i.saturating_sub(1)..(i + 2).min(w) {
+                    let f = nearest[jj * w + ii];
+                    if f != u32::MAX {
+                        let piece = piece_of[f as usize];
+                        if !candidates[first..].contains(&piece) {
+                            candidates.push(piece);
+                        }
+                    }
+                }
+            }
+            starts.push(candidates.len());
+        }
+    }
+    (starts, candidates)
+}
+
 impl DistanceField {
-    /// The squared distance from `p` to face `f`'s piece of wall.
-    fn piece_distance2(&self, f: usize, p: Point2) -> f64 {
-        let s = self.surface[f];
+    /// The squared distance from `p` to a face's piece of wall.
+    fn piece_distance2(&self, piece: &Piece, p: Point2) -> f64 {
+        let s = piece.surface;
         let (dx, dy) = (p.x - s.x, p.y - s.y);
-        match self.along[f] {
+        match piece.along {
             Some(t) => {
                 let a = dx * t.x + dy * t.y;
                 let n = -dx * t.y + dy * t.x;
