@@ -236,7 +236,10 @@ fn estimate_without_unusable_fixes(
 /// Runs the estimator and its smoother over the log's pose sensors.
 pub fn estimator_track(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<ChosenTrack, PipelineError> {
     let Inputs { inputs, gnss, config, mut notes, odometry_glitches } = inputs(plan, inv, bound)?;
-    let (e, inputs) = estimate_without_unusable_fixes(inputs, &config, &mut notes)?;
+    let (mut e, inputs) = estimate_without_unusable_fixes(inputs, &config, &mut notes)?;
+    // The map pass reads the smoothed track; the filter's own samples (a sample a step,
+    // 22 MB an hour of 40 Hz odometry) would only be held through it.
+    e.filtered = Vec::new();
     if e.report.gate_resets_refused > 0 {
         notes.push(format!(
             "GNSS: {} fixes rejected by the filter's gate; {} times a run of them (and the fixes after it) agreed with each other but lay farther from the track than the odometry could have drifted since the last fix taken (estimator.gate_reset_max_drift = {} of the distance driven): a jump of the receiver, not followed",
