@@ -55,7 +55,7 @@ impl CorrectedTrack {
             Err(i) if i == c.len() => c[i - 1].1,
             Err(i) => {
                 let ((t0, a, _, _), (t1, b, _, _)) = (c[i - 1], c[i]);
-                a.interpolate(b, (t.0 - t0.0) as f64 / (t1.0 - t0.0) as f64)
+                a.interpolate(b, fraction(t0, t1, t))
             }
         }
     }
@@ -63,22 +63,48 @@ impl CorrectedTrack {
     /// Between two scans across which the base track moves faster than a robot can (it
     /// jumped between them), the optimised poses interpolated: the base track holds the
     /// jump, the scans were placed by the lidar. Equal stamps say nothing of speed.
-    fn across_jump(&self, t: Stamp) -> Option<Pose2> {
+    /// Under [`SyncMode::Nearest`] the nearer scan's pose instead ([`between`]).
+    fn across_jump(&self, t: Stamp, mode: SyncMode) -> Option<Result<Pose2, NoPose>> {
         let c = &self.corrections;
         let i = c.partition_point(|x| x.0 < t);
         let ((t0, _, p0, b0), (t1, _, p1, b1)) = (*c.get(i.checked_sub(1)?)?, *c.get(i)?);
         (t1 != t && t1 != t0 && !self.limits.plausible((t0, b0), (t1, b1)))
-            .then(|| p0.interpolate(p1, (t.0 - t0.0) as f64 / (t1.0 - t0.0) as f64))
+            .then(|| between((t0, p0), (t1, p1), t, mode))
+    }
+}
+
+/// Where `t` lies from `t0` to `t1`, as a fraction (in `i128`: two stamps of a hostile log
+/// can lie further apart than `i64` holds).
+fn fraction(t0: Stamp, t1: Stamp, t: Stamp) -> f64 {
+    (i128::from(t.0) - i128::from(t0.0)) as f64 / (i128::from(t1.0) - i128::from(t0.0)) as f64
+}
+
+/// The pose at `t` between two optimised scan poses under `mode`: interpolated, or under
+/// [`SyncMode::Nearest`] the nearer one (the earlier on a tie) when within the tolerance,
+/// as [`crate::time::PoseBuffer::nearest`] picks a sample.
+fn between(a: (Stamp, Pose2), b: (Stamp, Pose2), t: Stamp, mode: SyncMode) -> Result<Pose2, NoPose> {
+    match mode {
+        SyncMode::Interpolate => Ok(a.1.interpolate(b.1, fraction(a.0, b.0, t))),
+        SyncMode::Nearest { tolerance_s } => {
+            let away = |s: Stamp| (i128::from(s.0) - i128::from(t.0)).unsigned_abs() as f64 * 1e-9;
+            let (d, p) = if away(a.0) <= away(b.0) { (away(a.0), a.1) } else { (away(b.0), b.1) };
+            if d <= tolerance_s {
+                Ok(p)
+            } else {
+                Err(NoPose::TooFar { distance_s: d, tolerance_s })
+            }
+        }
     }
 }
 
 impl PoseTrack for CorrectedTrack {
     /// Inside a gap of the base track, or across a jump of it, between two scans SLAM
     /// matched, the optimised poses themselves are interpolated: the scans were placed by
-    /// the lidar.
+    /// the lidar. Under [`SyncMode::Nearest`] those are the nearer scan's pose, within the
+    /// tolerance, as the base track's samples are.
     fn pose_at(&self, t: Stamp, mode: SyncMode) -> Result<Pose2, NoPose> {
-        if let Some(p) = self.across_jump(t) {
-            return Ok(p);
+        if let Some(p) = self.across_jump(t, mode) {
+            return p;
         }
         match self.base.pose_at(t, mode) {
             Ok(p) => Ok(self.correction_at(t).compose(p)),
@@ -86,7 +112,7 @@ impl PoseTrack for CorrectedTrack {
                 let i = self.slam.partition_point(|s| s.0 < t);
                 match (i.checked_sub(1).and_then(|j| self.slam.get(j)), self.slam.get(i)) {
                     (_, Some(b)) if b.0 == t => Ok(b.1),
-                    (Some(a), Some(b)) => Ok(a.1.interpolate(b.1, (t.0 - a.0 .0) as f64 / (b.0 .0 - a.0 .0) as f64)),
+                    (Some(&a), Some(&b)) => between(a, b, t, mode),
                     _ => Err(e),
                 }
             }
@@ -105,7 +131,10 @@ impl PoseTrack for CorrectedTrack {
     /// interpolated, as [`pose_at`](Self::pose_at) gives them).
     fn samples(&self) -> Vec<(Stamp, Pose2)> {
         (self.base.samples().into_iter())
-            .map(|(t, p)| (t, self.across_jump(t).unwrap_or_else(|| self.correction_at(t).compose(p))))
+            .map(|(t, p)| {
+                let jumped = self.across_jump(t, SyncMode::Interpolate).and_then(Result::ok);
+                (t, jumped.unwrap_or_else(|| self.correction_at(t).compose(p)))
+            })
             .collect()
     }
 }
@@ -161,5 +190,30 @@ mod tests {
             let p = track.pose_at(Stamp(t * 1_000_000), SyncMode::Interpolate).unwrap();
             assert!((0.3..=0.6).contains(&p.x), "{t} ms: {p:?}");
         }
+        // Nearest-neighbour sync takes the nearer scan's pose there, within its tolerance.
+        let nearest =
+            |ms: i64, tolerance_s: f64| track.pose_at(Stamp(ms * 1_000_000), SyncMode::Nearest { tolerance_s });
+        assert_eq!(nearest(430, 0.05).unwrap(), slam[4].1);
+        assert_eq!(nearest(470, 0.05).unwrap(), slam[5].1);
+        assert!(matches!(nearest(450, 0.04), Err(NoPose::TooFar { .. })));
+    }
+
+    /// Inside a gap of the base track the optimised poses stand in for it: interpolated,
+    /// or the nearer one under nearest-neighbour sync (refused beyond its tolerance).
+    #[test]
+    fn inside_a_gap_of_the_track_the_sync_mode_is_kept() {
+        let mut odo = PoseBuffer::new(0.15);
+        for k in [0, 1, 2, 3, 4, 9, 10] {
+            odo.push(Stamp(k * 100_000_000), Pose2::new(k as f64 * 0.1, 0.0, 0.0));
+        }
+        let slam: Vec<(Stamp, Pose2)> =
+            [0, 4, 9, 10].iter().map(|&k| (Stamp(k * 100_000_000), Pose2::new(k as f64 * 0.1, 1.0, 0.0))).collect();
+        let track = CorrectedTrack::new(Box::new(odo), &slam, limits());
+        let at = |ms: i64, mode| track.pose_at(Stamp(ms * 1_000_000), mode);
+        let p = at(650, SyncMode::Interpolate).unwrap();
+        assert!((p.x - 0.65).abs() < 1e-12 && (p.y - 1.0).abs() < 1e-12, "{p:?}");
+        assert_eq!(at(450, SyncMode::Nearest { tolerance_s: 0.1 }).unwrap(), slam[1].1);
+        assert_eq!(at(850, SyncMode::Nearest { tolerance_s: 0.1 }).unwrap(), slam[2].1);
+        assert!(matches!(at(650, SyncMode::Nearest { tolerance_s: 0.1 }), Err(NoPose::TooFar { .. })));
     }
 }

@@ -182,10 +182,11 @@ impl PoseBuffer {
             return Err(NoPose::Empty);
         }
         let i = self.stamps.partition_point(|&s| s < t);
-        let mut best: Option<(i64, usize)> = None;
+        // In i128: two stamps of a hostile log can lie further apart than i64 holds.
+        let mut best: Option<(u128, usize)> = None;
         for j in [i.wrapping_sub(1), i] {
             if let Some(&s) = self.stamps.get(j) {
-                let d = (s.0 - t.0).abs();
+                let d = (i128::from(s.0) - i128::from(t.0)).unsigned_abs();
                 if best.is_none_or(|(bd, _)| d < bd) {
                     best = Some((d, j));
                 }
