@@ -158,8 +158,8 @@ pub(crate) fn estimate_held(
     };
     let fix_slip = slip_fixes::FixSlipCheck::new(&sorted.corrections, &odo, cfg);
     let sources = run::MotionSources { odo: &odo, gyro: gyro.as_ref(), slip: &slip, fix_slip: &fix_slip };
-    let forward = |keep, counts: &mut run::RunCounts, whole| {
-        run::run(&sources, &sorted.corrections, &init, cfg, counts, keep, whole)
+    let forward = |pass: run::Pass, counts: &mut run::RunCounts| {
+        run::run(&sources, &sorted.corrections, &init, cfg, counts, &pass)
     };
     let track = smoother::filter_and_smooth(forward, &mut rc, held)?;
 

@@ -34,10 +34,45 @@ pub(crate) struct RunCounts {
 pub(crate) struct RunOutput {
     /// The records of the steps the pass was asked to keep.
     pub records: Vec<StepRecord>,
-    /// Per odometry interval: flagged as slipping.
+    /// Per odometry interval: flagged as slipping (from the pass's start on).
     pub slip: Vec<bool>,
     /// Steps of the whole pass.
     pub steps: usize,
+    /// The checkpoints it was asked for ([`Pass::checkpoint_every`]), in step order.
+    pub checkpoints: Vec<Checkpoint>,
+}
+
+/// What one forward pass keeps and where it starts.
+pub(crate) struct Pass<'a> {
+    /// The steps whose records are kept (step 0 is the start).
+    pub keep: std::ops::Range<usize>,
+    /// Run to the end of the log, not only to the end of `keep`.
+    pub whole: bool,
+    /// Resume from this checkpoint instead of the log's start.
+    pub resume: Option<&'a Checkpoint>,
+    /// With `n > 0`, a checkpoint for every multiple `k·n` (`k ≥ 1`) of the steps: the
+    /// state at the start of the odometry interval holding step `k·n`.
+    pub checkpoint_every: usize,
+}
+
+/// The forward pass's state at the start of an odometry interval: all it needs to go on
+/// from there exactly as the pass did (the smoother's checkpoints: a segment's records are
+/// computed again from the checkpoint before it, not from the log's start). Counts are
+/// not part of it: a resumed pass counts into a scratch copy.
+#[derive(Clone)]
+pub(crate) struct Checkpoint {
+    interval: usize,
+    steps: usize,
+    x: [f64; N],
+    p: Mat<N, N>,
+    rejected_run: RejectedRun,
+    last_fix: Option<Stamp>,
+    driven_since_fix_m: f64,
+    reset_refused: bool,
+    next_correction: usize,
+    held_speed: f64,
+    t_cur: Stamp,
+    odo_cur: Pose2,
 }
 
 /// Time constant of the odometry speed held through a slip, seconds.
@@ -306,45 +341,87 @@ impl Filter<'_> {
     }
 }
 
-/// Runs the filter over the whole track (up to the end of `keep` only, unless `whole`),
-/// keeping the records of steps `keep` (step 0 is the start; see
-/// [`super::smoother::filter_and_smooth`]).
+impl Filter<'_> {
+    /// The filter at the log's start (its start corrections applied; step 0 recorded when
+    /// kept), or at `resume`; with the loop's state there.
+    fn begin(
+        &mut self,
+        init: &Init,
+        corrections: &[(Stamp, Correction)],
+        pass: &Pass,
+        t0: Stamp,
+    ) -> (Checkpoint, Vec<StepRecord>) {
+        let mut records = Vec::new();
+        if let Some(c) = pass.resume {
+            (self.x, self.p, self.rejected_run) = (c.x, c.p, c.rejected_run.clone());
+            (self.last_fix, self.driven_since_fix_m, self.reset_refused) =
+                (c.last_fix, c.driven_since_fix_m, c.reset_refused);
+            return (c.clone(), records);
+        }
+        let next_correction = self.start(corrections, t0);
+        if pass.keep.contains(&0) {
+            records.push(StepRecord { stamp: t0, x: self.x, p: self.p, x_pred: init.x, p_pred: init.p, f: identity() });
+        }
+        let mut at = self.checkpoint(0, 1, next_correction);
+        (at.held_speed, at.t_cur) = (0.0, t0);
+        (at, records)
+    }
+
+    /// The filter's state as a checkpoint at interval `interval`, step `steps`.
+    fn checkpoint(&self, interval: usize, steps: usize, next_correction: usize) -> Checkpoint {
+        Checkpoint {
+            interval,
+            steps,
+            x: self.x,
+            p: self.p,
+            rejected_run: self.rejected_run.clone(),
+            last_fix: self.last_fix,
+            driven_since_fix_m: self.driven_since_fix_m,
+            reset_refused: self.reset_refused,
+            next_correction,
+            held_speed: 0.0,
+            t_cur: Stamp(0),
+            odo_cur: Pose2::IDENTITY,
+        }
+    }
+}
+
+/// Runs the filter over the whole track from its start or from `pass.resume` (up to the
+/// end of `pass.keep` only, unless `pass.whole`), keeping the records of the steps in
+/// `pass.keep` and the checkpoints asked for (see [`super::smoother::filter_and_smooth`]).
 pub(crate) fn run(
     motion: &MotionSources,
     corrections: &[(Stamp, Correction)],
     init: &Init,
     cfg: &EstimatorConfig,
     counts: &mut RunCounts,
-    keep: std::ops::Range<usize>,
-    whole: bool,
+    pass: &Pass,
 ) -> Result<RunOutput, EstimatorError> {
     let MotionSources { odo, gyro, slip, fix_slip } = *motion;
-    let gates = gates(cfg)?;
     let (t0, t_last) = odo.span();
-    let mut records = Vec::with_capacity(keep.len().min(odo.stamps.len() + corrections.len()));
-    let mut steps = 0;
     let mut slips = vec![false; odo.intervals.len()];
     let mut f = Filter {
         x: init.x,
         p: init.p,
         cfg,
-        gates,
+        gates: gates(cfg)?,
         counts,
         rejected_run: Vec::new(),
         last_fix: None,
         driven_since_fix_m: f64::INFINITY,
         reset_refused: false,
     };
-    let mut j = f.start(corrections, t0);
-    if keep.contains(&steps) {
-        records.push(StepRecord { stamp: t0, x: f.x, p: f.p, x_pred: init.x, p_pred: init.p, f: identity() });
-    }
-    steps += 1;
-    let mut held_speed = 0.0;
-    let mut t_cur = t0;
-    let mut odo_cur = odo.pose_at(t0);
-    for (i, iv) in odo.intervals.iter().enumerate() {
+    let (at, mut records) = f.begin(init, corrections, pass, t0);
+    records.reserve(pass.keep.len().min(odo.stamps.len() + corrections.len()));
+    let (mut steps, mut j, mut held_speed, mut t_cur) = (at.steps, at.next_correction, at.held_speed, at.t_cur);
+    let mut odo_cur = if pass.resume.is_some() { at.odo_cur } else { odo.pose_at(t0) };
+    let mut checkpoints = Vec::new();
+    let every = pass.checkpoint_every;
+    for (i, iv) in odo.intervals.iter().enumerate().skip(at.interval) {
         let t_end = odo.stamps[i + 1];
+        // The checkpoint of the interval holding step k·every is taken at its start, and
+        // kept once that step is reached.
+        let start = (every > 0).then(|| Checkpoint { held_speed, t_cur, odo_cur, ..f.checkpoint(i, steps, j) });
         slips[i] = !iv.stationary && (slip.slips(i, f.x[3]) || fix_slip.slips(t_cur, t_end, odo, &f.x, &f.p));
         let inflation = if slips[i] { cfg.slip_noise_inflation } else { 1.0 };
         let drive = Drive { iv, inflation, speed_factor: speed_factor(slips[i], iv, &mut held_speed, cfg) };
@@ -364,12 +441,15 @@ pub(crate) fn run(
             if !all_finite(&f.p) || !f.x.iter().all(|v| v.is_finite()) {
                 return Err(EstimatorError::Numerical { stamp: t.0 });
             }
-            if keep.contains(&steps) {
+            if pass.keep.contains(&steps) {
                 records.push(StepRecord { stamp: t, x: f.x, p: f.p, x_pred, p_pred, f: jac });
             }
+            if every > 0 && steps % every == 0 && checkpoints.len() < steps / every {
+                checkpoints.extend(start.clone());
+            }
             steps += 1;
-            if !whole && steps >= keep.end {
-                return Ok(RunOutput { records, slip: slips, steps });
+            if !pass.whole && steps >= pass.keep.end {
+                return Ok(RunOutput { records, slip: slips, steps, checkpoints });
             }
             t_cur = t;
             odo_cur = odo_t;
@@ -382,7 +462,7 @@ pub(crate) fn run(
     for (stamp, c) in &corrections[j..] {
         count_outside(*stamp, c, f.counts);
     }
-    Ok(RunOutput { records, slip: slips, steps })
+    Ok(RunOutput { records, slip: slips, steps, checkpoints })
 }
 
 /// Empty per-quality counters.

@@ -12,15 +12,15 @@ use super::error::EstimatorError;
 use super::filter::{StepRecord, N, THETA};
 use super::linalg::{add, all_finite, mul, mul_vec, sandwich, spd_inverse, sub, transpose, Mat};
 use super::output::StateSample;
-use super::run::{RunCounts, RunOutput};
+use super::run::{Pass, RunCounts, RunOutput};
 use crate::geometry::{normalize_angle, Pose2};
 use crate::time::Stamp;
 use std::ops::Range;
 
-/// Steps whose records the smoother holds at once (688 bytes each: 45 MB, about 20 minutes
-/// of 50 Hz odometry). A longer log is smoothed a segment of this many steps at a time,
-/// from its end; see [`filter_and_smooth`].
-pub(crate) const HELD_RECORDS: usize = 1 << 16;
+/// Steps whose records the smoother holds at once (688 bytes each: 5.6 MB, about 2.7
+/// minutes of 50 Hz odometry). A longer log is smoothed a segment of this many steps at a
+/// time, from its end; see [`filter_and_smooth`].
+pub(crate) const HELD_RECORDS: usize = 1 << 13;
 
 /// The filter's and the smoother's samples of every step, in time order.
 pub(crate) struct Track {
@@ -33,28 +33,28 @@ pub(crate) struct Track {
     pub slip: Vec<bool>,
 }
 
-/// Runs the forward pass (`forward(keep, counts, whole)`: the filter over the log,
-/// keeping the records of the steps in `keep`, to its end when `whole`, else up to the end
-/// of `keep`) and the smoother over its records, holding at most `held` records at once.
+/// Runs the forward pass (`forward(pass, counts)`: the filter over the log, see
+/// [`Pass`]) and the smoother over its records, holding at most `held` records at once.
 ///
-/// The first pass runs whole, counts into `counts` and keeps the first `held` records. A
-/// log of more steps is smoothed a segment at a time from its end, and the forward pass
-/// runs again up to each segment, keeping that segment's records (and counting into a
-/// scratch copy): the filter is deterministic, so they are the first
-/// pass's records to the bit, and the samples are those of one pass holding them all.
-/// Memory then grows with the log by a sample's 240 bytes a step instead of a record's
-/// 688; time by a partial forward pass per segment (a whole one takes about 0.5 s an
-/// hour of 50 Hz odometry), so quadratically in the log's length past `held` steps. This is checkpointing with
-/// recomputation, as in Griewank & Walther's reverse-mode differentiation, with the start
-/// of the log as the only checkpoint.
+/// The first pass runs whole, counts into `counts`, keeps the first `held` records and a
+/// checkpoint of the filter's state before every further `held` steps. A log of more steps
+/// is smoothed a segment at a time from its end: the forward pass runs again from the
+/// checkpoint before each segment to its end, keeping that segment's records (and
+/// counting into a scratch copy). The filter is deterministic and a checkpoint holds all
+/// of its state, so they are the first pass's records to the bit, and the samples are
+/// those of one pass holding them all. Memory then grows with the log by a sample's 240
+/// bytes a step instead of a record's 688, and time by a second forward pass. This is
+/// checkpointing with recomputation, as in Griewank & Walther's reverse-mode
+/// differentiation, with a checkpoint per segment.
 pub(crate) fn filter_and_smooth(
-    forward: impl Fn(Range<usize>, &mut RunCounts, bool) -> Result<RunOutput, EstimatorError>,
+    forward: impl Fn(Pass, &mut RunCounts) -> Result<RunOutput, EstimatorError>,
     counts: &mut RunCounts,
     held: usize,
 ) -> Result<Track, EstimatorError> {
     let scratch = counts.clone();
     let held = held.max(1);
-    let RunOutput { records: first, slip, steps } = forward(0..held, counts, true)?;
+    let pass = Pass { keep: 0..held, whole: true, resume: None, checkpoint_every: held };
+    let RunOutput { records: first, slip, steps, checkpoints } = forward(pass, counts)?;
     let segments: Vec<Range<usize>> = (0..steps).step_by(held).map(|a| a..(a + held).min(steps)).collect();
     let (mut filtered, mut smoothed) = (Vec::with_capacity(steps), Vec::with_capacity(steps));
     let mut last = None;
@@ -64,12 +64,16 @@ pub(crate) fn filter_and_smooth(
     let mut bad = None;
     // Held through the whole backward pass only when it is the only segment; otherwise
     // the first segment is computed again at the end, so that one segment's records are
-    // held at a time, not two (45 MB more at the default `held`).
+    // held at a time, not two.
     let mut first = (segments.len() == 1).then_some(first);
-    for segment in segments.iter().rev() {
+    for (k, segment) in segments.iter().enumerate().rev() {
         let records = match first.take() {
             Some(records) => records,
-            None => forward(segment.clone(), &mut scratch.clone(), false)?.records,
+            None => {
+                let resume = k.checked_sub(1).and_then(|c| checkpoints.get(c));
+                let pass = Pass { keep: segment.clone(), whole: false, resume, checkpoint_every: 0 };
+                forward(pass, &mut scratch.clone())?.records
+            }
         };
         debug_assert_eq!(records.len(), segment.len());
         let Some(end) = records.last() else { continue };
