@@ -1,4 +1,4 @@
-//! Fork–join for the scan matcher and the map set (rayon's work-stealing `join` and
+//! Fork–join for the scan matcher, the map set and the camera calibration's cost curves (rayon's work-stealing `join` and
 //! indexed parallel iterators with the `parallel` feature, the same calls one after the
 //! other without it).
 //!

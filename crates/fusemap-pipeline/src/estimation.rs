@@ -27,8 +27,8 @@ use crate::track::{glitch_note, ChosenTrack, Track, TrackCounts};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SensorKind};
 use fusemap_core::estimator::{
-    base_yaw_rate, estimate, odometry_increment_covariance, Estimate, EstimatorConfig, EstimatorError, EstimatorInput,
-    StaleOrientation,
+    base_yaw_rate, estimate, odometry_increment_covariance, share_repeated, Estimate, EstimatorConfig, EstimatorError,
+    EstimatorInput, StaleOrientation,
 };
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{quaternion_yaw, Pose2, Pose3};
@@ -89,10 +89,13 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                 if let Some(v) = yaw {
                     all.config.fallback_pose_sigma_rad = v;
                 }
+                let mut shared = None;
                 for m in &inv.poses[&s.topic] {
-                    let cov = planar_covariance(&m.covariance).unwrap_or([[0.0; 3]; 3]).into();
+                    let cov = planar_covariance(&m.covariance).unwrap_or([[0.0; 3]; 3]);
+                    let covariance = share_repeated(shared.as_ref(), cov);
+                    shared = Some(Arc::clone(&covariance));
                     let (stamp, pose) = (s.stamp(m.stamp), m.pose2());
-                    all.inputs.push(EstimatorInput::Pose { stamp, pose, covariance: cov });
+                    all.inputs.push(EstimatorInput::Pose { stamp, pose, covariance });
                 }
             }
             // Lidars and cameras give the map evidence, not the estimator (cameras are
@@ -126,11 +129,15 @@ fn odometry_inputs(s: &BoundSensor, inv: &Inventory, cfg: &LogConfig, all: &mut 
     }
     all.odometry_glitches += glitches;
     let mut prev: Option<(&[[f64; 3]; 3], f64)> = None;
+    let mut shared: Option<Arc<[[f64; 3]; 3]>> = None;
     for (m, _) in msgs.iter().zip(&keep).filter(|(_, k)| **k) {
         let covariance = match (m.covariance.as_deref(), prev) {
-            (Some(c), Some((p, yaw))) => odometry_increment_covariance(c, p, yaw).map(Arc::new),
+            (Some(c), Some((p, yaw))) => {
+                odometry_increment_covariance(c, p, yaw).map(|i| share_repeated(shared.as_ref(), i))
+            }
             _ => None,
         };
+        shared = covariance.clone().or(shared);
         prev = m.covariance.as_deref().map(|c| (c, m.pose.theta));
         all.inputs.push(EstimatorInput::Odometry { stamp: s.stamp(m.stamp), pose: m.pose, covariance });
     }

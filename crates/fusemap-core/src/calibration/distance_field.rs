@@ -190,10 +190,12 @@ impl DistanceField {
     /// raster or farther.
     pub fn at(&self, p: Point2) -> f64 {
         // The nearest cell centre, ⌊x + ½⌋ on the cell grid (truncation is the floor once
-        // the range is checked; it spares a call to libm's `round` per point).
+        // the range is checked; it spares a call to libm's `round` per point). `> 0`, not
+        // `≥ 0`: a point half a cell before the first centre rounds away from it, as
+        // `round` does (x + ½ is exact for x in (−½, 0)).
         let u = (p.x - self.first_centre.x) / self.resolution + 0.5;
         let v = (p.y - self.first_centre.y) / self.resolution + 0.5;
-        if !(u >= 0.0 && v >= 0.0 && u < self.width as f64 && v < self.height as f64) {
+        if !(u > 0.0 && v > 0.0 && u < self.width as f64 && v < self.height as f64) {
             return self.max_m;
         }
         let cell = v as usize * self.width + u as usize;
@@ -359,6 +361,11 @@ mod tests {
         assert!((f.at(Point2::new(1.03, 1.04)) - 0.05).abs() < 1e-9);
         assert_eq!(f.at(Point2::new(2.5, 1.0)), 0.5);
         assert_eq!(f.at(Point2::new(-4.0, 1.0)), 0.5);
+        // The raster's edge: half a cell before the first centre is outside (as `round`
+        // puts it), just inside is in cell 0.
+        let edge = DistanceField::new(&raster(30, 20, &[(0, 10)]), |l| l > 1.0, None, 0.5).unwrap();
+        assert_eq!(edge.at(Point2::new(-0.05, 1.0)), 0.5);
+        assert!((edge.at(Point2::new(-0.0499, 1.0)) - 0.0499).abs() < 1e-9);
     }
 
     #[test]

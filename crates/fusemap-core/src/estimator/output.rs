@@ -24,7 +24,9 @@ pub struct StateSample {
 #[derive(Clone, Debug)]
 pub struct Estimate {
     /// The filter's states (each given the inputs up to its stamp, except the start
-    /// heading, which comes from the heading initialisation).
+    /// heading, which comes from the heading initialisation). The pipeline's estimator
+    /// track empties it before mapping (it maps with `smoothed`): there
+    /// [`Estimate::filtered_pose_at`] gives [`NoPose::Empty`].
     pub filtered: Vec<StateSample>,
     /// The smoother's states (each given the whole log): the track a mapper should use.
     pub smoothed: Vec<StateSample>,
