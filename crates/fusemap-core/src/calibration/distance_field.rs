@@ -410,6 +410,46 @@ mod tests {
     }
 
     proptest! {
+        /// The candidate lists give what the nine-cell look-up they replaced gave, to the
+        /// bit: the least over the pieces of the faces nearest the point's cell (rounded to
+        /// the nearest centre) and its eight neighbours.
+        #[test]
+        fn the_candidate_lists_equal_the_nine_cell_lookup(
+            walls in prop::collection::vec((0usize..17, 0usize..11), 1..8),
+            (px, py) in (-0.2f64..1.8, -0.2f64..1.2),
+        ) {
+            let (w, h, max_m) = (17usize, 11usize, 100.0);
+            let r = raster(w, h, &walls);
+            let f = DistanceField::new(&r, |l| l > 1.0, None, max_m).unwrap();
+            let wall = |c: usize, row: usize| r.log_odds[row * w + c] > 1.0;
+            let faces: Vec<bool> = (0..w * h)
+                .map(|i| {
+                    let (c, row) = (i % w, i / w);
+                    let around = [(c.wrapping_sub(1), row), (c + 1, row), (c, row.wrapping_sub(1)), (c, row + 1)];
+                    wall(c, row) && around.iter().any(|&(cc, rr)| cc < w && rr < h && !wall(cc, rr))
+                })
+                .collect();
+            let nearest = feature_transform(w, h, &faces);
+            let p = Point2::new(px, py);
+            // The first centre is at the origin.
+            let (u, v) = ((p.x / 0.1).round(), (p.y / 0.1).round());
+            let want = if !(u >= 0.0 && v >= 0.0 && u < w as f64 && v < h as f64) {
+                max_m
+            } else {
+                let (i, j) = (u as usize, v as usize);
+                let mut best = max_m * max_m;
+                for jj in j.saturating_sub(1)..(j + 2).min(h) {
+                    for ii in i.saturating_sub(1)..(i + 2).min(w) {
+                        let face = nearest[jj * w + ii] as usize;
+                        let piece = faces[..face].iter().filter(|b| **b).count();
+                        best = best.min(f.piece_distance2(&f.pieces[piece], p));
+                    }
+                }
+                best.sqrt()
+            };
+            prop_assert_eq!(f.at(p).to_bits(), want.to_bits(), "{} against {} at {:?}", f.at(p), want, p);
+        }
+
         /// A point is never farther from the walls than from the nearest face's centre,
         /// nor nearer than that less a piece's half length.
         #[test]
