@@ -27,13 +27,12 @@ use crate::track::{glitch_note, ChosenTrack, Track, TrackCounts};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SensorKind};
 use fusemap_core::estimator::{
-    base_yaw_rate, estimate, odometry_increment_covariance, share_repeated, Estimate, EstimatorConfig, EstimatorError,
-    EstimatorInput, StaleOrientation,
+    base_yaw_rate, estimate, odometry_increment_covariance, Estimate, EstimatorConfig, EstimatorError, EstimatorInput,
+    Repeated, StaleOrientation,
 };
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{quaternion_yaw, Pose2, Pose3};
 use fusemap_core::time::{plausible_samples, Stamp};
-use std::sync::Arc;
 
 /// The estimator's inputs from `inv`.
 pub struct Inputs {
@@ -89,11 +88,9 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
                 if let Some(v) = yaw {
                     all.config.fallback_pose_sigma_rad = v;
                 }
-                let mut shared = None;
+                let mut repeated = Repeated::new();
                 for m in &inv.poses[&s.topic] {
-                    let cov = planar_covariance(&m.covariance).unwrap_or([[0.0; 3]; 3]);
-                    let covariance = share_repeated(shared.as_ref(), cov);
-                    shared = Some(Arc::clone(&covariance));
+                    let covariance = repeated.share(planar_covariance(&m.covariance).unwrap_or([[0.0; 3]; 3]));
                     let (stamp, pose) = (s.stamp(m.stamp), m.pose2());
                     all.inputs.push(EstimatorInput::Pose { stamp, pose, covariance });
                 }
@@ -129,15 +126,12 @@ fn odometry_inputs(s: &BoundSensor, inv: &Inventory, cfg: &LogConfig, all: &mut 
     }
     all.odometry_glitches += glitches;
     let mut prev: Option<(&[[f64; 3]; 3], f64)> = None;
-    let mut shared: Option<Arc<[[f64; 3]; 3]>> = None;
+    let mut repeated = Repeated::new();
     for (m, _) in msgs.iter().zip(&keep).filter(|(_, k)| **k) {
         let covariance = match (m.covariance.as_deref(), prev) {
-            (Some(c), Some((p, yaw))) => {
-                odometry_increment_covariance(c, p, yaw).map(|i| share_repeated(shared.as_ref(), i))
-            }
+            (Some(c), Some((p, yaw))) => odometry_increment_covariance(c, p, yaw).map(|i| repeated.share(i)),
             _ => None,
         };
-        shared = covariance.clone().or(shared);
         prev = m.covariance.as_deref().map(|c| (c, m.pose.theta));
         all.inputs.push(EstimatorInput::Odometry { stamp: s.stamp(m.stamp), pose: m.pose, covariance });
     }

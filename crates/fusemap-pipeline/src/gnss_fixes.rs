@@ -9,12 +9,11 @@ use crate::recording::Inventory;
 use crate::sensors::{Bound, BoundSensor};
 use crate::PipelineError;
 use fusemap_core::config::{LogConfig, Plan, SensorKind};
-use fusemap_core::estimator::{check_fix, share_repeated, EstimatorInput, FixProblem, FixQuality, GnssCovarianceKind};
+use fusemap_core::estimator::{check_fix, EstimatorInput, FixProblem, FixQuality, GnssCovarianceKind, Repeated};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{geodetic::Datum, Point2};
 use fusemap_core::time::Stamp;
 use fusemap_io::log::GnssMessage;
-use std::sync::Arc;
 
 /// The datum of the map frame `[lat°, lon°, alt m]`, where it came from, and how many
 /// early fixes were passed over because the fixes after them disagreed.
@@ -191,7 +190,7 @@ pub(crate) fn gnss_inputs(
     r.lever_arm = Some([lever.x, lever.y]);
     let floors = s.sensor.gnss;
     let mut out = Vec::new();
-    let mut shared: Option<Arc<[[f64; 2]; 2]>> = None;
+    let mut repeated = Repeated::new();
     for f in msgs {
         if let Err(why) = problem(f, band) {
             count(&mut r, why);
@@ -213,8 +212,7 @@ pub(crate) fn gnss_inputs(
         r.unknown_covariance += u64::from(cov.unknown);
         r.floored += u64::from(cov.floored);
         r.passed += 1;
-        let covariance = share_repeated(shared.as_ref(), cov.enu);
-        shared = Some(Arc::clone(&covariance));
+        let covariance = repeated.share(cov.enu);
         out.push(EstimatorInput::Position {
             stamp: s.stamp(f.stamp),
             enu: [enu[0], enu[1]],

@@ -121,6 +121,30 @@ pub fn share_repeated<T: SameBits>(previous: Option<&Arc<T>>, value: T) -> Arc<T
     }
 }
 
+/// The last value handed out by [`share_repeated`], for a stream that keeps no previous
+/// element of its own to share with.
+pub struct Repeated<T>(Option<Arc<T>>);
+
+impl<T: SameBits> Repeated<T> {
+    /// Nothing handed out yet.
+    pub fn new() -> Self {
+        Self(None)
+    }
+
+    /// `value`, shared with the last value when the same to the bit.
+    pub fn share(&mut self, value: T) -> Arc<T> {
+        let shared = share_repeated(self.0.as_ref(), value);
+        self.0 = Some(Arc::clone(&shared));
+        shared
+    }
+}
+
+impl<T: SameBits> Default for Repeated<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// Equality of floating-point values to the bit.
 pub trait SameBits {
     /// Whether `self` and `other` have the same bits.

@@ -77,7 +77,7 @@ mod test_drive;
 pub use chi2::{chi_square_cdf, chi_square_quantile};
 pub use config::EstimatorConfig;
 pub use error::EstimatorError;
-pub use input::{share_repeated, EstimatorInput, FixQuality, SameBits};
+pub use input::{share_repeated, EstimatorInput, FixQuality, Repeated, SameBits};
 pub use output::{Estimate, StateSample};
 pub use report::{
     CorrectionReport, EstimatorReport, FixQualityCount, FixRejection, GyroReport, HeadingInit, HeadingSource,

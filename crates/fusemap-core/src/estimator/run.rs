@@ -349,7 +349,7 @@ impl Filter<'_> {
         init: &Init,
         corrections: &[(Stamp, Correction)],
         pass: &Pass,
-        t0: Stamp,
+        (t0, odo_t0): (Stamp, Pose2),
     ) -> (Checkpoint, Vec<StepRecord>) {
         let mut records = Vec::new();
         if let Some(c) = pass.resume {
@@ -362,13 +362,18 @@ impl Filter<'_> {
         if pass.keep.contains(&0) {
             records.push(StepRecord { stamp: t0, x: self.x, p: self.p, x_pred: init.x, p_pred: init.p, f: identity() });
         }
-        let mut at = self.checkpoint(0, 1, next_correction);
-        (at.held_speed, at.t_cur) = (0.0, t0);
-        (at, records)
+        (self.checkpoint(0, 1, next_correction, (0.0, t0, odo_t0)), records)
     }
 
-    /// The filter's state as a checkpoint at interval `interval`, step `steps`.
-    fn checkpoint(&self, interval: usize, steps: usize, next_correction: usize) -> Checkpoint {
+    /// The filter's state as a checkpoint at interval `interval`, step `steps`, with the
+    /// loop's held speed, time and odometry pose there.
+    fn checkpoint(
+        &self,
+        interval: usize,
+        steps: usize,
+        next_correction: usize,
+        (held_speed, t_cur, odo_cur): (f64, Stamp, Pose2),
+    ) -> Checkpoint {
         Checkpoint {
             interval,
             steps,
@@ -379,9 +384,9 @@ impl Filter<'_> {
             driven_since_fix_m: self.driven_since_fix_m,
             reset_refused: self.reset_refused,
             next_correction,
-            held_speed: 0.0,
-            t_cur: Stamp(0),
-            odo_cur: Pose2::IDENTITY,
+            held_speed,
+            t_cur,
+            odo_cur,
         }
     }
 }
@@ -411,17 +416,17 @@ pub(crate) fn run(
         driven_since_fix_m: f64::INFINITY,
         reset_refused: false,
     };
-    let (at, mut records) = f.begin(init, corrections, pass, t0);
+    let (at, mut records) = f.begin(init, corrections, pass, (t0, odo.pose_at(t0)));
     records.reserve(pass.keep.len().min(odo.stamps.len() + corrections.len()));
     let (mut steps, mut j, mut held_speed, mut t_cur) = (at.steps, at.next_correction, at.held_speed, at.t_cur);
-    let mut odo_cur = if pass.resume.is_some() { at.odo_cur } else { odo.pose_at(t0) };
+    let mut odo_cur = at.odo_cur;
     let mut checkpoints = Vec::new();
     let every = pass.checkpoint_every;
     for (i, iv) in odo.intervals.iter().enumerate().skip(at.interval) {
         let t_end = odo.stamps[i + 1];
         // The checkpoint of the interval holding step k·every is taken at its start, and
         // kept once that step is reached.
-        let start = (every > 0).then(|| Checkpoint { held_speed, t_cur, odo_cur, ..f.checkpoint(i, steps, j) });
+        let start = (every > 0).then(|| f.checkpoint(i, steps, j, (held_speed, t_cur, odo_cur)));
         slips[i] = !iv.stationary && (slip.slips(i, f.x[3]) || fix_slip.slips(t_cur, t_end, odo, &f.x, &f.p));
         let inflation = if slips[i] { cfg.slip_noise_inflation } else { 1.0 };
         let drive = Drive { iv, inflation, speed_factor: speed_factor(slips[i], iv, &mut held_speed, cfg) };
