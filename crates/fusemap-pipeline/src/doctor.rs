@@ -22,47 +22,18 @@
 //! The doctor uses the mapper's own functions (the first pass, the sensor binding, the
 //! pose track), so what it says is what `fusemap map` will do.
 
+use crate::log_findings::{stream_findings, timing_rows, track_topic, Roles, Row};
 use crate::recording::Inventory;
 use crate::sync::Skipped;
 use crate::sync::{limits, sync_mode};
 use crate::track::Track;
 use crate::PipelineError;
-use fusemap_core::config::{LogConfig, Plan, PoseSource, SyncConfig};
+use fusemap_core::config::{LogConfig, Plan, SyncConfig};
 use fusemap_core::geometry::quaternion_yaw;
-use fusemap_core::time::{PoseTrack, Stamp, StreamTiming, SyncMode, TimingLimits};
+use fusemap_core::time::{PoseTrack, Stamp, SyncMode, TimingLimits};
 use fusemap_io::text::{printable, table_cell};
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// The timing of one topic: `backwards` and the delays in log order, the rest in time order.
-fn timing(header: &[Stamp], receive: &[Option<Stamp>], limits: TimingLimits) -> StreamTiming {
-    let in_log_order = StreamTiming::analyze(header, receive, limits);
-    let mut sorted = header.to_vec();
-    sorted.sort_unstable();
-    let in_time_order = StreamTiming::analyze(&sorted, &[], limits);
-    StreamTiming { regressions: in_log_order.regressions, delay: in_log_order.delay, ..in_time_order }
-}
-
-/// "once", "3 times".
-fn times(n: u64) -> String {
-    if n == 1 {
-        "once".into()
-    } else {
-        format!("{n} times")
-    }
-}
-
-/// What a topic is to the mapper.
-#[derive(Clone, Copy, PartialEq)]
-enum Role {
-    /// The scans that are mapped, posed from a pose track.
-    ScansOnTrack,
-    /// The pose track.
-    PoseTrack,
-    /// Anything else.
-    Other,
-}
 
 /// How the scan topic gets its poses.
 struct Sync {
@@ -160,7 +131,14 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
         findings.push(format!("the log is cut short (`fusemap map` maps it up to the cut): {cut}"));
     }
     findings.extend(log.malformed_note());
-    stream_findings(&rows, sync.as_ref(), cfg, limits, &mut findings);
+    let roles = sync
+        .as_ref()
+        .and_then(|s| {
+            let tr = s.track.as_ref()?;
+            Some(Roles { scans: Some(&s.topic), track: tr.topic.as_deref(), slam: tr.slam.is_some() })
+        })
+        .unwrap_or_default();
+    stream_findings(&rows, roles, cfg, limits, &mut findings);
     if let Some(s) = &sync {
         write_sync(&mut out, s, cfg, &mut findings)?;
     }
@@ -174,38 +152,6 @@ pub fn report(plan: &Plan, path: &Path) -> Result<Report, PipelineError> {
         writeln!(out, "- {}", printable(&f))?;
     }
     Ok(Report { text: out, refusal })
-}
-
-/// A row of the timing table: topic, kind and its timing.
-type Row = (String, &'static str, StreamTiming);
-
-/// Every stream's timing: the scans, each pose sensor's messages, and the dynamic TF.
-fn timing_rows(log: &Inventory, limits: TimingLimits) -> Vec<Row> {
-    fn add<T>(
-        rows: &mut Vec<Row>,
-        kind: &'static str,
-        streams: &BTreeMap<String, Vec<T>>,
-        stamps: impl Fn(&T) -> (Stamp, Option<Stamp>),
-        limits: TimingLimits,
-    ) {
-        for (topic, items) in streams {
-            let (header, receive): (Vec<Stamp>, Vec<Option<Stamp>>) = items.iter().map(&stamps).unzip();
-            rows.push((topic.clone(), kind, timing(&header, &receive, limits)));
-        }
-    }
-    let mut rows: Vec<Row> = Vec::new();
-    for (topic, scans) in &log.scans {
-        rows.push((topic.clone(), "scan", timing(&scans.stamps, &scans.receive, limits)));
-    }
-    add(&mut rows, "odometry", &log.odom, |o| (o.stamp, o.receive_stamp), limits);
-    add(&mut rows, "gnss", &log.gnss, |o| (o.stamp, o.receive_stamp), limits);
-    add(&mut rows, "pose", &log.poses, |o| (o.stamp, o.receive_stamp), limits);
-    add(&mut rows, "imu", &log.imu, |o| (o.stamp, o.receive_stamp), limits);
-    if !log.tf_dynamic.is_empty() {
-        let h: Vec<Stamp> = log.tf_dynamic.iter().map(|t| t.stamp).collect();
-        rows.push(("/tf".into(), "tf", timing(&h, &[], limits)));
-    }
-    rows
 }
 
 /// The timing table, one row a stream.
@@ -296,13 +242,7 @@ fn how_posed(plan: &Plan, log: &Inventory) -> Posed {
                         }
                         skipped
                     };
-                    let topic_of_track = match chosen.source {
-                        PoseSource::Odometry => {
-                            bound.first(fusemap_core::config::SensorKind::WheelOdometry).map(|b| b.topic.clone())
-                        }
-                        PoseSource::Tf => Some("/tf".to_string()),
-                        _ => None,
-                    };
+                    let topic_of_track = track_topic(chosen.source, &bound);
                     let (slam_on, reason) = crate::slam::applies(plan, log, &bound, &chosen);
                     let slam = slam_on.then(|| SlamCover::count(reason, track.as_ref(), stamps, offset, configured));
                     sync = Some(Sync {
@@ -371,74 +311,6 @@ fn unobservable(log: &Inventory, bound: &crate::sensors::Bound) -> Option<String
         r.returns,
         if r.returns > 0 { format!(", from {} to {} m", r.nearest, r.farthest) } else { String::new() },
     ))
-}
-
-/// Findings per stream: stamps going backwards or repeated, header stamps far from the
-/// receive time, pauses; each with what it means for the scans or the pose track.
-fn stream_findings(
-    rows: &[Row],
-    sync: Option<&Sync>,
-    cfg: &LogConfig,
-    limits: TimingLimits,
-    findings: &mut Vec<String>,
-) {
-    let track = sync.and_then(|s| s.track.as_ref());
-    for (topic, kind, t) in rows {
-        let role = match (&sync, track) {
-            (Some(s), Some(_)) if *topic == s.topic => Role::ScansOnTrack,
-            (_, Some(tr)) if tr.topic.as_deref() == Some(topic.as_str()) => Role::PoseTrack,
-            _ => Role::Other,
-        };
-        if t.regressions > 0 {
-            let consequence = match role {
-                Role::ScansOnTrack => ": the scans are mapped in stamp order",
-                Role::PoseTrack => ": the pose track takes its samples in stamp order",
-                Role::Other => "",
-            };
-            findings.push(format!("{topic} stamps go backwards {}{consequence}", times(t.regressions)));
-        }
-        if t.duplicates > 0 {
-            let consequence =
-                if role == Role::PoseTrack { ": the pose track uses the first sample of each stamp" } else { "" };
-            findings.push(format!("{topic} repeats a stamp {}{consequence}", times(t.duplicates)));
-        }
-        if let Some(d) = t.delay {
-            let spread = d.max_s - d.min_s;
-            if d.far > 0 && d.far == d.count && spread <= limits.far_delay_s {
-                // Every delay is far and they spread less than the limit: all have one sign.
-                let (near, far) = (d.min_s.abs().min(d.max_s.abs()), d.min_s.abs().max(d.max_s.abs()));
-                findings.push(format!(
-                    "{topic}: every header stamp is {near:.3} to {far:.3} s {} the log's receive time: the stamps \
-                     and the log count time from different origins (a CARMEN logger counts from the start of the \
-                     log), which is no clock fault, but the delay cannot be judged",
-                    if d.mean_s < 0.0 { "later than" } else { "earlier than" },
-                ));
-            } else if d.far > 0 {
-                findings.push(format!(
-                    "{topic}: {} header stamps are more than {:.1} s from the log's receive time (largest {:.3} s): check the sensor's clock",
-                    d.far, limits.far_delay_s, d.max_s.abs().max(d.min_s.abs())
-                ));
-            }
-        }
-        if *kind != "scan" && t.gaps > 0 {
-            let consequence = if role == Role::PoseTrack && track.is_some_and(|tr| tr.slam.is_some()) {
-                ": SLAM interpolates the odometry across them as its scan matcher's first guess".to_string()
-            } else if role == Role::PoseTrack {
-                format!(
-                    ": a scan inside one gets a pose only if the robot moved at most {} m and {}° across it",
-                    cfg.gap_bridge_motion_m, cfg.gap_bridge_motion_deg
-                )
-            } else {
-                String::new()
-            };
-            findings.push(format!(
-                "{topic} pauses longer than {:.2} s {} (longest {:.2} s){consequence}",
-                limits.gap_s,
-                times(t.gaps),
-                t.max_gap_s
-            ));
-        }
-    }
 }
 
 /// How the scans get their poses: the shares each sync mode poses, and what happens to the rest.

@@ -40,6 +40,7 @@ pub mod in_memory;
 mod insert;
 pub mod job;
 mod lidar_frames;
+pub(crate) mod log_findings;
 mod map_pass;
 pub mod merge;
 pub mod outputs;

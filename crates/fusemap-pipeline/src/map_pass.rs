@@ -201,6 +201,7 @@ pub fn map_with_track(
     let mut report = log_report(&input, &chosen, streams, mode, skipped, &tree);
     (report.track_s, report.map_s) = (track_s, map_s);
     report.correlated_merged = engine.stats().correlated_merged;
+    report.log_findings = crate::log_findings::log_findings(plan, inv, bound, &chosen, slam_summary.is_some());
     report.slam = slam_summary.map(|s| *s);
     notes.extend(chosen.notes.iter().cloned());
     Ok(MapRun {
@@ -558,8 +559,8 @@ fn camera_notes(engine: &Engine, streams: &mut Streams, notes: &mut Vec<String>)
     }
 }
 
-/// The run report of the pass (its timings, the engine's counters and the SLAM summary
-/// are the caller's to fill in).
+/// The run report of the pass (its timings, the engine's counters, the SLAM summary and
+/// the log's findings are the caller's to fill in).
 fn log_report(
     input: &Inputs,
     chosen: &ChosenTrack,
@@ -610,5 +611,6 @@ fn log_report(
         cameras: streams.cameras.into_iter().map(|c| c.report).collect(),
         correlated_merged: 0,
         slam: None,
+        log_findings: Vec::new(),
     }
 }

@@ -99,4 +99,7 @@ pub struct LogReport {
     pub track_s: f64,
     /// Seconds of the second pass (reading and inserting scans).
     pub map_s: f64,
+    /// What `fusemap doctor` finds in the log's streams and pose sensors (stamps going
+    /// backwards or repeated, delays, pauses, GNSS fix quality, odometry against the gyro).
+    pub log_findings: Vec<String>,
 }

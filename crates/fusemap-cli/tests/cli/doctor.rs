@@ -62,3 +62,30 @@ fn doctor_fails_on_a_log_map_would_refuse() {
     assert!(!err.contains("panicked"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A mapping run keeps what the doctor finds in the log's streams and pose sensors
+/// (`summary.json`'s `log.log_findings`, shown by `report.html`), in the doctor's words.
+#[test]
+fn map_keeps_the_doctors_findings_of_the_log() {
+    let Some(fixtures) = intel_fixtures() else { return };
+    let mcap = fixtures.join("bare.mcap");
+    let dir = crate::util::temp_dir("doctor-in-map");
+    let out = dir.join("out");
+    let o = run(&["map", "--out", out.to_str().unwrap(), mcap.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    let found: Vec<&str> = summary["log"]["log_findings"]
+        .as_array()
+        .expect("log.log_findings")
+        .iter()
+        .filter_map(|f| f.as_str())
+        .collect();
+    // The fixture's re-anchored odometry repeats stamps: at least that is found.
+    assert!(found.iter().any(|f| f.contains("repeats a stamp")), "{found:?}");
+    let doctor = doctor(&mcap);
+    for f in &found {
+        assert!(doctor.contains(&format!("- {f}\n")), "{f:?} is not in the doctor's findings:\n{doctor}");
+    }
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("<h3>The log</h3>") && html.contains("repeats a stamp"));
+}

@@ -20,6 +20,10 @@ pub struct InnovationStats {
     pub mean_nis_accepted: f64,
     /// Share of evaluated corrections whose NIS was above the gate.
     pub share_above_gate: f64,
+    /// The same figures over time: a filter consistent on average can still be
+    /// overconfident for a stretch (a multipath street, a slipping floor), which the mean
+    /// hides.
+    pub over_time: NisOverTime,
     #[serde(skip)]
     pub(crate) nis_sum_accepted: f64,
     #[serde(skip)]
@@ -33,7 +37,7 @@ impl InnovationStats {
         Self { dof, ..Default::default() }
     }
 
-    pub(crate) fn record(&mut self, nis: f64, accepted: bool) {
+    pub(crate) fn record(&mut self, stamp: Stamp, nis: f64, accepted: bool) {
         self.count += 1;
         if accepted {
             self.accepted += 1;
@@ -43,6 +47,83 @@ impl InnovationStats {
         }
         self.mean_nis_accepted = if self.accepted > 0 { self.nis_sum_accepted / self.accepted as f64 } else { 0.0 };
         self.share_above_gate = self.above as f64 / self.count as f64;
+        self.over_time.record(stamp, nis, accepted);
+    }
+}
+
+/// The most bins [`NisOverTime`] holds: a run of any length reads as a curve of a
+/// hundred-odd points, and the report stays small.
+pub const NIS_BINS: usize = 128;
+
+/// NIS statistics in consecutive stretches of equal length from the first correction's
+/// stamp. A stretch starts at one second and doubles (neighbouring bins merged) whenever a
+/// stamp would need more than [`NIS_BINS`] bins: bounded memory, whatever the run's
+/// length.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct NisOverTime {
+    /// The first bin's start (the first correction's stamp).
+    pub start: Stamp,
+    /// Length of a bin, seconds.
+    pub bin_s: f64,
+    /// The bins, in time order; a bin without a correction has `count` 0.
+    pub bins: Vec<NisBin>,
+    #[serde(skip)]
+    bin_ns: i64,
+}
+
+/// One stretch of [`NisOverTime`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct NisBin {
+    /// Corrections evaluated in it.
+    pub count: usize,
+    /// Of those, accepted by the gate.
+    pub accepted: usize,
+    /// Mean NIS of the accepted ones (0 when none).
+    pub mean_nis_accepted: f64,
+    #[serde(skip)]
+    nis_sum: f64,
+}
+
+impl NisBin {
+    fn merge(a: Self, b: Self) -> Self {
+        let (accepted, nis_sum) = (a.accepted + b.accepted, a.nis_sum + b.nis_sum);
+        Self { count: a.count + b.count, accepted, nis_sum, mean_nis_accepted: mean(nis_sum, accepted) }
+    }
+}
+
+fn mean(sum: f64, n: usize) -> f64 {
+    if n > 0 {
+        sum / n as f64
+    } else {
+        0.0
+    }
+}
+
+impl NisOverTime {
+    fn record(&mut self, stamp: Stamp, nis: f64, accepted: bool) {
+        if self.bin_ns == 0 {
+            (self.start, self.bin_ns) = (stamp, 1_000_000_000);
+        }
+        // Corrections come in time order; one before the first (never, but a caller's
+        // order is not ours to trust) counts in the first bin.
+        let since = i128::from(stamp.0) - i128::from(self.start.0);
+        let mut k = (since.max(0) / i128::from(self.bin_ns)) as usize;
+        while k >= NIS_BINS {
+            self.bins = self.bins.chunks(2).map(|p| p.iter().copied().fold(NisBin::default(), NisBin::merge)).collect();
+            self.bin_ns = self.bin_ns.saturating_mul(2);
+            k = (since.max(0) / i128::from(self.bin_ns)) as usize;
+        }
+        if self.bins.len() <= k {
+            self.bins.resize(k + 1, NisBin::default());
+        }
+        let b = &mut self.bins[k];
+        b.count += 1;
+        if accepted {
+            b.accepted += 1;
+            b.nis_sum += nis;
+            b.mean_nis_accepted = mean(b.nis_sum, b.accepted);
+        }
+        self.bin_s = self.bin_ns as f64 * 1e-9;
     }
 }
 
@@ -244,4 +325,57 @@ pub struct EstimatorReport {
     pub stationary_s: f64,
     /// Filter steps (samples of the track).
     pub steps: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// However long the run, the bins number at most `NIS_BINS`, they hold every
+        /// correction, and each equals binning the same corrections directly at the final
+        /// width: merging on the way loses nothing.
+        #[test]
+        fn the_bins_are_direct_binning_at_the_final_width(
+            steps in proptest::collection::vec((0i64..5_000_000_000_000, 0.0f64..20.0, any::<bool>()), 1..300),
+        ) {
+            let mut stamps: Vec<i64> = steps.iter().map(|s| s.0).collect();
+            stamps.sort_unstable();
+            let mut stats = InnovationStats::new(2);
+            for (&t, &(_, nis, ok)) in stamps.iter().zip(&steps) {
+                stats.record(Stamp(t), nis, ok);
+            }
+            let o = &stats.over_time;
+            prop_assert!(o.bins.len() <= NIS_BINS && o.start == Stamp(stamps[0]));
+            prop_assert_eq!(o.bins.iter().map(|b| b.count).sum::<usize>(), steps.len());
+            let width = (o.bin_s * 1e9).round() as i64;
+            prop_assert!(width >= 1_000_000_000);
+            let mut direct = vec![(0usize, 0usize, 0.0f64); o.bins.len()];
+            for (&t, &(_, nis, ok)) in stamps.iter().zip(&steps) {
+                let d = &mut direct[((t - stamps[0]) / width) as usize];
+                d.0 += 1;
+                if ok {
+                    d.1 += 1;
+                    d.2 += nis;
+                }
+            }
+            for (b, d) in o.bins.iter().zip(&direct) {
+                prop_assert_eq!((b.count, b.accepted), (d.0, d.1));
+                prop_assert!((b.mean_nis_accepted - mean(d.2, d.1)).abs() <= 1e-9 * (1.0 + d.2));
+            }
+        }
+    }
+
+    #[test]
+    fn a_short_run_keeps_one_second_bins() {
+        let mut stats = InnovationStats::new(1);
+        for (t, nis) in [(0, 1.0), (400_000_000, 3.0), (2_500_000_000, 9.0)] {
+            stats.record(Stamp(10_000_000_000 + t), nis, nis < 5.0);
+        }
+        let o = &stats.over_time;
+        assert_eq!((o.start, o.bin_s, o.bins.len()), (Stamp(10_000_000_000), 1.0, 3));
+        assert_eq!((o.bins[0].count, o.bins[0].mean_nis_accepted), (2, 2.0));
+        assert_eq!((o.bins[1].count, o.bins[2].count, o.bins[2].accepted), (0, 1, 0));
+    }
 }

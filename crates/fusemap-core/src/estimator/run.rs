@@ -119,7 +119,7 @@ impl Filter<'_> {
                 let r_w = [[r[0][0] * k, r[0][1] * k], [r[1][0] * k, r[1][1] * k]];
                 let g = update_weighted(&mut self.x, &mut self.p, nu, &h, &r, &r_w, self.gates.two);
                 let accepted = g.accepted || (!g.nis.is_nan() && self.reset_if_consistent(nu, &r, z, antenna));
-                record(&mut self.counts.fixes, g, accepted);
+                record(&mut self.counts.fixes, stamp, g, accepted);
                 let q = &mut self.counts.by_quality[quality.index()];
                 if accepted {
                     q.used += 1;
@@ -134,12 +134,12 @@ impl Filter<'_> {
             Correction::Heading { yaw, var } => {
                 let (nu, h) = models::heading(&self.x, yaw);
                 let g = update(&mut self.x, &mut self.p, nu, &h, &[[var]], self.gates.one);
-                record(&mut self.counts.headings, g, g.accepted);
+                record(&mut self.counts.headings, stamp, g, g.accepted);
             }
             Correction::Pose { z, r } => {
                 let (nu, h) = models::pose(&self.x, z);
                 let g = update(&mut self.x, &mut self.p, nu, &h, &r, self.gates.three);
-                record(&mut self.counts.poses, g, g.accepted);
+                record(&mut self.counts.poses, stamp, g, g.accepted);
             }
         }
     }
@@ -211,14 +211,14 @@ impl Filter<'_> {
     }
 }
 
-fn record(rep: &mut CorrectionReport, g: Gated, accepted: bool) {
+fn record(rep: &mut CorrectionReport, stamp: Stamp, g: Gated, accepted: bool) {
     if accepted {
         rep.used += 1;
     } else {
         rep.rejected_gate += 1;
     }
     if g.nis.is_finite() {
-        rep.innovation.record(g.nis, g.accepted);
+        rep.innovation.record(stamp, g.nis, g.accepted);
     }
 }
 
@@ -293,14 +293,14 @@ impl Filter<'_> {
         j
     }
 
-    /// Predicts over `dt` seconds of `drive` moving by `inc` (odometry) and `gyro_angle`
+    /// Predicts over the `dt` seconds ending at `t` of `drive` moving by `inc` (odometry) and `gyro_angle`
     /// (the gyro's integral, with its variance), and while standing still corrects with
     /// the gyro's zero rate. Returns the prediction and its Jacobian.
     fn predict_step(
         &mut self,
         drive: Drive,
         inc: Pose2,
-        dt: f64,
+        (t, dt): (Stamp, f64),
         gyro_angle: Option<(f64, f64)>,
     ) -> ([f64; N], Mat<N, N>, Mat<N, N>) {
         let (iv, cfg) = (drive.iv, self.cfg);
@@ -334,7 +334,7 @@ impl Filter<'_> {
         if let (true, Some((angle, var))) = (iv.stationary && dt > 0.0, gyro_angle) {
             let (nu, h) = models::zero_rate(&self.x, angle / dt);
             let g = update(&mut self.x, &mut self.p, nu, &h, &[[var / (dt * dt)]], self.gates.one);
-            record(&mut self.counts.zero_rate, g, g.accepted);
+            record(&mut self.counts.zero_rate, t, g, g.accepted);
             self.counts.stationary_s += dt;
         }
         (x_pred, p_pred, jac)
@@ -438,7 +438,7 @@ pub(crate) fn run(
             let odo_t = odo.pose_at(t);
             let inc = odo_cur.inverse().compose(odo_t);
             let gyro_angle = gyro.and_then(|g| g.integral(t_cur, t));
-            let (x_pred, p_pred, jac) = f.predict_step(drive, inc, t.secs_since(t_cur), gyro_angle);
+            let (x_pred, p_pred, jac) = f.predict_step(drive, inc, (t, t.secs_since(t_cur)), gyro_angle);
             while j < corrections.len() && corrections[j].0 == t {
                 f.correct(corrections[j].0, &corrections[j].1);
                 j += 1;

@@ -304,8 +304,21 @@ fn findings(s: &Value) -> String {
     } else {
         format!("<ul>{}</ul>", notes.join(""))
     };
-    let hint = "<p><small>The run's notes: what it skipped, replaced or could not use, and why. <code>fusemap doctor LOG</code> checks a log without mapping it.</small></p>";
-    section("findings", "Findings", &format!("{body}{hint}"))
+    let hint = "<p><small>The run's notes: what it skipped, replaced or could not use, and why.</small></p>";
+    let doctor: Vec<String> = s["log"]["log_findings"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|n| n.as_str())
+        .map(|n| format!("<li>{}</li>", escape(n)))
+        .collect();
+    let doctor = match (s["log"]["log_findings"].is_array(), doctor.is_empty()) {
+        (false, _) => String::new(),
+        (true, true) => "<h3>The log</h3><p class=\"none\">No clock or pose-sensor fault found.</p>".to_string(),
+        (true, false) => format!("<h3>The log</h3><ul>{}</ul>", doctor.join("")),
+    };
+    let tail = "<p><small>The log's findings are <code>fusemap doctor LOG</code>'s: its streams' timing and its pose sensors, checked without mapping.</small></p>";
+    section("findings", "Findings", &format!("{body}{hint}{doctor}{tail}"))
 }
 
 fn estimator(e: &Value) -> String {
@@ -337,6 +350,7 @@ fn estimator(e: &Value) -> String {
         num(&e["gyro_bias"]),
         num(&e["gyro_bias_sigma"])
     );
+    body.push_str(&super::report_tables::nis_over_time(e));
     body.push_str(&super::report_tables::rejections_over_time(e));
     section("estimator", "Estimator", &body)
 }
@@ -378,6 +392,18 @@ mod tests {
             assert!(page.contains(&format!("<section id=\"{id}\">")), "{id}");
         }
         assert!(page.contains("a &lt;b&gt;") && !page.contains("<b>a"));
+    }
+
+    #[test]
+    fn the_findings_hold_the_logs_apart_from_the_runs() {
+        let s = serde_json::json!({"notes": ["a note"], "log": {"log_findings": ["/odom pauses <b>"]}});
+        let f = findings(&s);
+        assert!(
+            f.contains("<li>a note</li>") && f.contains("<h3>The log</h3><ul><li>/odom pauses &lt;b&gt;</li></ul>")
+        );
+        let none = findings(&serde_json::json!({"notes": [], "log": {"log_findings": []}}));
+        assert!(none.contains("No clock or pose-sensor fault found"));
+        assert!(!findings(&serde_json::json!({"notes": []})).contains("<h3>"));
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! The sections of `report.html` that read the commands' own results: the validation's
 //! maps and verdict, the calibration's estimates with their intervals and cost curves, and
-//! the estimator's rejections over time.
+//! the estimator's rejections and innovations over time.
 
 use super::report_page::{escape, section};
 use super::svg_plot::{svg, Plot};
@@ -182,6 +182,60 @@ pub(crate) fn rejections_over_time(e: &Value) -> String {
     }
 }
 
+/// Each correction kind's mean NIS of accepted corrections over time, divided by its
+/// degrees of freedom: near 1 where the filter is consistent (Bar-Shalom et al., §5.4),
+/// well above where its noise figures are too small for that stretch, below where too
+/// large. One plot per kind that has corrections, times from the earliest of them.
+pub(crate) fn nis_over_time(e: &Value) -> String {
+    let kinds = [
+        ("fixes", "GNSS fixes"),
+        ("poses", "absolute poses"),
+        ("headings", "headings"),
+        ("zero_rate", "zero-rate updates"),
+    ];
+    // A kind without corrections has no bins (and a start of 0).
+    let start = |k: &str| {
+        let o = &e[k]["innovation"]["over_time"];
+        o["bins"].as_array().is_some_and(|b| !b.is_empty()).then(|| o["start"].as_f64()).flatten()
+    };
+    let Some(t0) = kinds.iter().filter_map(|(k, _)| start(k)).reduce(f64::min) else {
+        return String::new();
+    };
+    let mut out = String::new();
+    for (kind, name) in kinds {
+        let i = &e[kind]["innovation"];
+        let (Some(start), Some(bin_s), Some(dof)) = (start(kind), i["over_time"]["bin_s"].as_f64(), i["dof"].as_f64())
+        else {
+            continue;
+        };
+        let line: Vec<[f64; 2]> = i["over_time"]["bins"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .enumerate()
+            .filter(|(_, b)| b["accepted"].as_u64().unwrap_or(0) > 0)
+            .filter_map(|(k, b)| {
+                Some([(start - t0) * 1e-9 + (k as f64 + 0.5) * bin_s, b["mean_nis_accepted"].as_f64()? / dof.max(1.0)])
+            })
+            .collect();
+        let plot = Plot {
+            x_label: "time since the first correction, s",
+            y_label: "mean NIS ÷ dof",
+            line: &line,
+            ..Default::default()
+        };
+        if let (false, Some(svg)) = (line.is_empty(), svg(&plot)) {
+            let _ = write!(
+                out,
+                "<figure><figcaption>{name}: mean NIS of the accepted ones per {} s, over its {} degrees of freedom (about 1 when consistent)</figcaption>{svg}</figure>",
+                f(&i["over_time"]["bin_s"], 0),
+                f(&i["dof"], 0)
+            );
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -211,5 +265,17 @@ mod tests {
         let e = json!({"rejected_fixes": [{"stamp": 2.0e9, "nis": 70.0}], "slip_stretches": [{"start": 1.0e9, "end": 1.5e9}]});
         assert!(rejections_over_time(&e).contains("<circle"));
         assert!(rejections_over_time(&json!({})).contains("No GNSS fix"));
+    }
+
+    #[test]
+    fn nis_is_plotted_over_time_per_kind() {
+        let bins = json!([{"count": 3, "accepted": 3, "mean_nis_accepted": 2.2}, {"count": 0, "accepted": 0, "mean_nis_accepted": 0.0},
+            {"count": 5, "accepted": 4, "mean_nis_accepted": 1.8}]);
+        let e = json!({"fixes": {"innovation": {"dof": 2, "over_time": {"start": 1.0e9, "bin_s": 2.0, "bins": bins}}},
+            "zero_rate": {"innovation": {"dof": 1, "over_time": {"start": 0.0, "bin_s": 1.0, "bins": []}}}});
+        let s = nis_over_time(&e);
+        assert_eq!(s.matches("<svg").count(), 1, "{s}");
+        assert!(s.contains("GNSS fixes") && s.contains("per 2 s"));
+        assert!(nis_over_time(&json!({})).is_empty());
     }
 }

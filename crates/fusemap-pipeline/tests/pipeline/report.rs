@@ -61,6 +61,8 @@ fn the_report_renders_every_section_in_a_browser() {
         }
     }
     assert!(dom.matches("<img ").count() >= 2 && dom.contains("data:image/png;base64,iVBOR"));
+    // The estimator's consistency over time: its GNSS fixes' NIS, plotted.
+    assert!(dom.contains("GNSS fixes: mean NIS"), "no NIS over time in the estimator's section");
     let shot = dir.join("report.png");
     let _ = std::fs::remove_file(&shot);
     let run = chromium(
