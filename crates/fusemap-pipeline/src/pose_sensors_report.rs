@@ -16,7 +16,7 @@ use std::fmt::Write as _;
 pub fn gnss_quality(plan: &Plan, inv: &Inventory, out: &mut String, findings: &mut Vec<String>) -> std::fmt::Result {
     // The band of the GNSS table each topic is bound to, as the run binds it (the default
     // where binding fails: doctor then reports why).
-    let bound = crate::sensors::bind(plan, &crate::run::topics_by_kind(inv)).ok();
+    let bound = crate::sensors::bind(plan, &crate::sensors::topics_by_kind(inv)).ok();
     let band_of = |topic: &str| {
         bound
             .as_ref()

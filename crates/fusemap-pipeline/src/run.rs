@@ -11,12 +11,12 @@
 pub use crate::map_pass::{map_with_track, MapRun, PassMaps};
 pub use crate::progress::Progress;
 use crate::recording::Inventory;
+pub use crate::sensors::topics_by_kind;
 use crate::sensors::{bind, Bound};
 pub use crate::sync::{limits, sync_mode};
 use crate::track::{choose, ChosenTrack};
 use crate::PipelineError;
-use fusemap_core::config::{Plan, SensorKind};
-use std::collections::BTreeMap;
+use fusemap_core::config::Plan;
 use std::path::Path;
 use std::time::Instant;
 
@@ -26,27 +26,6 @@ pub fn map_log(plan: &Plan, path: &Path, progress: &mut dyn FnMut(Progress)) -> 
     let inv = Inventory::read_with(path, &plan.limits)?;
     progress(Progress::Done);
     map_inventory(plan, &inv, progress)
-}
-
-/// The topics of the first pass, by kind, with their message counts.
-pub fn topics_by_kind(inv: &Inventory) -> BTreeMap<SensorKind, BTreeMap<String, u64>> {
-    let mut m: BTreeMap<SensorKind, BTreeMap<String, u64>> = BTreeMap::new();
-    for (t, s) in &inv.scans {
-        m.entry(SensorKind::Lidar).or_default().insert(t.clone(), s.stamps.len() as u64);
-    }
-    for (t, v) in &inv.odom {
-        m.entry(SensorKind::WheelOdometry).or_default().insert(t.clone(), v.len() as u64);
-    }
-    for (t, v) in &inv.imu {
-        m.entry(SensorKind::Imu).or_default().insert(t.clone(), v.len() as u64);
-    }
-    for (t, v) in &inv.gnss {
-        m.entry(SensorKind::Gnss).or_default().insert(t.clone(), v.len() as u64);
-    }
-    for (t, v) in &inv.poses {
-        m.entry(SensorKind::Pose).or_default().insert(t.clone(), v.len() as u64);
-    }
-    m
 }
 
 /// Binds the sensors and builds the pose track from the pose sensors alone.

@@ -6,6 +6,7 @@
 //! log's only topic of that kind (CARMEN logs: `FLASER`, `ROBOTLASER1`, `RAWLASER1` for
 //! the front laser, `ODOM`).
 
+use crate::recording::Inventory;
 use crate::PipelineError;
 use fusemap_core::config::{auto_sensor, Plan, PlannedLidar, PlannedSensor, SensorKind};
 use fusemap_core::time::Stamp;
@@ -180,4 +181,25 @@ fn auto_topic(kind: SensorKind, topics: &BTreeMap<String, u64>) -> Option<String
         return Some(t.to_string());
     }
     (topics.len() == 1).then(|| topics.keys().next().cloned()).flatten()
+}
+
+/// The topics of the first pass, by kind, with their message counts.
+pub fn topics_by_kind(inv: &Inventory) -> BTreeMap<SensorKind, BTreeMap<String, u64>> {
+    let mut m: BTreeMap<SensorKind, BTreeMap<String, u64>> = BTreeMap::new();
+    for (t, s) in &inv.scans {
+        m.entry(SensorKind::Lidar).or_default().insert(t.clone(), s.stamps.len() as u64);
+    }
+    for (t, v) in &inv.odom {
+        m.entry(SensorKind::WheelOdometry).or_default().insert(t.clone(), v.len() as u64);
+    }
+    for (t, v) in &inv.imu {
+        m.entry(SensorKind::Imu).or_default().insert(t.clone(), v.len() as u64);
+    }
+    for (t, v) in &inv.gnss {
+        m.entry(SensorKind::Gnss).or_default().insert(t.clone(), v.len() as u64);
+    }
+    for (t, v) in &inv.poses {
+        m.entry(SensorKind::Pose).or_default().insert(t.clone(), v.len() as u64);
+    }
+    m
 }
