@@ -291,31 +291,24 @@ fn pose_sensors(log: &Value) -> Vec<Vec<String>> {
     rows
 }
 
+/// The strings of the array `v` as escaped `<li>` items, joined; empty without any.
+pub(crate) fn list_items(v: &Value) -> String {
+    v.as_array().into_iter().flatten().filter_map(|n| n.as_str()).map(|n| format!("<li>{}</li>", escape(n))).collect()
+}
+
 fn findings(s: &Value) -> String {
-    let notes: Vec<String> = s["notes"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(|n| n.as_str())
-        .map(|n| format!("<li>{}</li>", escape(n)))
-        .collect();
+    let notes = list_items(&s["notes"]);
     let body = if notes.is_empty() {
         "<p class=\"none\">Nothing to report.</p>".to_string()
     } else {
-        format!("<ul>{}</ul>", notes.join(""))
+        format!("<ul>{notes}</ul>")
     };
     let hint = "<p><small>The run's notes: what it skipped, replaced or could not use, and why.</small></p>";
-    let doctor: Vec<String> = s["log"]["log_findings"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(|n| n.as_str())
-        .map(|n| format!("<li>{}</li>", escape(n)))
-        .collect();
+    let doctor = list_items(&s["log"]["log_findings"]);
     let doctor = match (s["log"]["log_findings"].is_array(), doctor.is_empty()) {
         (false, _) => String::new(),
         (true, true) => "<h3>The log</h3><p class=\"none\">No clock or pose-sensor fault found.</p>".to_string(),
-        (true, false) => format!("<h3>The log</h3><ul>{}</ul>", doctor.join("")),
+        (true, false) => format!("<h3>The log</h3><ul>{doctor}</ul>"),
     };
     let tail = "<p><small>The log's findings are <code>fusemap doctor LOG</code>'s: its streams' timing and its pose sensors, checked without mapping.</small></p>";
     section("findings", "Findings", &format!("{body}{hint}{doctor}{tail}"))

@@ -2,7 +2,7 @@
 //! maps and verdict, the calibration's estimates with their intervals and cost curves, and
 //! the estimator's rejections and innovations over time.
 
-use super::report_page::{escape, section};
+use super::report_page::{escape, list_items, section};
 use super::svg_plot::{svg, Plot};
 use serde_json::Value;
 use std::fmt::Write;
@@ -131,15 +131,9 @@ pub(crate) fn calibration(c: &Value) -> String {
         let _ = write!(s, "<p class=\"verdict\">{}</p>", escape(r));
     }
     s.push_str(&plots);
-    let undetermined: Vec<String> = c["undetermined"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(|x| x.as_str())
-        .map(|u| format!("<li>{}</li>", escape(u)))
-        .collect();
+    let undetermined = list_items(&c["undetermined"]);
     if !undetermined.is_empty() {
-        let _ = write!(s, "<p>Not determined:</p><ul>{}</ul>", undetermined.join(""));
+        let _ = write!(s, "<p>Not determined:</p><ul>{undetermined}</ul>");
     }
     section("calibration", "Calibration", &s)
 }
