@@ -6,6 +6,7 @@
 //! Hornung et al. 2013).
 
 use crate::camera::MappedCamera;
+use crate::outputs::map_formats::ENDPOINT_BYTES;
 use crate::recording::{line_key, LineKey, RangeMessage};
 use crate::report::LidarReport;
 use crate::track::{LinePoses, Track};
@@ -145,11 +146,27 @@ impl Endpoints {
 }
 
 impl Inserter<'_> {
-    /// Keeps the last inserted scan's returns, when asked.
-    fn keep_endpoints(&mut self) {
-        if let Some(e) = &mut self.endpoints {
-            e.add(self.engine.last_range_data(), self.engine.maps().primary().grid().geometry());
+    /// Keeps the last inserted scan's returns, when asked; an error once they no longer
+    /// fit in `[limits] memory_mib` beside the maps (at [`ENDPOINT_BYTES`] a return: a
+    /// log's returns grow with its length, and an hour of them can take gigabytes).
+    fn keep_endpoints(&mut self, stamp: Stamp) -> Result<(), PipelineError> {
+        let Some(e) = &mut self.endpoints else { return Ok(()) };
+        e.add(self.engine.last_range_data(), self.engine.maps().primary().grid().geometry());
+        let Some((maps, limit)) = self.engine.memory_use() else { return Ok(()) };
+        let kept = (e.points.len() as u64).saturating_mul(ENDPOINT_BYTES);
+        if maps.saturating_add(kept) <= limit {
+            return Ok(());
         }
+        Err(PipelineError::Refused(format!(
+            "the lidar returns kept for [output] points = \"endpoints\" reached limits.memory_mib = {} MiB at the \
+             scan stamped {:.6} s ({} returns need {} MiB to hold and write, beside the maps' {} MiB); raise \
+             limits.memory_mib, or write the occupied cells (points = \"cells\")",
+            limit >> 20,
+            stamp.as_secs_f64(),
+            e.points.len(),
+            kept >> 20,
+            maps >> 20
+        )))
     }
 
     fn insert(&mut self, l: &mut Mapped, key: Stamp, msg: &ScanMessage) -> Result<(), PipelineError> {
@@ -190,8 +207,9 @@ impl Inserter<'_> {
                 scan.stamp = self.last.map_or(stamp, |last| last.max(stamp));
                 self.engine.insert_scan_observed(sensor, id, scan, msg.range_min, msg.range_max, |_| pose)?;
                 self.placed.push((scan.stamp, pose));
-                self.last = Some(scan.stamp);
-                self.keep_endpoints();
+                let at = scan.stamp;
+                self.last = Some(at);
+                self.keep_endpoints(at)?;
             }
             Track::Timed(track) => {
                 let t = key;
@@ -223,7 +241,7 @@ impl Inserter<'_> {
                 if let Some(s) = &mut self.surface {
                     s.add(self.engine.last_range_data(), self.engine.maps().primary().grid().geometry());
                 }
-                self.keep_endpoints();
+                self.keep_endpoints(t)?;
                 self.placed.push((t, pose));
                 self.last = Some(t);
             }

@@ -195,3 +195,43 @@ fn a_world_pose_1e8_m_off_is_a_counted_glitch_and_the_map_is_the_one_without_it(
     assert!(maps[0] == maps[1], "the glitch changed the map");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `[output] points = "endpoints"` keeps every return of a log until the clouds are
+/// written, which grows with the log: past `limits.memory_mib` beside the maps the run
+/// stops naming the key, the scan and what to change, and writes no map; the same log
+/// and budget map with the occupied cells as points.
+#[test]
+fn endpoint_clouds_past_the_memory_budget_stop_the_run_naming_the_limit() {
+    let dir = temp_dir("limits-endpoints");
+    // 3,000 scans of 360 beams driving to and fro along a corridor 2 m wide: about 200
+    // returns kept a scan, 48 bytes each (29 MB in all), over a few tiles of map.
+    let lines: Vec<String> = (0..3000)
+        .map(|i| {
+            let ranges: Vec<String> = (0..360)
+                .map(|k| {
+                    let a = (k as f64 * 0.5 - 90.0).to_radians();
+                    format!("{:.3}", (1.0 / a.sin().abs()).min(8.0) + 0.001 * ((i + k) % 5) as f64)
+                })
+                .collect();
+            let (x, t) = (0.05 * (i % 100) as f64, 1.0 + 0.1 * i as f64);
+            format!("FLASER 360 {} {x:.2} 0 0 {x:.2} 0 0 {t:.3} host {t:.3}", ranges.join(" "))
+        })
+        .collect();
+    let log = write_file(&dir, "corridor.log", lines.join("\n") + "\n");
+    let ends = write_file(&dir, "ends.toml", "[output]\npoints = \"endpoints\"\n\n[limits]\nmemory_mib = 16\n");
+    let cells = write_file(&dir, "cells.toml", "[output]\npoints = \"cells\"\n\n[limits]\nmemory_mib = 16\n");
+    let out = dir.join("out");
+    let line = one_line_error(&run(&["map", "--config", s(&ends), "--out", s(&out), s(&log)]));
+    for part in
+        ["points = \"endpoints\"", "limits.memory_mib = 16 MiB", "at the scan stamped", "raise limits.memory_mib"]
+    {
+        assert!(line.contains(part), "`{part}` missing: {line}");
+    }
+    if out.exists() {
+        let names = file_names(&out);
+        assert!(!names.iter().any(|n| n.starts_with("map.")), "a map was written: {names:?}");
+    }
+    assert_success(&run(&["map", "--config", s(&cells), "--out", s(&out), s(&log)]));
+    assert!(out.join("map.ply").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -213,10 +213,23 @@ impl Engine {
     /// box may not.
     pub fn export_room(&self, map: &MapEntry) -> Option<(u64, usize)> {
         let b = self.budget?;
-        let held: u64 =
-            self.maps.iter().map(|m| (m.grid().tile_count() * self.tile_layers(m).tile_bytes()) as u64).sum();
         let per_cell = super::budget::export_bytes_per_cell(self.tile_layers(map).semantic_classes);
-        Some((b.limits.memory_bytes().saturating_sub(held), per_cell))
+        Some((b.limits.memory_bytes().saturating_sub(self.tile_bytes()), per_cell))
+    }
+
+    /// The bytes the maps take now, their tiles with what exporting them as stored
+    /// reserves (the largest map's, as they are written one at a time; see `budget.rs`),
+    /// and `[limits] memory_mib` in bytes; `None` without limits. What a run keeps beside
+    /// the maps, such as the lidar returns for endpoint clouds, must fit in the difference.
+    pub fn memory_use(&self) -> Option<(u64, u64)> {
+        let b = self.budget?;
+        let export = self.maps.iter().map(|m| (m.grid().tile_count() * self.tile_layers(m).export_bytes()) as u64);
+        Some((self.tile_bytes() + export.max().unwrap_or(0), b.limits.memory_bytes()))
+    }
+
+    /// Bytes every map's tiles take now, with every layer they can come to carry.
+    fn tile_bytes(&self) -> u64 {
+        self.maps.iter().map(|m| (m.grid().tile_count() * self.tile_layers(m).tile_bytes()) as u64).sum()
     }
 
     /// The layers `map`'s tiles may come to carry.

@@ -84,6 +84,32 @@ fn a_camera_with_many_classes_and_the_dynamic_layer_shrink_the_tiles_a_map_may_h
     assert!(3 * dynamic < 2 * lidar_only, "{dynamic} vs {lidar_only}");
 }
 
+#[test]
+fn the_memory_in_use_is_the_tiles_with_their_export_and_stays_within_the_limit() {
+    let (mut e, a, _) = engine();
+    assert_eq!(e.memory_use(), None, "no limits, no budget");
+    let limits = LimitsConfig { memory_mib: 1, ..Default::default() };
+    e.set_limits(&limits);
+    assert_eq!(e.memory_use(), Some((0, 1 << 20)));
+    e.insert_scan(a, &scan(1), Pose2::IDENTITY).unwrap();
+    let tiles = e.grid().tile_count();
+    assert!(tiles > 0);
+    use crate::fusion::budget::TileLayers;
+    let per_tile = (TileLayers::default().tile_bytes() + TileLayers::default().export_bytes()) as u64;
+    assert_eq!(e.memory_use(), Some((tiles as u64 * per_tile, 1 << 20)));
+    // Grown until the budget refuses: what is in use never passes the limit.
+    for k in 2..200 {
+        if e.insert_scan(a, &scan(k), Pose2::new(100.0 * k as f64, 0.0, 0.0)).is_err() {
+            break;
+        }
+        let (used, limit) = e.memory_use().unwrap();
+        assert!(used <= limit, "{used} > {limit} after {k} scans");
+    }
+    let (held, per_cell) = e.export_room(e.maps().primary()).unwrap();
+    assert_eq!(held, (1 << 20) - e.grid().tile_count() as u64 * TileLayers::default().tile_bytes() as u64);
+    assert_eq!(per_cell, 9);
+}
+
 mod observed {
     use super::*;
     use crate::geometry::{PlanarMount, Point2};

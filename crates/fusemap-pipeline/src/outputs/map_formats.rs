@@ -9,8 +9,14 @@ use fusemap_core::geometry::{Point2, Pose2};
 use fusemap_core::grid::{CellRaster, Raster};
 use fusemap_core::time::Stamp;
 use fusemap_io::map_mcap::{write_map_mcap, MapMessages};
-use fusemap_io::point_cloud::{write_pcd, write_ply, MapCloud};
+use fusemap_io::point_cloud::{write_pcd, write_ply, MapCloud, MapPoint};
 use fusemap_io::semantic::SemanticRaster;
+
+/// Bytes one lidar return kept for `[output] points = "endpoints"` takes by the time the
+/// clouds are written, when all three copies are held: the point as kept (8), its
+/// [`MapPoint`] and its `PointCloud2` record for `map.mcap` (16 bytes without classes).
+/// The returns count against `[limits] memory_mib` at this price beside the maps.
+pub const ENDPOINT_BYTES: u64 = (std::mem::size_of::<[f32; 2]>() + std::mem::size_of::<MapPoint>() + 16) as u64;
 
 /// The formats a run writes, and the lidar returns for `[output] points = "endpoints"`
 /// (a log run's; `None` for the other runs, whose clouds hold the occupied cells).

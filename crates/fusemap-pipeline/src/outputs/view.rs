@@ -6,10 +6,14 @@
 use super::OutputError;
 use fusemap_core::config::{OutputConfig, Plan};
 use fusemap_core::geometry::Point2;
-use fusemap_core::grid::{CellBox, ExtraLayers, GridGeometry, LayeredGrid, Raster, SparseTiles};
+use fusemap_core::grid::{CellBox, ExtraLayers, GridGeometry, LayeredGrid, Raster, SparseTiles, TILE_CELLS};
 
 /// Largest side of the overview picture of a sparse export, in pixels before enlargement.
 pub const OVERVIEW_SIDE: usize = 4096;
+
+/// Bytes a pixel of the overview takes while it is written: its log-odds and known flag
+/// (5) and the picture writer's buffers (4), as `budget.rs` counts a cell of a dense export.
+const OVERVIEW_BYTES_PER_PIXEL: u64 = 9;
 
 /// A region of the map to export densely, metres, from `--crop x0,y0,x1,y1`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -141,6 +145,21 @@ impl ExportRoom {
     fn fits(&self, n: u128) -> bool {
         self.needs(n) <= self.bytes as u128
     }
+
+    /// The room left once `bytes` more are held beside the maps (the lidar returns of an
+    /// endpoint cloud).
+    pub fn without(self, bytes: u64) -> Self {
+        Self { bytes: self.bytes.saturating_sub(bytes), ..self }
+    }
+}
+
+/// The side of a sparse export's overview: [`OVERVIEW_SIDE`], or less where the room left
+/// beside the maps, less the copy of their `tiles` as stored, cannot hold that picture.
+fn overview_side(room: Option<ExportRoom>, tiles: usize) -> usize {
+    let Some(r) = room else { return OVERVIEW_SIDE };
+    let copy = (tiles as u64).saturating_mul((TILE_CELLS * std::mem::size_of::<f32>()) as u64);
+    let pixels = r.bytes.saturating_sub(copy) / OVERVIEW_BYTES_PER_PIXEL;
+    usize::try_from(pixels.isqrt()).unwrap_or(usize::MAX).clamp(1, OVERVIEW_SIDE)
 }
 
 /// Chooses the view of `grid` to export under `options`, within `room` when the run has a
@@ -182,7 +201,9 @@ pub fn view_of<L: ExtraLayers>(
             None => MapView::Empty,
         });
     }
-    let Some((overview, factor)) = grid.overview(OVERVIEW_SIDE) else { return Ok(MapView::Empty) };
+    let Some((overview, factor)) = grid.overview(overview_side(room, grid.tile_count())) else {
+        return Ok(MapView::Empty);
+    };
     let tiles = grid.sparse_tiles();
     let why = match over_memory {
         Some(r) if n <= limit as u128 => format!(
@@ -269,6 +290,20 @@ mod tests {
         };
         assert_eq!(tiles.keys.len(), g.tile_count());
         assert!(notes[0].contains("limits.memory_mib leaves beside the maps"), "{}", notes[0]);
+        // The overview fits the room left beside the copy of the tiles: coarser when it
+        // is short, never more than OVERVIEW_SIDE.
+        let copy = (g.tile_count() * TILE_CELLS * 4) as u64;
+        for (bytes, side) in [(copy + 9 * 100, 10), (copy + 9 * 99, 9), (copy, 1), (0, 1), (u64::MAX, OVERVIEW_SIDE)] {
+            assert_eq!(overview_side(Some(ExportRoom { bytes, per_cell: 9 }), g.tile_count()), side, "{bytes}");
+        }
+        let cramped = ExportRoom { bytes: copy + 9 * 100, per_cell: 9 };
+        let tight = ExportOptions { export_cells: 100, ..options };
+        let MapView::Sparse { overview, .. } = view_of(&g, &tight, Some(cramped), &mut notes).unwrap() else {
+            panic!("sparse")
+        };
+        assert!(overview.width <= 10 && overview.height <= 10, "{} x {}", overview.width, overview.height);
+        assert!(overview.known_count() > 0);
+        assert_eq!(overview_side(None, g.tile_count()), OVERVIEW_SIDE);
         // A crop the room cannot hold is refused naming the key.
         let crop = ExportOptions { crop: Some(parse_crop("0,-1,4,1").unwrap()), ..options };
         let tiny = ExportRoom { bytes: 1000, per_cell: 9 };

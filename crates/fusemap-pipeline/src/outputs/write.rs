@@ -389,7 +389,9 @@ pub fn finish(
     } = record;
     let clock = RunClock { started, outputs_from: Instant::now(), phases: seconds };
     let grid = engine.grid();
-    let room = ExportRoom::of(engine.export_room(engine.maps().primary()));
+    // The returns of an endpoint cloud are held beside the maps while they are written.
+    let kept = endpoints.map_or(0, |e| (e.len() as u64).saturating_mul(super::map_formats::ENDPOINT_BYTES));
+    let room = ExportRoom::of(engine.export_room(engine.maps().primary())).map(|r| r.without(kept));
     let view = view_of(grid, export, room, &mut notes)?;
     let raster = match &view {
         MapView::Dense(r) => Some(r),
