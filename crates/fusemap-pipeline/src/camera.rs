@@ -11,7 +11,7 @@ use crate::extrinsics::{from_tf, resolve, ExtrinsicsReport};
 use crate::recording::Inventory;
 use crate::sync::Skipped;
 use crate::track::Track;
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::calibration::CameraSample;
 use fusemap_core::config::{ExtrinsicsSource, LogConfig, PlannedCamera};
 use fusemap_core::frames::FrameTree;
@@ -128,7 +128,7 @@ pub(crate) fn build_camera(
     notes: &mut Vec<String>,
 ) -> Result<BuiltCamera, PipelineError> {
     let unusable = |m: String| Ok(BuiltCamera::Unusable(m));
-    let refuse = |m: String| PipelineError::Refused(format!("camera `{}`: {m}", c.name));
+    let refuse = |m: String| PipelineError::refused(Stage::Sensors, format!("camera `{}`: {m}", c.name));
     let info = inv.camera_info.get(&c.info_topic).ok_or_else(|| {
         refuse(format!(
             "the log has no camera info on `{}` (the intrinsics of the label and depth images); log camera-info topics: {}",

@@ -24,7 +24,7 @@ use crate::gnss_fixes;
 use crate::recording::{planar_covariance, Inventory};
 use crate::sensors::{Bound, BoundSensor};
 use crate::track::{glitch_note, ChosenTrack, Track, TrackCounts};
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::{LogConfig, Plan, PoseSource, SensorKind};
 use fusemap_core::estimator::{
     base_yaw_rate, estimate, odometry_increment_covariance, Estimate, EstimatorConfig, EstimatorError, EstimatorInput,
@@ -63,11 +63,14 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
     let odometers: Vec<&str> =
         bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::WheelOdometry).map(|s| s.topic.as_str()).collect();
     if odometers.len() > 1 {
-        return Err(PipelineError::Refused(format!(
-            "the estimator fuses one wheel odometry, the config lists {} ({}): disable all but one",
-            odometers.len(),
-            odometers.join(", ")
-        )));
+        return Err(PipelineError::refused(
+            Stage::Poses,
+            format!(
+                "the estimator fuses one wheel odometry, the config lists {} ({}): disable all but one",
+                odometers.len(),
+                odometers.join(", ")
+            ),
+        ));
     }
     for s in &bound.sensors {
         match s.sensor.kind {
@@ -212,7 +215,7 @@ fn estimate_without_unusable_fixes(
     config: &EstimatorConfig,
     notes: &mut Vec<String>,
 ) -> Result<(Estimate, usize), PipelineError> {
-    let refused = |e: EstimatorError| PipelineError::Refused(format!("pose estimator: {e}"));
+    let refused = |e: EstimatorError| PipelineError::refused(Stage::Poses, format!("pose estimator: {e}"));
     match estimate(&inputs, config) {
         Err(EstimatorError::HeadingNotObservable { travelled_m, needed_m }) => {
             let is_fix = |i: &EstimatorInput| matches!(i, EstimatorInput::Position { .. });

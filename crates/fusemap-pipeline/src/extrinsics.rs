@@ -7,7 +7,7 @@
 
 use crate::recording::ScanTopic;
 use crate::sensors::BoundSensor;
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::{ExtrinsicsSource, LogConfig};
 use fusemap_core::frames::{FrameTree, FrameTreeLimits, LookupError};
 use fusemap_core::geometry::{normalize_angle, Mount3, Pose3};
@@ -119,10 +119,10 @@ pub fn resolve(
         }
         (ExtrinsicsSource::Auto | ExtrinsicsSource::Tf, Some((m, n)), _) => (n.to_string(), m),
         (ExtrinsicsSource::Tf, None, _) => {
-            return Err(PipelineError::Refused(format!(
-                "log.extrinsics = \"tf\" but the log has no transform {} → `{name}`",
-                cfg.base_frame
-            )))
+            return Err(PipelineError::refused(
+                Stage::Mounts,
+                format!("log.extrinsics = \"tf\" but the log has no transform {} → `{name}`", cfg.base_frame),
+            ))
         }
     };
     Ok(ExtrinsicsReport {

@@ -7,7 +7,7 @@ use crate::estimation_report::GnssInputReport;
 use crate::extrinsics::frame_tree;
 use crate::recording::Inventory;
 use crate::sensors::{Bound, BoundSensor};
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::{LogConfig, Plan, SensorKind};
 use fusemap_core::estimator::{check_fix, EstimatorInput, FixProblem, FixQuality, GnssCovarianceKind, Repeated};
 use fusemap_core::frames::FrameTree;
@@ -182,8 +182,8 @@ pub(crate) fn gnss_inputs(
     };
     r.datum_source = chosen.source.to_string();
     let (lat0, lon0, alt0) = chosen.lla;
-    let datum =
-        Datum::new(lat0, lon0, alt0).map_err(|e| PipelineError::Refused(format!("GNSS `{}`: datum: {e}", s.topic)))?;
+    let datum = Datum::new(lat0, lon0, alt0)
+        .map_err(|e| PipelineError::refused(Stage::Poses, format!("GNSS `{}`: datum: {e}", s.topic)))?;
     r.datum = Some([lat0, lon0, alt0]);
     let frame = s.sensor.frame.clone().or_else(|| msgs.first().map(|m| m.frame_id.clone())).unwrap_or_default();
     let lever = crate::extrinsics::sensor_mount(s, cfg, tree, &frame, msgs.first().map(|m| m.stamp), &mut notes)?;

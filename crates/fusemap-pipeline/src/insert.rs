@@ -10,7 +10,7 @@ use crate::outputs::map_formats::ENDPOINT_BYTES;
 use crate::recording::{line_key, LineKey, RangeMessage};
 use crate::report::LidarReport;
 use crate::track::{LinePoses, Track};
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::calibration::SurfaceHits;
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
@@ -157,16 +157,19 @@ impl Inserter<'_> {
         if maps.saturating_add(kept) <= limit {
             return Ok(());
         }
-        Err(PipelineError::Refused(format!(
-            "the lidar returns kept for [output] points = \"endpoints\" reached limits.memory_mib = {} MiB at the \
+        Err(PipelineError::refused(
+            Stage::Budget,
+            format!(
+                "the lidar returns kept for [output] points = \"endpoints\" reached limits.memory_mib = {} MiB at the \
              scan stamped {:.6} s ({} returns need {} MiB to hold and write, beside the maps' {} MiB); raise \
              limits.memory_mib, or write the occupied cells (points = \"cells\")",
-            limit >> 20,
-            stamp.as_secs_f64(),
-            e.points.len(),
-            kept >> 20,
-            maps >> 20
-        )))
+                limit >> 20,
+                stamp.as_secs_f64(),
+                e.points.len(),
+                kept >> 20,
+                maps >> 20
+            ),
+        ))
     }
 
     fn insert(&mut self, l: &mut Mapped, key: Stamp, msg: &ScanMessage) -> Result<(), PipelineError> {

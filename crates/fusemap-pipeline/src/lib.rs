@@ -74,10 +74,58 @@ pub enum PipelineError {
     /// The engine refused a measurement.
     #[error(transparent)]
     Engine(#[from] fusemap_core::fusion::EngineError),
-    /// The log and the configuration do not allow a run, with the reason.
+    /// The log and the configuration do not allow a run: the stage that refused, and why.
     #[error("{0}")]
-    Refused(String),
+    Refused(Refusal),
     /// Writing a text report failed.
     #[error("cannot format the report")]
     Format(#[from] std::fmt::Error),
+}
+
+impl PipelineError {
+    /// A refusal by `stage`, saying `why`.
+    pub fn refused(stage: Stage, why: impl Into<String>) -> Self {
+        Self::Refused(Refusal { stage, why: why.into() })
+    }
+
+    /// The stage that refused the run, if it was refused.
+    pub fn refusal_stage(&self) -> Option<Stage> {
+        match self {
+            Self::Refused(r) => Some(r.stage),
+            _ => None,
+        }
+    }
+}
+
+/// Why the log and the configuration allow no run: the stage that said so, for a caller
+/// to act on (a budget to raise, a pose source to add), and the sentence a user reads.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{why}")]
+pub struct Refusal {
+    /// Which stage refused.
+    pub stage: Stage,
+    /// Why, naming the sensor, topic, key or stamp concerned.
+    pub why: String,
+}
+
+/// The stage of a run that refused it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Stage {
+    /// Binding the configured sensors to the log's topics: no scans, no lidar, a topic the
+    /// log lacks or that two sensors claim, a camera whose streams are unusable.
+    Sensors,
+    /// A sensor's mount (the configuration's or TF's) cannot be placed.
+    Mounts,
+    /// No pose track can be built: odometry, TF, scan-line poses or the estimator.
+    Poses,
+    /// A budget of `[limits]` is met: SLAM's grids, the returns of an endpoint cloud.
+    Budget,
+    /// A built-in configuration or scenario is not valid.
+    Configuration,
+    /// A world scan the engine refused.
+    World,
+    /// `fusemap validate` has nothing it can judge.
+    Validation,
+    /// `fusemap slam-bench` cannot score a log.
+    Benchmark,
 }

@@ -6,7 +6,7 @@
 use crate::extrinsics::{lidar_mount_from_log, resolve, ExtrinsicsReport};
 use crate::recording::Inventory;
 use crate::sensors::BoundLidar;
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::LogConfig;
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::PlanarMount;
@@ -51,10 +51,9 @@ fn frame_model(
     let log_mount = lidar_mount_from_log(tree, &cfg.base_frame, frame, topic);
     let config_mount = b.lidar.mount_given.then_some(b.lidar.mount);
     let ext: ExtrinsicsReport = resolve(frame, cfg, config_mount, log_mount, notes)?;
-    let planar: PlanarMount = ext
-        .base_from_sensor
-        .to_planar(b.lidar.max_tilt)
-        .map_err(|e| PipelineError::Refused(format!("mount of lidar `{}` ({}): {e}", b.lidar.name, ext.source)))?;
+    let planar: PlanarMount = ext.base_from_sensor.to_planar(b.lidar.max_tilt).map_err(|e| {
+        PipelineError::refused(Stage::Mounts, format!("mount of lidar `{}` ({}): {e}", b.lidar.name, ext.source))
+    })?;
     let mut params = *b.lidar.model.params();
     if !b.lidar.explicit {
         // Defaults suited to a typical indoor 2D lidar rather than the document's 10 m corridor.

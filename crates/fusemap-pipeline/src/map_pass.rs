@@ -16,7 +16,7 @@ use crate::report::{LidarReport, LogReport};
 use crate::sensors::Bound;
 use crate::sync::{limits, offset_ns, sync_mode, Skipped};
 use crate::track::{count_reordered, ChosenTrack, Track};
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::calibration::{CameraSample, SurfaceHits};
 use fusemap_core::config::{default_camera, Plan, PlannedCamera, PointsMode, SensorKind};
 use fusemap_core::frames::FrameTree;
@@ -83,7 +83,8 @@ pub(crate) fn planned_cameras(
     if !plan.cameras.is_empty() || plan.disabled_kinds.contains(&SensorKind::Camera) {
         return Ok(plan.cameras.clone());
     }
-    let c = default_camera(plan.occupancy.prior).map_err(|e| PipelineError::Refused(e.to_string()))?;
+    let c = default_camera(plan.occupancy.prior)
+        .map_err(|e| PipelineError::refused(Stage::Configuration, e.to_string()))?;
     let present = inv.images.contains_key(&c.topic)
         && inv.images.contains_key(&c.depth_topic)
         && inv.camera_info.contains_key(&c.info_topic);
@@ -158,7 +159,10 @@ pub fn map_with_track(
     let mut notes = bound.notes.clone();
     let slam_summary = chosen.slam.take();
     if bound.lidars.is_empty() {
-        return Err(PipelineError::Refused("no lidar to map: every [[sensor]] of kind lidar is disabled".into()));
+        return Err(PipelineError::refused(
+            Stage::Sensors,
+            "no lidar to map: every [[sensor]] of kind lidar is disabled",
+        ));
     }
     let mode = sync_mode(cfg, &inv.scans[&bound.lidars[0].topic].stamps);
     let mut engine = match maps.set {

@@ -15,7 +15,7 @@ pub use crate::sensors::topics_by_kind;
 use crate::sensors::{bind, Bound};
 pub use crate::sync::{limits, sync_mode};
 use crate::track::{choose, ChosenTrack};
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::Plan;
 use std::path::Path;
 use std::time::Instant;
@@ -31,11 +31,14 @@ pub fn map_log(plan: &Plan, path: &Path, progress: &mut dyn FnMut(Progress)) -> 
 /// Binds the sensors and builds the pose track from the pose sensors alone.
 pub fn prepare_track(plan: &Plan, inv: &Inventory) -> Result<(Bound, ChosenTrack, f64), PipelineError> {
     if inv.scans.is_empty() && inv.stats.malformed > 0 {
-        return Err(PipelineError::Refused(format!(
-            "the log holds no usable laser scans; {} records could not be decoded, the first: {}",
-            inv.stats.malformed,
-            inv.stats.malformed_examples.first().map_or("", |s| s.as_str())
-        )));
+        return Err(PipelineError::refused(
+            Stage::Sensors,
+            format!(
+                "the log holds no usable laser scans; {} records could not be decoded, the first: {}",
+                inv.stats.malformed,
+                inv.stats.malformed_examples.first().map_or("", |s| s.as_str())
+            ),
+        ));
     }
     let bound = bind(plan, &topics_by_kind(inv))?;
     let t0 = Instant::now();

@@ -8,7 +8,7 @@
 //! wall, did the lidar's own artefacts carve the pillars and machines open, and did the
 //! walking person stay out of the static map.
 
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::Plan;
 use fusemap_core::fusion::rasters::{semantic_cells, shown_classes};
 use fusemap_core::fusion::{MapSet, SensorSelection};
@@ -31,7 +31,8 @@ pub const PRODUCTION_LINE_CONFIG: &str = include_str!("../configs/production_lin
 pub fn production_line_plan() -> Result<Plan, PipelineError> {
     let cfg =
         fusemap_io::config_file::parse_config_str(PRODUCTION_LINE_CONFIG, Path::new("configs/production_line.toml"))?;
-    cfg.validate().map_err(|e| PipelineError::Refused(format!("configs/production_line.toml: {e}")))
+    cfg.validate()
+        .map_err(|e| PipelineError::refused(Stage::Configuration, format!("configs/production_line.toml: {e}")))
 }
 
 /// The three maps of one pass: fused (every sensor, the primary map), lidar-only and

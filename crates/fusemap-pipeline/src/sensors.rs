@@ -7,7 +7,7 @@
 //! the front laser, `ODOM`).
 
 use crate::recording::Inventory;
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::{auto_sensor, Plan, PlannedLidar, PlannedSensor, SensorKind};
 use fusemap_core::time::Stamp;
 use std::collections::BTreeMap;
@@ -93,23 +93,32 @@ fn bind_lidars(plan: &Plan, topics: &LogTopics, out: &mut Bound) -> Result<(), P
         let topic = match &l.topic {
             Some(t) if scans.contains_key(t) => t.clone(),
             Some(t) => {
-                return Err(PipelineError::Refused(format!(
-                    "lidar `{}`: topic `{t}` is not in the log (its scan topics: {})",
-                    l.name,
-                    topics.list(SensorKind::Lidar)
-                )))
+                return Err(PipelineError::refused(
+                    Stage::Sensors,
+                    format!(
+                        "lidar `{}`: topic `{t}` is not in the log (its scan topics: {})",
+                        l.name,
+                        topics.list(SensorKind::Lidar)
+                    ),
+                ))
             }
             None => auto_topic(SensorKind::Lidar, scans).ok_or_else(|| match scans.len() {
-                0 => PipelineError::Refused("the log holds no laser scans".into()),
-                _ => PipelineError::Refused(format!(
-                    "the log has several scan topics ({}) and none is `/scan`: list the lidars as \
+                0 => PipelineError::refused(Stage::Sensors, "the log holds no laser scans"),
+                _ => PipelineError::refused(
+                    Stage::Sensors,
+                    format!(
+                        "the log has several scan topics ({}) and none is `/scan`: list the lidars as \
                      [[sensor]] tables with kind = \"lidar\" and their topics",
-                    topics.list(SensorKind::Lidar)
-                )),
+                        topics.list(SensorKind::Lidar)
+                    ),
+                ),
             })?,
         };
         if out.lidars.iter().any(|b| b.topic == topic) {
-            return Err(PipelineError::Refused(format!("two lidars read topic `{topic}`: give each its own topic")));
+            return Err(PipelineError::refused(
+                Stage::Sensors,
+                format!("two lidars read topic `{topic}`: give each its own topic"),
+            ));
         }
         out.lidars.push(BoundLidar { lidar: l.clone(), topic });
     }
@@ -135,23 +144,29 @@ fn bind_pose_sensors(plan: &Plan, topics: &LogTopics, out: &mut Bound) -> Result
             let topic = match &s.topic {
                 Some(t) if topics.of(kind).contains_key(t) => t.clone(),
                 Some(t) => {
-                    return Err(PipelineError::Refused(format!(
-                        "{} sensor `{}`: topic `{t}` is not in the log (its {} topics: {})",
-                        kind.as_str(),
-                        s.name,
-                        kind.as_str(),
-                        topics.list(kind)
-                    )))
+                    return Err(PipelineError::refused(
+                        Stage::Sensors,
+                        format!(
+                            "{} sensor `{}`: topic `{t}` is not in the log (its {} topics: {})",
+                            kind.as_str(),
+                            s.name,
+                            kind.as_str(),
+                            topics.list(kind)
+                        ),
+                    ))
                 }
                 None => auto_topic(kind, topics.of(kind)).ok_or_else(|| {
-                    PipelineError::Refused(format!(
-                        "{} sensor `{}`: no topic given and the log has no `{}` (its {} topics: {})",
-                        kind.as_str(),
-                        s.name,
-                        kind.default_topic(),
-                        kind.as_str(),
-                        topics.list(kind)
-                    ))
+                    PipelineError::refused(
+                        Stage::Sensors,
+                        format!(
+                            "{} sensor `{}`: no topic given and the log has no `{}` (its {} topics: {})",
+                            kind.as_str(),
+                            s.name,
+                            kind.default_topic(),
+                            kind.as_str(),
+                            topics.list(kind)
+                        ),
+                    )
                 })?,
             };
             out.sensors.push(BoundSensor { sensor: s.clone(), topic });

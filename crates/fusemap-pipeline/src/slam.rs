@@ -21,7 +21,7 @@ use crate::sensors::{Bound, BoundLidar};
 pub use crate::slam_summary::{GraphEdge, GraphNode, GraphPrior, SlamSummary};
 use crate::sync::sync_mode;
 use crate::track::{ChosenTrack, LinePoses, TfTrack, Track};
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::{Plan, PoseSource, SlamMode};
 use fusemap_core::estimator::{EstimatorInput, FixQuality};
 use fusemap_core::geometry::{PlanarMount, Point2, Pose2};
@@ -240,7 +240,7 @@ impl<'a> ScanFeed<'a> {
         }
         let bytes = self.slam.held_bytes();
         if bytes as u64 > self.memory_bytes {
-            return Err(PipelineError::Refused(format!(
+            return Err(PipelineError::refused(Stage::Budget, format!(
                 "SLAM reached limits.memory_mib = {} MiB ({} submaps, the loop search's grids and {} nodes' points, {bytes} bytes) at the scan stamped {:.6} s; \
                  raise limits.memory_mib, lower slam.loop_closure_grid_cache_mib, coarsen slam.resolution_m, or shorten slam.max_range_m",
                 self.memory_bytes >> 20,

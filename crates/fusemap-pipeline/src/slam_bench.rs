@@ -21,7 +21,7 @@
 
 use crate::recording::Inventory;
 use crate::run::prepare;
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::Plan;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::metrics::{
@@ -193,16 +193,17 @@ pub fn run_case(
     let inv = Inventory::read(&raw)?;
     let (_, chosen, _) = prepare(plan, &inv)?;
     let Some(slam) = chosen.slam else {
-        return Err(PipelineError::Refused(format!("{}: SLAM did not run on the raw log", raw.display())));
+        return Err(PipelineError::refused(
+            Stage::Benchmark,
+            format!("{}: SLAM did not run on the raw log", raw.display()),
+        ));
     };
     let estimate: Vec<Pose2> = slam.scan_poses.iter().map(|s| s.1).collect();
     if estimate.len() != truth.len() {
-        return Err(PipelineError::Refused(format!(
-            "{}: SLAM gave {} scan poses for {} scans",
-            raw.display(),
-            estimate.len(),
-            truth.len()
-        )));
+        return Err(PipelineError::refused(
+            Stage::Benchmark,
+            format!("{}: SLAM gave {} scan poses for {} scans", raw.display(), estimate.len(), truth.len()),
+        ));
     }
     // FUSEMAP_BENCH_DUMP=DIR: every scan's reference, odometry and SLAM pose, one line each.
     if let Ok(dir) = std::env::var("FUSEMAP_BENCH_DUMP") {
@@ -214,7 +215,8 @@ pub fn run_case(
             .collect();
         let name = format!("{}-{}{suffix}", log.name, drift.name());
         let write = |file: String, text: String| {
-            std::fs::write(Path::new(&dir).join(file), text).map_err(|e| PipelineError::Refused(e.to_string()))
+            std::fs::write(Path::new(&dir).join(file), text)
+                .map_err(|e| PipelineError::refused(Stage::Benchmark, e.to_string()))
         };
         write(format!("{name}.txt"), lines)?;
         let graph = serde_json::json!({ "nodes": slam.nodes, "edges": slam.edges, "open": slam.open_loops });

@@ -11,7 +11,7 @@
 
 use crate::recording::Inventory;
 use crate::sensors::{Bound, BoundSensor};
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::{LogConfig, PoseSource, SensorKind};
 use fusemap_core::frames::{FrameTree, LookupError};
 use fusemap_core::geometry::{Mount3, Pose2};
@@ -297,22 +297,26 @@ pub fn choose(
         PoseSource::Auto if odom.is_some() => PoseSource::Odometry,
         PoseSource::Auto if !tf.chain_stamps.is_empty() => PoseSource::Tf,
         PoseSource::Auto => {
-            return Err(PipelineError::Refused(format!(
-                "the log has no poses: no pose on scan lines, no odometry topic, no TF to `{}`",
-                cfg.base_frame
-            )))
+            return Err(PipelineError::refused(
+                Stage::Poses,
+                format!(
+                    "the log has no poses: no pose on scan lines, no odometry topic, no TF to `{}`",
+                    cfg.base_frame
+                ),
+            ))
         }
         s => s,
     };
     match source {
         PoseSource::ScanLine if !lines_have_poses => {
-            Err(PipelineError::Refused("log.pose_source = \"scan_line\" but the scans carry no pose".into()))
+            Err(PipelineError::refused(Stage::Poses, "log.pose_source = \"scan_line\" but the scans carry no pose"))
         }
         PoseSource::ScanLine => Ok(scan_line_track(inv, cfg, bound)),
         PoseSource::Odometry => {
             let Some(o) = odom else {
-                return Err(PipelineError::Refused(
-                    "log.pose_source = \"odometry\" but the log has no odometry topic".into(),
+                return Err(PipelineError::refused(
+                    Stage::Poses,
+                    "log.pose_source = \"odometry\" but the log has no odometry topic",
                 ));
             };
             odometry_track(inv, cfg, o)
@@ -376,7 +380,7 @@ pub(crate) fn odometry_track(inv: &Inventory, cfg: &LogConfig, o: &BoundSensor) 
     let samples = msgs.iter().map(|m| (Stamp(m.stamp.0.saturating_add(off)), m.pose)).collect();
     let buffer = buffer_of(cfg, samples, &mut counts);
     if buffer.is_empty() {
-        return Err(PipelineError::Refused(format!("the odometry `{}` holds no usable pose", o.topic)));
+        return Err(PipelineError::refused(Stage::Poses, format!("the odometry `{}` holds no usable pose", o.topic)));
     }
     let stamps = (msgs.iter().map(|m| m.stamp).collect(), msgs.iter().map(|m| m.receive_stamp).collect());
     let name = format!("odometry `{}`", o.topic);
@@ -438,7 +442,7 @@ impl TfChain {
         let single_edge = root.is_some() && root == parent && !self.samples.is_empty();
         // TF under `odom` is odometry (as SLAM takes it, `slam::applies`).
         let odom_frame = root.as_deref().map(|r| r.trim_start_matches('/')).filter(|r| *r == "odom").map(String::from);
-        let no_pose = || PipelineError::Refused(format!("no usable TF pose of `{}`", cfg.base_frame));
+        let no_pose = || PipelineError::refused(Stage::Poses, format!("no usable TF pose of `{}`", cfg.base_frame));
         if let (Some(root), false) = (root, single_edge) {
             // Several edges above the base, or a static one under a dynamic one: compose
             // the chain at each stamp where one of its dynamic edges has a sample. Each

@@ -19,7 +19,7 @@ use crate::outputs::{finish, prepare, ExportOptions, RunRecord, Summary};
 use crate::recording::Inventory;
 use crate::sensors::Bound;
 use crate::track::{ChosenTrack, Track};
-use crate::{PassMaps, PipelineError, Progress};
+use crate::{PassMaps, PipelineError, Progress, Stage};
 use fusemap_core::config::Plan;
 use fusemap_core::fusion::{Engine, HeldOut, MapSet, SensorSelection, OBSTACLE_PROBABILITY};
 use fusemap_core::geometry::Pose2;
@@ -234,18 +234,24 @@ fn validate(
     let all = sensors(engine);
     let (built, mut not_built) = built_maps(engine, &all);
     if built.is_empty() {
-        return Err(PipelineError::Refused(format!("nothing to validate: {}", not_built.join("; "))));
+        return Err(PipelineError::refused(
+            Stage::Validation,
+            format!("nothing to validate: {}", not_built.join("; ")),
+        ));
     }
     let area = built.iter().map(|b| b.4).reduce(CellBox::union).expect("a built map");
     let cells = (area.width() as u64).saturating_mul(area.height() as u64);
     if cells > plan.limits.export_cells {
-        return Err(PipelineError::Refused(format!(
-            "the maps span {} × {} cells, more than limits.export_cells ({}): the validation compares them cell \
+        return Err(PipelineError::refused(
+            Stage::Validation,
+            format!(
+                "the maps span {} × {} cells, more than limits.export_cells ({}): the validation compares them cell \
              by cell on one raster; raise the limit or use a coarser map.resolution",
-            area.width(),
-            area.height(),
-            plan.limits.export_cells
-        )));
+                area.width(),
+                area.height(),
+                plan.limits.export_cells
+            ),
+        ));
     }
     let mut rasters: Vec<Option<Raster>> = vec![None, None, None];
     for (name, _, _, grid, _) in &built {

@@ -3,7 +3,7 @@
 //! No log and no pose track: the poses are the truth, less those a glitch check refuses.
 
 use crate::progress::Progress;
-use crate::PipelineError;
+use crate::{PipelineError, Stage};
 use fusemap_core::config::Plan;
 use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
@@ -44,7 +44,9 @@ pub fn map_world(
         if keep[i] {
             for (k, id) in ids.iter().enumerate() {
                 let scan = simulate_scan(world, scanner, plan.lidars[k].model.mount(), *pose, stamp(i));
-                engine.insert_scan(*id, &scan, *pose).map_err(|e| PipelineError::Refused(format!("scan {i}: {e}")))?;
+                engine
+                    .insert_scan(*id, &scan, *pose)
+                    .map_err(|e| PipelineError::refused(Stage::World, format!("scan {i}: {e}")))?;
             }
         }
         progress(Progress::Advance(1));

@@ -137,10 +137,16 @@ fn endpoint_clouds_hold_the_returns_of_a_log() {
         &stray[..5.min(stray.len())]
     );
     let summary = read_json(&ends.join("summary.json"));
-    assert!(summary["notes"].as_array().unwrap().iter().all(|n| !n.as_str().unwrap().contains("endpoints")), "{summary}");
+    assert!(
+        summary["notes"].as_array().unwrap().iter().all(|n| !n.as_str().unwrap().contains("endpoints")),
+        "{summary}"
+    );
     let world = dir.join("world");
     assert_success(&run(&["demo", "--corridor", "--config", s(&config), "--out", s(&world)]));
     let summary = read_json(&world.join("summary.json"));
-    assert!(summary["notes"].to_string().contains("points = \\\"endpoints\\\" applies to `fusemap map` on a log"), "{summary}");
+    assert!(
+        summary["notes"].to_string().contains("points = \\\"endpoints\\\" applies to `fusemap map` on a log"),
+        "{summary}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -78,10 +78,15 @@ fn every_listed_lidar_is_mapped() {
 #[test]
 fn a_listed_topic_the_log_lacks_is_refused_by_name() {
     let cfg = with(vec![lidar("/scan"), lidar("/scan_rear")]);
-    let e = run(cfg).err().expect("refused").to_string();
+    let e = run(cfg).err().expect("refused");
+    // The binding of sensors to topics refused it: a caller can tell it from a budget.
+    assert_eq!(e.refusal_stage(), Some(fusemap_pipeline::Stage::Sensors), "{e}");
+    let e = e.to_string();
     assert!(e.contains("/scan_rear") && e.contains("/scan_copy"), "{e}");
     let cfg = with(vec![SensorConfig { topic: Some("/gps".into()), ..SensorConfig::new(SensorKind::Gnss) }]);
-    let e = run(cfg).err().expect("refused").to_string();
+    let e = run(cfg).err().expect("refused");
+    assert_eq!(e.refusal_stage(), Some(fusemap_pipeline::Stage::Sensors), "{e}");
+    let e = e.to_string();
     assert!(e.contains("/gps") && e.contains("/gnss/fix"), "{e}");
 }
 
