@@ -3,8 +3,9 @@
 //! evidence.
 //!
 //! ## Projection
-//! A pixel `(u, v)` at the stride, through its centre `(u + 0.5, v + 0.5)`, with depth
-//! `d` along the optical axis, is the optical-frame point `d · ray(u + 0.5, v + 0.5)`
+//! A pixel `(u, v)` at the stride, through its centre (at `(u, v)` itself in the
+//! convention of `CameraInfo`, see [`Pinhole`]), with depth `d` along the optical axis, is
+//! the optical-frame point `d · ray(u, v)`
 //! ([`Pinhole::ray`]); the mount `base_from_optical` (full 3D, REP 103 optical axes)
 //! takes it to the base frame, whose `z` (floor at 0) decides its [`Band`]; the robot's
 //! planar pose `world_from_base` takes its `(x, y)` to the map. The rays of the used
@@ -48,9 +49,9 @@ pub struct CameraModel {
     params: CameraParams,
     cell_size_m: f64,
     classes: ClassTable,
-    /// Per used column `u`: `x_u · R·e_x`, with `x_u = (u + 0.5 - cx) / fx`.
+    /// Per used column `u`: `x_u · R·e_x`, with `x_u = (u - cx) / fx`.
     cols: Vec<[f64; 3]>,
-    /// Per used row `v`: `y_v · R·e_y + R·e_z`, with `y_v = (v + 0.5 - cy) / fy`.
+    /// Per used row `v`: `y_v · R·e_y + R·e_z`, with `y_v = (v - cy) / fy`.
     rows: Vec<[f64; 3]>,
     /// Per class index: its pixels are skipped.
     ignored: Vec<bool>,
@@ -92,14 +93,14 @@ impl CameraModel {
         let cols = (0..pinhole.width)
             .step_by(s)
             .map(|u| {
-                let x = (u as f64 + 0.5 - pinhole.cx) / pinhole.fx;
+                let x = (f64::from(u) - pinhole.cx) / pinhole.fx;
                 ex.map(|e| x * e)
             })
             .collect();
         let rows = (0..pinhole.height)
             .step_by(s)
             .map(|v| {
-                let y = (v as f64 + 0.5 - pinhole.cy) / pinhole.fy;
+                let y = (f64::from(v) - pinhole.cy) / pinhole.fy;
                 [0, 1, 2].map(|k| y * ey[k] + ez[k])
             })
             .collect();

@@ -41,8 +41,8 @@ fn level_camera_sees_wall_and_floor_where_they_are() {
     let mut expected = Vec::new();
     for v in 0..48 {
         for u in 0..64 {
-            let xn = (u as f64 + 0.5 - 32.0) / 40.0;
-            let yn = (v as f64 + 0.5 - 24.0) / 40.0;
+            let xn = (u as f64 - 32.0) / 40.0;
+            let yn = (v as f64 - 24.0) / 40.0;
             // The ray with optical z = 1 points along base (1, -xn, -yn) from the camera.
             let z_at_wall = 1.0 - 2.8 * yn;
             let (class, t) = if (0.0..=2.0).contains(&z_at_wall) {
@@ -85,6 +85,31 @@ fn level_camera_sees_wall_and_floor_where_they_are() {
     assert!(out.points.iter().any(|p| class_of(&m, p) == WALL && p.band == Band::Floor));
 }
 
+/// The pixel convention of `CameraInfo` (centres at integer coordinates): an ideal camera,
+/// `cx = (w − 1) / 2`, facing a wall square on sees it symmetrically, the first column's
+/// points the mirror images of the last's. Centres at `u + 0.5` turn every ray by half a
+/// pixel and break the symmetry by about a centimetre here.
+#[test]
+fn an_ideal_camera_sees_a_square_wall_symmetrically() {
+    let (w, h, f) = (32u32, 8u32, 20.0);
+    let ph = Pinhole::new(w, h, f, f, (f64::from(w) - 1.0) / 2.0, (f64::from(h) - 1.0) / 2.0).unwrap();
+    let params = CameraParams { stride: 1, max_depth_m: 10.0, depth_sigma_k: 0.0, ..Default::default() };
+    let m = model(ph, optical_mount([0.0, 0.0, 1.0], 0.0, 0.0), params);
+    let n = (w * h) as usize;
+    let labels = LabelImage::new(w, h, vec![WALL; n]).unwrap();
+    let depth = DepthImage::new(w, h, vec![3.0; n]).unwrap();
+    let (out, counts) = run(&m, &labels, &depth, Pose2::default());
+    assert_eq!(counts.used, n as u64);
+    // Points come row by row, left to right; the base frame's y is left.
+    for row in out.points.chunks(w as usize) {
+        for (a, b) in row.iter().zip(row.iter().rev()) {
+            assert!((a.end.x - 3.0).abs() < 1e-9 && (b.end.x - 3.0).abs() < 1e-9, "{:?} {:?}", a.end, b.end);
+            assert!((a.end.y + b.end.y).abs() < 1e-9, "{:?} and {:?} are not mirror images", a.end, b.end);
+        }
+        assert!((row[0].end.y - 3.0 * 15.5 / f).abs() < 1e-9, "{:?}", row[0].end);
+    }
+}
+
 /// The optical axes of `optical_mount` in the base frame, against REP 103.
 #[test]
 fn optical_mount_axes() {
@@ -111,14 +136,14 @@ fn optical_mount_axes() {
 #[test]
 fn pitched_camera_over_the_floor() {
     let (pitch, yaw, h) = (0.5f64, 0.3f64, 1.2);
-    let ph = Pinhole::new(40, 30, 30.0, 32.0, 19.5, 14.5).unwrap();
+    let ph = Pinhole::new(40, 30, 30.0, 32.0, 19.0, 14.0).unwrap();
     let params = CameraParams { stride: 1, max_depth_m: 20.0, ..Default::default() };
     let m = model(ph, optical_mount([0.1, -0.2, h], yaw, pitch), params);
     let r = Mount3 { roll: -(FRAC_PI_2 + pitch), yaw: yaw - FRAC_PI_2, ..Default::default() }.rotation();
     let (mut depth, mut expected) = (vec![f32::NAN; 40 * 30], Vec::new());
     for v in 0..30 {
         for u in 0..40 {
-            let ray = [(u as f64 + 0.5 - 19.5) / 30.0, (v as f64 + 0.5 - 14.5) / 32.0, 1.0];
+            let ray = [(u as f64 - 19.0) / 30.0, (v as f64 - 14.0) / 32.0, 1.0];
             let dir: Vec<f64> = (0..3).map(|i| (0..3).map(|j| r[i][j] * ray[j]).sum()).collect();
             if dir[2] < -1e-3 {
                 let t = h / -dir[2];
@@ -168,7 +193,7 @@ fn stride_takes_every_nth_pixel_of_every_nth_row() {
 /// Every counter, from a 3×3 camera (rays at ±0.5 and 0 in x and y), level at 1 m.
 #[test]
 fn every_pixel_counter() {
-    let ph = Pinhole::new(3, 3, 2.0, 2.0, 1.5, 1.5).unwrap();
+    let ph = Pinhole::new(3, 3, 2.0, 2.0, 1.0, 1.0).unwrap();
     let params = CameraParams { stride: 1, ..Default::default() };
     let m = model(ph, optical_mount([0.0, 0.0, 1.0], 0.0, 0.0), params);
     let labels = LabelImage::new(3, 3, vec![99, 0, WALL, WALL, WALL, WALL, FLOOR, FLOOR, WALL]).unwrap();
@@ -395,7 +420,7 @@ fn bad_parameters_are_named() {
 
 proptest! {
     /// A point in front of the camera, projected to a pixel, back-projected through that
-    /// pixel's centre at its own depth and projected again, lands in the same pixel.
+    /// pixel's centre (at its integer coordinates) at its own depth and projected again, lands in the same pixel.
     #[test]
     fn reprojection_hits_the_same_pixel(
         f in (50.0..1500.0f64, 0.8..1.25f64),
@@ -405,13 +430,14 @@ proptest! {
         let (w, h) = (640u32, 480u32);
         let ph = Pinhole::new(w, h, f.0, f.0 * f.1, c.0 * w as f64, c.1 * h as f64).unwrap();
         let Some((u, v)) = ph.project([p.0, p.1, p.2]) else { unreachable!("z > 0") };
-        prop_assume!(u >= 0.0 && v >= 0.0 && u < w as f64 && v < h as f64);
-        let (pu, pv) = (u.floor(), v.floor());
-        let r = ph.ray(pu + 0.5, pv + 0.5);
+        prop_assume!(u >= -0.5 && v >= -0.5 && u < w as f64 - 0.5 && v < h as f64 - 0.5);
+        // Pixel centres at integer coordinates: the pixel is the nearest integer.
+        let (pu, pv) = (u.round(), v.round());
+        let r = ph.ray(pu, pv);
         let back = r.map(|x| x * p.2);
         let (u2, v2) = ph.project(back).unwrap();
-        prop_assert_eq!((u2.floor(), v2.floor()), (pu, pv));
-        prop_assert!((u2 - pu - 0.5).abs() < 1e-9 && (v2 - pv - 0.5).abs() < 1e-9);
+        prop_assert_eq!((u2.round(), v2.round()), (pu, pv));
+        prop_assert!((u2 - pu).abs() < 1e-9 && (v2 - pv).abs() < 1e-9);
         prop_assert!(ph.project([p.0, p.1, -p.2]).is_none());
     }
 }
