@@ -135,3 +135,34 @@ fn a_glitch_on_one_edge_of_a_chain_is_left_out() {
         .fold(0.0, f64::max);
     assert!(worst < 0.01, "the track moved by {worst} m");
 }
+
+/// map.mcap's `/tf_static` gives `map → odom` only where the log does not: with a
+/// localiser's `map → odom` on the log's /tf above the wheel odometry's `odom` frame, a
+/// second parent would break the tree a player of both files builds, so there is none, and
+/// a note says why. (The log without it gets one: `validation.rs`.)
+#[test]
+fn a_log_whose_tf_already_parents_the_odometry_frame_gets_no_second_parent() {
+    let mut s = Scenario::default();
+    s.robot.duration_s = 20.0;
+    let rec = simulate(&s).unwrap();
+    let bag = fusemap_io::testdata::temp_dir("tf-localised-odometry").into_child("bag");
+    let mut w =
+        Rosbag2Writer::create_with(&bag, Rosbag2WriterOptions { overwrite: true, ..Default::default() }).unwrap();
+    // Scans and wheel odometry only: the pose source is the odometry, in its `odom` frame.
+    let kept = rec
+        .messages
+        .iter()
+        .filter(|m| matches!(m, SimMessage::Scan(_) | SimMessage::Odometry(_) | SimMessage::StaticTransform(_)));
+    for (k, m) in kept.enumerate() {
+        w.write(m.stamp(), m.topic(), &to_out_message(m)).unwrap();
+        if matches!(m, SimMessage::Odometry(_)) && k % 5 == 0 {
+            w.write(m.stamp(), "/tf", &tf(m.stamp(), "map", "odom", 10.0, 0.0, std::f64::consts::FRAC_PI_2)).unwrap();
+        }
+    }
+    w.finish().unwrap();
+    let run = map_log(&Config::default().validate().unwrap(), &bag, &mut |_| {}).unwrap();
+    assert!(run.report.pose_source.contains("over odometry"), "{}", run.report.pose_source);
+    assert_eq!(run.map_from_odom, None);
+    let note = "map.mcap has no /tf_static: the log's TF already gives `odom` a parent";
+    assert!(run.notes.iter().any(|n| n.contains(note)), "{:?}", run.notes);
+}
