@@ -4,6 +4,7 @@ directories and command lines."""
 from __future__ import annotations
 
 import gzip
+import math
 import os
 import random
 import struct
@@ -400,6 +401,20 @@ def output_cases() -> None:
                                          "{case}/room.log"], "error", names=["--crop", "limits.export_cells"])
     with_log("output/crop-outside-the-map", ["map", "--crop", "100,100,101,101", "--out", "{case}/out",
                                              "{case}/room.log"], "either")
+    # `[output] points = "endpoints"` keeps every return until the clouds are written: 1,500
+    # scans driving to and fro in a corridor keep about 285,000 (13 MB at 48 bytes), past an
+    # 8 MiB budget the maps alone fit in: refused naming the key, no map written.
+    d = case("output/endpoints-past-memory", ["map", "--config", "{case}/c.toml", "--out", "{case}/out",
+                                              "{case}/corridor.log"], "error",
+             names=["{case}/corridor.log", "limits.memory_mib = 8 MiB", "points = \"endpoints\""])
+    (d / "c.toml").write_text("[output]\npoints = \"endpoints\"\n\n[limits]\nmemory_mib = 8\n")
+    corridor = []
+    for i in range(1500):
+        ranges = " ".join(f"{min(1.0 / max(abs(math.sin(math.radians(k * 0.5 - 90))), 1e-9), 8.0) + 0.001 * ((i + k) % 5):.3f}"
+                          for k in range(360))
+        x, t = 0.05 * (i % 100), 1.0 + 0.1 * i
+        corridor.append(f"FLASER 360 {ranges} {x:.2f} 0 0 {x:.2f} 0 0 {t:.3f} host {t:.3f}")
+    (d / "corridor.log").write_bytes(text(corridor))
     case("cli/bench-max-scans-overflow", ["bench", "--scanfile", "{case}/none", "--max-scans",
                                           "9223372036854775807"], "error", names=["max-scans"])
     d = case("cli/log-is-a-fifo", ["map", "--out", "{case}/out", "{case}/pipe"], "error", names=["{case}/pipe", "FIFO"],
