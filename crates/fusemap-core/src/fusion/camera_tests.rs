@@ -26,7 +26,7 @@ fn render(m: &CameraModel, wall_x: f64, person: std::ops::Range<f64>) -> (LabelI
     let (mut labels, mut depth) = (Vec::new(), Vec::new());
     for v in 0..p.height {
         for u in 0..p.width {
-            let r = mount.rotate([(u as f64 + 0.5 - p.cx) / p.fx, (v as f64 + 0.5 - p.cy) / p.fy, 1.0]);
+            let r = mount.rotate([(f64::from(u) - p.cx) / p.fx, (f64::from(v) - p.cy) / p.fy, 1.0]);
             let floor = (r[2] < 0.0).then(|| -t[2] / r[2]);
             let wall = (r[0] > 0.0).then(|| (wall_x - t[0]) / r[0]).filter(|s| t[2] + s * r[2] <= 4.0);
             let (s, label) = match (floor, wall) {

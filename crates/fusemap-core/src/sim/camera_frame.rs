@@ -19,7 +19,7 @@ pub fn room_frame(model: &CameraModel, half_x: f64, half_y: f64) -> (LabelImage,
     let mut depth = Vec::with_capacity(labels.capacity());
     for v in 0..p.height {
         for u in 0..p.width {
-            let r = mount.rotate([(u as f64 + 0.5 - p.cx) / p.fx, (v as f64 + 0.5 - p.cy) / p.fy, 1.0]);
+            let r = mount.rotate([(f64::from(u) - p.cx) / p.fx, (f64::from(v) - p.cy) / p.fy, 1.0]);
             let mut s_wall = f64::INFINITY;
             for (axis, half) in [(0, half_x), (1, half_y)] {
                 for side in [-1.0, 1.0] {
