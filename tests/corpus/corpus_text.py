@@ -401,9 +401,10 @@ def output_cases() -> None:
                                          "{case}/room.log"], "error", names=["--crop", "limits.export_cells"])
     with_log("output/crop-outside-the-map", ["map", "--crop", "100,100,101,101", "--out", "{case}/out",
                                              "{case}/room.log"], "either")
-    # `[output] points = "endpoints"` keeps every return until the clouds are written: 1,500
-    # scans driving to and fro in a corridor keep about 285,000 (13 MB at 48 bytes), past an
-    # 8 MiB budget the maps alone fit in: refused naming the key, no map written.
+    # `[output] points = "endpoints"` keeps every return until the clouds are written:
+    # 1,500 scans along a corridor (its first 5 m over and over) keep about 285,000 (23 MB
+    # at 80 bytes), past an 8 MiB budget the maps alone fit in: refused naming the key, no
+    # map written.
     d = case("output/endpoints-past-memory", ["map", "--config", "{case}/c.toml", "--out", "{case}/out",
                                               "{case}/corridor.log"], "error",
              names=["{case}/corridor.log", "limits.memory_mib = 8 MiB", "points = \"endpoints\""])

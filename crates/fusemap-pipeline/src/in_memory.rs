@@ -6,7 +6,7 @@
 use crate::job::JobError;
 use crate::outputs::{layers_of, view_of, ExportOptions, ExportRoom, Layers, MapView};
 use crate::{PipelineError, Progress};
-use fusemap_core::config::Plan;
+use fusemap_core::config::{Plan, PointsMode};
 use fusemap_core::geometry::Pose2;
 use fusemap_core::grid::Raster;
 use fusemap_core::time::Stamp;
@@ -28,6 +28,10 @@ pub struct MappedLog {
 /// `limits.export_cells` (which the files would hold sparsely), is an error that says so.
 pub fn map_log_in_memory(plan: &Plan, path: &Path) -> Result<MappedLog, JobError> {
     let input = path.display().to_string();
+    // No file is written, so no endpoint cloud: its returns are not kept.
+    let mut plan = plan.clone();
+    plan.output.points = PointsMode::Cells;
+    let plan = &plan;
     let run = crate::map_log(plan, path, &mut |_: Progress| {}).map_err(|error| match error {
         PipelineError::Read(e) => JobError::File(e),
         error => JobError::Run { input: input.clone(), error },

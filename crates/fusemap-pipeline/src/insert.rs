@@ -6,7 +6,7 @@
 //! Hornung et al. 2013).
 
 use crate::camera::MappedCamera;
-use crate::outputs::map_formats::ENDPOINT_BYTES;
+use crate::outputs::map_formats::endpoint_bytes;
 use crate::recording::{line_key, LineKey, RangeMessage};
 use crate::report::LidarReport;
 use crate::track::{LinePoses, Track};
@@ -147,13 +147,13 @@ impl Endpoints {
 
 impl Inserter<'_> {
     /// Keeps the last inserted scan's returns, when asked; an error once they no longer
-    /// fit in `[limits] memory_mib` beside the maps (at [`ENDPOINT_BYTES`] a return: a
-    /// log's returns grow with its length, and an hour of them can take gigabytes).
+    /// fit in `[limits] memory_mib` beside the maps (at [`endpoint_bytes`]: a log's returns
+    /// grow with its length, and an hour of them can take gigabytes).
     fn keep_endpoints(&mut self, stamp: Stamp) -> Result<(), PipelineError> {
         let Some(e) = &mut self.endpoints else { return Ok(()) };
         e.add(self.engine.last_range_data(), self.engine.maps().primary().grid().geometry());
         let Some((maps, limit)) = self.engine.memory_use() else { return Ok(()) };
-        let kept = (e.points.len() as u64).saturating_mul(ENDPOINT_BYTES);
+        let kept = endpoint_bytes(e.points.len(), e.points.capacity());
         if maps.saturating_add(kept) <= limit {
             return Ok(());
         }

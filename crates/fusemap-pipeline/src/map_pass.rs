@@ -18,7 +18,7 @@ use crate::sync::{limits, offset_ns, sync_mode, Skipped};
 use crate::track::{count_reordered, ChosenTrack, Track};
 use crate::{PipelineError, Stage};
 use fusemap_core::calibration::{CameraSample, SurfaceHits};
-use fusemap_core::config::{default_camera, Plan, PlannedCamera, PointsMode, SensorKind};
+use fusemap_core::config::{default_camera, Plan, PlannedCamera, SensorKind};
 use fusemap_core::frames::FrameTree;
 use fusemap_core::fusion::{Correlation, Engine, MapSet};
 use fusemap_core::geometry::Pose2;
@@ -135,11 +135,14 @@ pub struct PassMaps {
     /// Keep every placed camera frame's obstacle points in the base frame
     /// ([`MapRun::camera_samples`]): what the camera's calibration scores.
     pub camera_samples: bool,
+    /// Keep the lidar returns for endpoint clouds ([`MapRun::endpoints`]): only a run that
+    /// writes them asks (`OutputConfig::endpoint_clouds`).
+    pub endpoints: bool,
 }
 
 impl From<MapSet> for PassMaps {
     fn from(set: MapSet) -> Self {
-        Self { set: Some(set), holdout_share: None, camera_samples: false }
+        Self { set: Some(set), holdout_share: None, camera_samples: false, endpoints: false }
     }
 }
 
@@ -184,7 +187,7 @@ pub fn map_with_track(
     // held-out period there (the images of such a log, if any, carry stamps).
     let scans_only = matches!(chosen.track, Track::ScanLine(_));
     let hold_from = hold_from.map(|k| (k, scans_only));
-    let keep_endpoints = plan.output.points == PointsMode::Endpoints;
+    let keep_endpoints = maps.endpoints;
     let (placed, lidar_surface, endpoints) =
         streams.run(&input, &mut engine, mode, hold_from, (maps.camera_samples, keep_endpoints), progress)?;
     let map_s = t_map.elapsed().as_secs_f64();

@@ -123,5 +123,6 @@ pub fn map_inventory(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MapRun, PipelineError> {
     let (bound, chosen, track_s) = prepare_with(plan, inv, progress)?;
-    map_with_track(plan, inv, &bound, chosen, track_s, Default::default(), progress)
+    let maps = PassMaps { endpoints: plan.output.endpoint_clouds(), ..Default::default() };
+    map_with_track(plan, inv, &bound, chosen, track_s, maps, progress)
 }

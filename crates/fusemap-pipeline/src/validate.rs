@@ -212,7 +212,8 @@ pub(crate) fn validated(
     let (chosen, track_s) = crate::run::correct(plan, inv, &bound, raw, track_s, progress)?;
     let motion = lidar_motion(&bound, &chosen, &raw_at_scans);
     let set = validation_maps(plan, inv, &bound)?;
-    let maps = PassMaps { set: Some(set), holdout_share: Some(plan.holdout_share), camera_samples: false };
+    let maps =
+        PassMaps { set: Some(set), holdout_share: Some(plan.holdout_share), camera_samples: false, endpoints: false };
     let run = crate::map_with_track(plan, inv, &bound, chosen, track_s, maps, progress)?;
     let (validation, rasters) = validate(&run.engine, plan, motion)?;
     Ok((run, validation, rasters))
@@ -233,26 +234,8 @@ fn validate(
     let held = engine.held_out().cloned().unwrap_or_default();
     let all = sensors(engine);
     let (built, mut not_built) = built_maps(engine, &all);
-    if built.is_empty() {
-        return Err(PipelineError::refused(
-            Stage::Validation,
-            format!("nothing to validate: {}", not_built.join("; ")),
-        ));
-    }
-    let area = built.iter().map(|b| b.4).reduce(CellBox::union).expect("a built map");
+    let area = shared_area(built.iter().map(|b| b.4), &not_built, plan)?;
     let cells = (area.width() as u64).saturating_mul(area.height() as u64);
-    if cells > plan.limits.export_cells {
-        return Err(PipelineError::refused(
-            Stage::Validation,
-            format!(
-                "the maps span {} × {} cells, more than limits.export_cells ({}): the validation compares them cell \
-             by cell on one raster; raise the limit or use a coarser map.resolution",
-                area.width(),
-                area.height(),
-                plan.limits.export_cells
-            ),
-        ));
-    }
     let mut rasters: Vec<Option<Raster>> = vec![None, None, None];
     for (name, _, _, grid, _) in &built {
         let slot = ROLES.iter().position(|r| r.0 == *name).expect("a role");
@@ -305,6 +288,35 @@ fn validate(
         judgement,
     };
     Ok((validation, rasters))
+}
+
+/// The box of every built map's observed cells (`areas`), which the maps are compared on
+/// cell by cell; refused when no map was built or the box is past `limits.export_cells`.
+fn shared_area(
+    areas: impl Iterator<Item = CellBox>,
+    not_built: &[String],
+    plan: &Plan,
+) -> Result<CellBox, PipelineError> {
+    let Some(area) = areas.reduce(CellBox::union) else {
+        return Err(PipelineError::refused(
+            Stage::Validation,
+            format!("nothing to validate: {}", not_built.join("; ")),
+        ));
+    };
+    let cells = (area.width() as u64).saturating_mul(area.height() as u64);
+    if cells > plan.limits.export_cells {
+        return Err(PipelineError::refused(
+            Stage::Validation,
+            format!(
+                "the maps span {} × {} cells, more than limits.export_cells ({}): the validation compares them cell \
+             by cell on one raster; raise the limit or use a coarser map.resolution",
+                area.width(),
+                area.height(),
+                plan.limits.export_cells
+            ),
+        ));
+    }
+    Ok(area)
 }
 
 /// The roles of the validation's maps, in the order of `fusion_validate.npz`.

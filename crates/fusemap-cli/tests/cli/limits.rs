@@ -203,8 +203,9 @@ fn a_world_pose_1e8_m_off_is_a_counted_glitch_and_the_map_is_the_one_without_it(
 #[test]
 fn endpoint_clouds_past_the_memory_budget_stop_the_run_naming_the_limit() {
     let dir = temp_dir("limits-endpoints");
-    // 3,000 scans of 360 beams driving to and fro along a corridor 2 m wide: about 200
-    // returns kept a scan, 48 bytes each (29 MB in all), over a few tiles of map.
+    // 3,000 scans of 360 beams along a corridor 2 m wide, driving its first 5 m over and
+    // over (back to the start every 100 scans): about 200 returns kept a scan, 80 bytes
+    // each (48 MB in all), over a few tiles of map.
     let lines: Vec<String> = (0..3000)
         .map(|i| {
             let ranges: Vec<String> = (0..360)

@@ -26,6 +26,14 @@ impl Default for OutputConfig {
     }
 }
 
+impl OutputConfig {
+    /// Whether a run writes clouds of the lidar returns: `points = "endpoints"` with a
+    /// cloud format on. Only then are the returns kept (they grow with the log).
+    pub fn endpoint_clouds(&self) -> bool {
+        self.points == PointsMode::Endpoints && (self.mcap || self.pcd || self.ply)
+    }
+}
+
 /// What the map's point clouds hold.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]

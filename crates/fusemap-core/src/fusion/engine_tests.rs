@@ -98,13 +98,16 @@ fn the_memory_in_use_is_the_tiles_with_their_export_and_stays_within_the_limit()
     let per_tile = (TileLayers::default().tile_bytes() + TileLayers::default().export_bytes()) as u64;
     assert_eq!(e.memory_use(), Some((tiles as u64 * per_tile, 1 << 20)));
     // Grown until the budget refuses: what is in use never passes the limit.
+    let mut refused = false;
     for k in 2..200 {
         if e.insert_scan(a, &scan(k), Pose2::new(100.0 * k as f64, 0.0, 0.0)).is_err() {
+            refused = true;
             break;
         }
         let (used, limit) = e.memory_use().unwrap();
         assert!(used <= limit, "{used} > {limit} after {k} scans");
     }
+    assert!(refused, "1 MiB holds about 60 tiles: the budget is met");
     let (held, per_cell) = e.export_room(e.maps().primary()).unwrap();
     assert_eq!(held, (1 << 20) - e.grid().tile_count() as u64 * TileLayers::default().tile_bytes() as u64);
     assert_eq!(per_cell, 9);

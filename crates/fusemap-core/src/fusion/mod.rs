@@ -14,7 +14,7 @@ mod merge_tests;
 pub mod rasters;
 mod sensors;
 
-pub use budget::BudgetKey;
+pub use budget::{export_bytes_per_cell, BudgetKey};
 pub use correlation::Correlation;
 pub use engine::{Engine, EngineError, EngineStats};
 pub use holdout::{HeldOut, HitRate, OBSTACLE_PROBABILITY};

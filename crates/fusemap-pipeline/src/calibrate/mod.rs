@@ -137,7 +137,7 @@ impl CalibrateJob {
             SensorSelection::Kinds(vec![fusemap_core::measurement::SensorKind::Lidar]),
             grid(),
         );
-        let maps = PassMaps { set: Some(set), holdout_share: None, camera_samples: true };
+        let maps = PassMaps { set: Some(set), holdout_share: None, camera_samples: true, endpoints: false };
         let run = crate::map_with_track(plan, &inv, &bound, chosen, track_s, maps, progress).map_err(named)?;
         let mount = run.report.lidars.first().map(|l| (l.name.clone(), l.topic.clone(), l.extrinsics.base_from_sensor));
         let configured_offset = run.report.lidars.first().map_or(0.0, |l| l.time_offset_s);

@@ -12,11 +12,21 @@ use fusemap_io::map_mcap::{write_map_mcap, MapMessages};
 use fusemap_io::point_cloud::{write_pcd, write_ply, MapCloud, MapPoint};
 use fusemap_io::semantic::SemanticRaster;
 
-/// Bytes one lidar return kept for `[output] points = "endpoints"` takes by the time the
-/// clouds are written, when all three copies are held: the point as kept (8), its
-/// [`MapPoint`] and its `PointCloud2` record for `map.mcap` (16 bytes without classes).
-/// The returns count against `[limits] memory_mib` at this price beside the maps.
-pub const ENDPOINT_BYTES: u64 = (std::mem::size_of::<[f32; 2]>() + std::mem::size_of::<MapPoint>() + 16) as u64;
+/// Bytes one lidar return kept for `[output] points = "endpoints"` takes at the peak of
+/// writing the clouds, beside the point as kept (8 bytes, counted by the kept vector's
+/// capacity): its [`MapPoint`] (24), held while the three files are written one after
+/// another, and the largest writer's buffer, `map.mcap`'s: the `PointCloud2` record (16
+/// bytes without classes) in the message and the CDR encoding of it, whose buffer may
+/// have grown to twice that (32); `map.pcd` reserves 22. The returns count against
+/// `[limits] memory_mib` at this price beside the maps.
+pub const ENDPOINT_WRITE_BYTES: u64 = (std::mem::size_of::<MapPoint>() + 16 + 32) as u64;
+
+/// Bytes `kept` returns (in a vector of `capacity`) take by the time their clouds are
+/// written ([`ENDPOINT_WRITE_BYTES`] each, and the kept vector itself).
+pub fn endpoint_bytes(kept: usize, capacity: usize) -> u64 {
+    let held = (capacity as u64).saturating_mul(std::mem::size_of::<[f32; 2]>() as u64);
+    held.saturating_add((kept as u64).saturating_mul(ENDPOINT_WRITE_BYTES))
+}
 
 /// The formats a run writes, and the lidar returns for `[output] points = "endpoints"`
 /// (a log run's; `None` for the other runs, whose clouds hold the occupied cells).

@@ -5,15 +5,12 @@
 
 use super::OutputError;
 use fusemap_core::config::{OutputConfig, Plan};
+use fusemap_core::fusion::export_bytes_per_cell;
 use fusemap_core::geometry::Point2;
 use fusemap_core::grid::{CellBox, ExtraLayers, GridGeometry, LayeredGrid, Raster, SparseTiles, TILE_CELLS};
 
 /// Largest side of the overview picture of a sparse export, in pixels before enlargement.
 pub const OVERVIEW_SIDE: usize = 4096;
-
-/// Bytes a pixel of the overview takes while it is written: its log-odds and known flag
-/// (5) and the picture writer's buffers (4), as `budget.rs` counts a cell of a dense export.
-const OVERVIEW_BYTES_PER_PIXEL: u64 = 9;
 
 /// A region of the map to export densely, metres, from `--crop x0,y0,x1,y1`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -154,11 +151,13 @@ impl ExportRoom {
 }
 
 /// The side of a sparse export's overview: [`OVERVIEW_SIDE`], or less where the room left
-/// beside the maps, less the copy of their `tiles` as stored, cannot hold that picture.
+/// beside the maps, less the copy of their `tiles` as stored (a log-odds a cell,
+/// [`SparseTiles`]), cannot hold that picture at what a cell of a dense export without
+/// layers takes while it is written.
 fn overview_side(room: Option<ExportRoom>, tiles: usize) -> usize {
     let Some(r) = room else { return OVERVIEW_SIDE };
     let copy = (tiles as u64).saturating_mul((TILE_CELLS * std::mem::size_of::<f32>()) as u64);
-    let pixels = r.bytes.saturating_sub(copy) / OVERVIEW_BYTES_PER_PIXEL;
+    let pixels = r.bytes.saturating_sub(copy) / export_bytes_per_cell(0) as u64;
     usize::try_from(pixels.isqrt()).unwrap_or(usize::MAX).clamp(1, OVERVIEW_SIDE)
 }
 

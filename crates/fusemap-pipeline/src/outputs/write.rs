@@ -390,7 +390,7 @@ pub fn finish(
     let clock = RunClock { started, outputs_from: Instant::now(), phases: seconds };
     let grid = engine.grid();
     // The returns of an endpoint cloud are held beside the maps while they are written.
-    let kept = endpoints.map_or(0, |e| (e.len() as u64).saturating_mul(super::map_formats::ENDPOINT_BYTES));
+    let kept = endpoints.map_or(0, |e| super::map_formats::endpoint_bytes(e.len(), e.len()));
     let room = ExportRoom::of(engine.export_room(engine.maps().primary())).map(|r| r.without(kept));
     let view = view_of(grid, export, room, &mut notes)?;
     let raster = match &view {
