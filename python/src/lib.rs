@@ -31,16 +31,35 @@ fn message(e: &dyn std::error::Error) -> String {
 /// `OSError` for a file that could not be read or written, `ValueError` otherwise.
 fn io_error(e: fusemap_io::Error) -> PyErr {
     let text = message(&e);
-    match e {
+    let err = match e {
         fusemap_io::Error::Io { .. } => PyOSError::new_err(text),
         _ => PyValueError::new_err(text),
-    }
+    };
+    with_stage(err, None)
 }
 
+/// `err` with the stage of the run that refused it as its `stage` attribute (`None`
+/// when it is no refusal): every error `map_log` raises has one.
+fn with_stage(err: PyErr, stage: Option<fusemap_pipeline::Stage>) -> PyErr {
+    Python::attach(|py| {
+        // Setting an attribute on a fresh exception cannot fail; if it did, the error
+        // would still carry its message.
+        let _ = err.value(py).setattr("stage", stage.map(fusemap_pipeline::Stage::name));
+    });
+    err
+}
+
+/// `OSError` for a file, `ValueError` otherwise; a refused run's carries the stage that
+/// refused it as `stage` (`"sensors"`, `"poses"`, `"budget"`, …; `None` for other errors),
+/// so a caller can tell a budget to raise from a sensor to add without reading the text.
 fn job_error(e: JobError) -> PyErr {
+    let stage = match &e {
+        JobError::Run { error, .. } | JobError::Pipeline(error) => error.refusal_stage(),
+        _ => None,
+    };
     match e {
         JobError::File(e) => io_error(e),
-        e => PyValueError::new_err(message(&e)),
+        e => with_stage(PyValueError::new_err(message(&e)), stage),
     }
 }
 

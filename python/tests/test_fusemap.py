@@ -93,6 +93,7 @@ def test_a_missing_log_is_an_os_error_with_the_cli_message(tmp_path):
     with pytest.raises(OSError) as e:
         fusemap.map_log(missing)
     assert str(e.value) == err
+    assert e.value.stage is None
 
 
 def test_a_bad_config_is_a_value_error_with_the_cli_message(tmp_path):
@@ -105,6 +106,7 @@ def test_a_bad_config_is_a_value_error_with_the_cli_message(tmp_path):
     with pytest.raises(ValueError) as e:
         fusemap.map_log(log, config=config)
     assert str(e.value) == err
+    assert e.value.stage is None, "a bad config is no run's refusal"
     with pytest.raises(ValueError, match="map.resolution"):
         fusemap.Grid(config="[map]\nresolution = -1\n")
     with pytest.raises(ValueError, match="map.resolution"):
@@ -169,3 +171,15 @@ def test_mapping_releases_the_gil():
     middle = [t for t in ticks if t0 + quarter < t < t1 - quarter]
     assert len(middle) > 100, f"{len(middle)} loop turns in the middle half of a {t1 - t0:.3f} s call"
     assert grid.occupancy().shape[0] == 401  # 20 m across at 5 cm
+
+
+def test_a_refused_run_names_the_stage_that_refused_it(tmp_path):
+    log = tmp_path / "odometry-only.log"
+    log.write_text("ODOM 0 0 0 0 0 0 1.0 host 1.0\nODOM 0.1 0 0 0 0 0 1.1 host 1.1\n")
+    code, err = cli("map", "--out", tmp_path / "out", log)
+    assert code != 0
+    with pytest.raises(ValueError) as e:
+        fusemap.map_log(log)
+    assert str(e.value) == err
+    assert "no laser scans" in err
+    assert e.value.stage == "sensors"

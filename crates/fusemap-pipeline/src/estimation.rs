@@ -64,7 +64,7 @@ pub fn inputs(plan: &Plan, inv: &Inventory, bound: &Bound) -> Result<Inputs, Pip
         bound.sensors.iter().filter(|s| s.sensor.kind == SensorKind::WheelOdometry).map(|s| s.topic.as_str()).collect();
     if odometers.len() > 1 {
         return Err(PipelineError::refused(
-            Stage::Poses,
+            Stage::Sensors,
             format!(
                 "the estimator fuses one wheel odometry, the config lists {} ({}): disable all but one",
                 odometers.len(),

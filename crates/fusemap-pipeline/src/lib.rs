@@ -88,10 +88,12 @@ impl PipelineError {
         Self::Refused(Refusal { stage, why: why.into() })
     }
 
-    /// The stage that refused the run, if it was refused.
+    /// The stage that refused the run, if it was refused: a map past its budget, which
+    /// the engine refuses, is the budget's.
     pub fn refusal_stage(&self) -> Option<Stage> {
         match self {
             Self::Refused(r) => Some(r.stage),
+            Self::Engine(fusemap_core::fusion::EngineError::MapBudget { .. }) => Some(Stage::Budget),
             _ => None,
         }
     }
@@ -109,7 +111,8 @@ pub struct Refusal {
 }
 
 /// The stage of a run that refused it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Stage {
     /// Binding the configured sensors to the log's topics: no scans, no lidar, a topic the
     /// log lacks or that two sensors claim, a camera whose streams are unusable.
@@ -118,7 +121,8 @@ pub enum Stage {
     Mounts,
     /// No pose track can be built: odometry, TF, scan-line poses or the estimator.
     Poses,
-    /// A budget of `[limits]` is met: SLAM's grids, the returns of an endpoint cloud.
+    /// A budget of `[limits]` is met: the maps' tiles, SLAM's grids, the returns of an
+    /// endpoint cloud.
     Budget,
     /// A built-in configuration or scenario is not valid.
     Configuration,
@@ -128,4 +132,43 @@ pub enum Stage {
     Validation,
     /// `fusemap slam-bench` cannot score a log.
     Benchmark,
+}
+
+impl Stage {
+    /// Its name in snake case (`"budget"`), as the Python package's exceptions carry it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Sensors => "sensors",
+            Stage::Mounts => "mounts",
+            Stage::Poses => "poses",
+            Stage::Budget => "budget",
+            Stage::Configuration => "configuration",
+            Stage::World => "world",
+            Stage::Validation => "validation",
+            Stage::Benchmark => "benchmark",
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_stage_is_named_as_serde_names_it() {
+        for stage in [
+            Stage::Sensors,
+            Stage::Mounts,
+            Stage::Poses,
+            Stage::Budget,
+            Stage::Configuration,
+            Stage::World,
+            Stage::Validation,
+            Stage::Benchmark,
+        ] {
+            assert_eq!(serde_json::to_value(stage).unwrap(), stage.name(), "{stage:?}");
+        }
+        let e = PipelineError::refused(Stage::Budget, "past limits.memory_mib");
+        assert_eq!((e.refusal_stage(), e.to_string().as_str()), (Some(Stage::Budget), "past limits.memory_mib"));
+    }
 }

@@ -215,8 +215,8 @@ pub fn run_case(
             .collect();
         let name = format!("{}-{}{suffix}", log.name, drift.name());
         let write = |file: String, text: String| {
-            std::fs::write(Path::new(&dir).join(file), text)
-                .map_err(|e| PipelineError::refused(Stage::Benchmark, e.to_string()))
+            let path = Path::new(&dir).join(file);
+            std::fs::write(&path, text).map_err(|e| PipelineError::Read(fusemap_io::Error::io(&path, e)))
         };
         write(format!("{name}.txt"), lines)?;
         let graph = serde_json::json!({ "nodes": slam.nodes, "edges": slam.edges, "open": slam.open_loops });
