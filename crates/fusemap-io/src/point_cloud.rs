@@ -194,22 +194,10 @@ pub fn write_ply(path: &Path, cloud: &MapCloud) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fusemap_core::geometry::Point2;
-    use fusemap_core::grid::{logodds::logit, CellIndex, OccupancyParams};
 
     fn raster() -> Raster {
         // 3 × 2 cells of 0.5 m at (10, 20): occupied at (col 1, row 0) and (col 2, row 1).
-        let probs = [0.2, 0.9, 0.5, 0.3, 0.4, 0.95];
-        Raster {
-            width: 3,
-            height: 2,
-            resolution: 0.5,
-            origin: Point2::new(10.0, 20.0),
-            first_cell: CellIndex::new(0, 0),
-            log_odds: probs.iter().map(|&p| logit(p) as f32).collect(),
-            known: vec![true; 6],
-            params: OccupancyParams::default(),
-        }
+        crate::testdata::raster_3x2([0.2, 0.9, 0.5, 0.3, 0.4, 0.95], [true; 6])
     }
 
     #[test]

@@ -207,3 +207,20 @@ pub fn scan_message(
         laser_pose: None,
     }
 }
+
+/// A 3 × 2 raster of 0.5 m cells whose lower-left corner is at (10, 20), with the cells'
+/// occupancy probabilities and known flags row by row (row 0 the lowest y): the small map
+/// the writers' tests turn into files.
+pub fn raster_3x2(probabilities: [f64; 6], known: [bool; 6]) -> fusemap_core::grid::Raster {
+    use fusemap_core::grid::{logodds::logit, CellIndex, OccupancyParams, Raster};
+    Raster {
+        width: 3,
+        height: 2,
+        resolution: 0.5,
+        origin: fusemap_core::geometry::Point2::new(10.0, 20.0),
+        first_cell: CellIndex::new(0, 0),
+        log_odds: probabilities.iter().map(|&p| logit(p) as f32).collect(),
+        known: known.to_vec(),
+        params: OccupancyParams::default(),
+    }
+}

@@ -2,20 +2,10 @@ use super::*;
 use crate::log::ros2::cdr::CdrReader;
 use crate::log::ros2::msgs::wire::FieldReader;
 use crate::semantic::ClassInfo;
-use fusemap_core::grid::{logodds::logit, CellIndex, OccupancyParams};
+use fusemap_core::grid::CellIndex;
 
 fn raster() -> Raster {
-    let probs = [0.2, 0.9, 0.5, 0.3, 0.6504, 0.95];
-    Raster {
-        width: 3,
-        height: 2,
-        resolution: 0.5,
-        origin: Point2::new(10.0, 20.0),
-        first_cell: CellIndex::new(0, 0),
-        log_odds: probs.iter().map(|&p| logit(p) as f32).collect(),
-        known: vec![true, true, true, true, true, false],
-        params: OccupancyParams::default(),
-    }
+    crate::testdata::raster_3x2([0.2, 0.9, 0.5, 0.3, 0.6504, 0.95], [true, true, true, true, true, false])
 }
 
 /// Every message of `path`, as (topic, schema name, payload).
