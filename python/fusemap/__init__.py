@@ -7,7 +7,9 @@
   ``occupancy()`` or ``to_npz(path)``; a ROS 2 node (rclpy) or a notebook can map live.
 
 Errors are ``OSError`` (a file that cannot be read or written) or ``ValueError``
-(anything else), with the messages the CLI prints. The GIL is released while mapping.
+(anything else), with the messages the CLI prints; ``map_log``'s carry ``stage``, the
+stage that refused the run (``"sensors"``, ``"mounts"``, ``"poses"``, ``"budget"``, …),
+or ``None`` when the run was not refused. The GIL is released while mapping.
 Arrays are row 0 = lowest y, column 0 = lowest x, as ``map.npz``.
 """
 
