@@ -68,7 +68,8 @@ pub(crate) use sync::offset_ns;
 /// Why a run could not be done.
 #[derive(Debug, thiserror::Error)]
 pub enum PipelineError {
-    /// Reading the log failed (the error names the file and the place in it).
+    /// Reading the log failed, or writing a file beside it (slam-bench's dumps): the error
+    /// names the file and the place in it.
     #[error(transparent)]
     Read(#[from] fusemap_io::Error),
     /// The engine refused a measurement.
