@@ -2,7 +2,9 @@
 //! is refused before the memory is taken, naming the limit, the value met and the key;
 //! a map too large for one dense raster is written sparsely; `--crop` exports a region.
 
-use crate::util::{assert_success, file_names, one_line_error, read_json, repo_file, run, temp_dir, write_file};
+use crate::util::{
+    assert_success, corridor_log, file_names, one_line_error, read_json, repo_file, run, temp_dir, write_file,
+};
 use std::path::Path;
 
 /// Which file an error must name.
@@ -206,19 +208,7 @@ fn endpoint_clouds_past_the_memory_budget_stop_the_run_naming_the_limit() {
     // 3,000 scans of 360 beams along a corridor 2 m wide, driving its first 5 m over and
     // over (back to the start every 100 scans): about 200 returns kept a scan, 80 bytes
     // each (48 MB in all), over a few tiles of map.
-    let lines: Vec<String> = (0..3000)
-        .map(|i| {
-            let ranges: Vec<String> = (0..360)
-                .map(|k| {
-                    let a = (k as f64 * 0.5 - 90.0).to_radians();
-                    format!("{:.3}", (1.0 / a.sin().abs()).min(8.0) + 0.001 * ((i + k) % 5) as f64)
-                })
-                .collect();
-            let (x, t) = (0.05 * (i % 100) as f64, 1.0 + 0.1 * i as f64);
-            format!("FLASER 360 {} {x:.2} 0 0 {x:.2} 0 0 {t:.3} host {t:.3}", ranges.join(" "))
-        })
-        .collect();
-    let log = write_file(&dir, "corridor.log", lines.join("\n") + "\n");
+    let log = write_file(&dir, "corridor.log", corridor_log(3000, 360, 8.0, 5, |i| 0.05 * (i % 100) as f64));
     let ends = write_file(&dir, "ends.toml", "[output]\npoints = \"endpoints\"\n\n[limits]\nmemory_mib = 16\n");
     let cells = write_file(&dir, "cells.toml", "[output]\npoints = \"cells\"\n\n[limits]\nmemory_mib = 16\n");
     let out = dir.join("out");

@@ -4,7 +4,7 @@
 //! set with its size and SHA-256; `[output]` chooses the optional formats and what the
 //! point clouds hold.
 
-use crate::util::{assert_success, file_names, read_json, repo_file, run, temp_dir, write_file};
+use crate::util::{assert_success, corridor_log, file_names, read_json, repo_file, run, temp_dir, write_file};
 use std::path::Path;
 
 fn s(p: &Path) -> &str {
@@ -98,19 +98,7 @@ fn endpoint_clouds_hold_the_returns_of_a_log() {
     let dir = temp_dir("endpoint-clouds");
     // A robot driving 5 cm a line along a corridor with walls at y = ±1 m (beams at ±90°
     // see the walls, the rest go to 1/|sin|, capped at 20 m).
-    let lines: Vec<String> = (0..60)
-        .map(|i| {
-            let ranges: Vec<String> = (0..180)
-                .map(|k| {
-                    let a = (k as f64 - 90.0).to_radians();
-                    format!("{:.3}", (1.0 / a.sin().abs()).min(20.0) + 0.001 * ((i + k) % 3) as f64)
-                })
-                .collect();
-            let (x, t) = (0.05 * i as f64, 1.0 + 0.1 * i as f64);
-            format!("FLASER 180 {} {x:.2} 0 0 {x:.2} 0 0 {t:.3} host {t:.3}", ranges.join(" "))
-        })
-        .collect();
-    let log = write_file(&dir, "corridor.log", lines.join("\n") + "\n");
+    let log = write_file(&dir, "corridor.log", corridor_log(60, 180, 20.0, 3, |i| 0.05 * i as f64));
     let config = write_file(&dir, "c.toml", "[output]\npoints = \"endpoints\"\n");
     let (cells, ends) = (dir.join("cells"), dir.join("ends"));
     assert_success(&run(&["map", "--out", s(&cells), s(&log)]));

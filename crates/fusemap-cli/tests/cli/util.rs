@@ -131,3 +131,23 @@ pub fn check_map_outputs(dir: &Path) -> Option<serde_json::Value> {
     assert!(o.status.success(), "map outputs disagree:\nstdout: {}\nstderr: {}", stdout(&o), stderr(&o));
     Some(serde_json::from_str(&stdout(&o)).expect("the checker prints JSON"))
 }
+
+/// A CARMEN log of `scans` FLASER lines in a corridor with walls at y = ±1 m: `beams`
+/// beams over 180° from the right (beam `k` at `k · 180 / beams − 90` degrees), each range
+/// `1 / |sin|` capped at `max_range_m` plus `0.001 · ((i + k) mod jitter)` metres so no two
+/// scans repeat, scan `i` at x = `x(i)` and 1 + 0.1 i s.
+pub fn corridor_log(scans: usize, beams: usize, max_range_m: f64, jitter: usize, x: impl Fn(usize) -> f64) -> String {
+    let lines: Vec<String> = (0..scans)
+        .map(|i| {
+            let ranges: Vec<String> = (0..beams)
+                .map(|k| {
+                    let a = (k as f64 * (180.0 / beams as f64) - 90.0).to_radians();
+                    format!("{:.3}", (1.0 / a.sin().abs()).min(max_range_m) + 0.001 * ((i + k) % jitter) as f64)
+                })
+                .collect();
+            let (x, t) = (x(i), 1.0 + 0.1 * i as f64);
+            format!("FLASER {beams} {} {x:.2} 0 0 {x:.2} 0 0 {t:.3} host {t:.3}", ranges.join(" "))
+        })
+        .collect();
+    lines.join("\n") + "\n"
+}
