@@ -79,16 +79,19 @@ pub struct SensorCalibration {
     /// The true wheel base as a multiple of the one the odometry assumes.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub wheel_base: Option<Interval>,
-    /// The residual RMS of the motion equations before, metres.
+    /// The residual RMS of the motion equations before, metres (a camera: of its obstacle
+    /// points' distances to the lidar's walls, truncated at 0.3 m).
     pub cost_before: f64,
     /// … and after.
     pub cost_after: f64,
     /// Robot steps used (and of them, turning ones); a camera: frames and points scored.
     pub steps: [u64; 2],
-    /// The cost over the clock offsets searched, `[offset_s, cost]` (a camera).
+    /// The cost over the clock offsets searched, `[offset_s, cost]` (a camera): the one
+    /// its fine searches minimise, truncated nearer the walls than `cost_before` and
+    /// `cost_after` are (`CameraSearch::fine_reach_m`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub clock_curve: Vec<[f64; 2]>,
-    /// The cost over the mount yaws searched, `[yaw, cost]` (a camera).
+    /// The same cost over the mount yaws searched, `[yaw, cost]` (a camera).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub yaw_curve: Vec<[f64; 2]>,
 }

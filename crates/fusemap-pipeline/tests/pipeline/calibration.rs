@@ -131,8 +131,11 @@ fn finds_a_camera_clock_running_late() {
     let late = calibrate("camera-late", late_camera_bag(), &config((0.25, 0.0), 0.0));
     let on_time = calibrate("on-time", bag(), &config((0.25, 0.0), 0.0));
     let (late, on_time) = (get(&late, "camera", |s| s.time_offset_s), get(&on_time, "camera", |s| s.time_offset_s));
-    // The two bags share every noise draw: the difference is the search's response to a
-    // clock 40 ms late, −0.040 s ± 0.005 s.
+    // The figure: −0.040 s ± 0.005 s for the late one, and the on-time one within
+    // as much of 0. The two bags share every noise draw: their difference is the search's
+    // response alone.
+    assert!((late.value + 0.04).abs() < 0.005, "{late:?}");
+    assert!(on_time.value.abs() < 0.005, "{on_time:?}");
     assert!((late.value - on_time.value + 0.04).abs() < 0.005, "{late:?} {on_time:?}");
 }
 
@@ -211,37 +214,35 @@ fn the_calibrated_configuration_maps_as_well_as_the_right_one() {
     assert!(turn(&after) < 0.5 && turn(&after) < turn(&before), "{} {}", turn(&after), turn(&before));
 }
 
-/// The figure for the camera, not met: its clock found within 5 ms of the truth,
-/// each interval holding it. Measured (2026-12-07): 40 ms late, −0.0290 s (−0.0329 ..
-/// −0.0252); on time, +0.0110 s (0.0071 .. 0.0148). The response is right (−0.0400 s), the
-/// level is 11 ms late on both: the camera's wall points sit about 1.6 cm nearer the robot
-/// than the lidar's walls, which reads as a late clock while the robot drives at a wall.
-/// 2 ms of the 13 measured before came from the camera model's pixel centres, half a
-/// pixel off the `CameraInfo` convention the simulator renders in (fixed; the simulator's
-/// wall pixels now land on the wall to the micrometre). Neither the cells behind the
-/// walls' faces (now left out), the walls' cell centres (now the lidar returns' mean), the
-/// depth cut-off (8 m: +0.008 s) nor the obstacle band's edges (points within 0.3 m of them
-/// left out) explain the rest, and the camera's own points are not it: the production
-/// camera's obstacle points (its noise, the default parameters, true poses in the hall,
-/// 400 views) lie −1 mm from the walls on average (±0.006 m by depth band). Nor the lidar's
-/// surface points, the other way: a straight wall scanned with 1 cm range noise at 40
-/// offsets across a 5 cm cell puts them 3 mm in front of it on average (up to 1.3 cm where
-/// the wall lies just past a cell border and the cell in front holds the face), which
-/// would read as an early clock. Nor SLAM or a lagging track: `fusemap calibrate` with
-/// `[slam] mode = "off"` finds the same +0.011 s on the on-time bag, and the estimator's
-/// track is within 1 ms of the simulator's truth along the path (its along-track error
-/// over speed). Not found yet. The mount yaw comes out
-/// 0.10° off with it (it was 0.006°,
-/// when the half pixel's 0.125° cancelled it): laps turn one way, so a clock error turns
-/// the points as a yaw error would.
+/// The other figure for the camera, not met: each interval holds the truth.
+/// Measured (2026-12-08): 40 ms late, −0.0362 s (−0.0378 .. −0.0346); on time, +0.0038 s
+/// (0.0022 .. 0.0054). Both are within the 5 ms `finds_a_camera_clock_running_late` asks,
+/// but 4 ms late on both bags, and the intervals are ±1.6 ms.
+///
+/// Until 2026-12-08 the level was 11 ms late: every point within 0.3 m of a wall pulled the
+/// fine searches, which now truncate at 0.1 m (`CameraSearch::fine_reach_m`). What is
+/// left is the lidar's map (experiments, not kept, truncated at 0.05 m, which gives the
+/// same +0.0036 s as 0.1 m): scored with the simulator's true poses, the 4 ms stays
+/// (+0.0049 s); scored on the simulator's true map as well, it goes (−0.0016 s,
+/// −0.0040 .. 0.0008). It is not the faces'
+/// surface points (the cells' centres give the same +0.004 s, and so do the returns of a
+/// face's free neighbours added to its mean), nor glass (+0.0047 s without it); the
+/// walls alone give +0.0039 s, the machines +0.0025 s (−0.0057 .. 0.0108). The hall's
+/// south and west walls are where the simulator puts them in the lidar-only map, to the
+/// cell. Earlier
+/// findings: the camera model's pixel centres were half a pixel off the `CameraInfo`
+/// convention (fixed); the camera's obstacle points lie −1 mm from the walls on average
+/// with true poses; SLAM off and a track within 1 ms of the truth change nothing. The
+/// mount yaw comes out 0.068° off with it (0.099° before): laps turn one way, so a clock
+/// error turns the points as a yaw error would.
 #[test]
-#[ignore = "not met: the camera's clock comes out 11 ms late on both bags (see the doc comment)"]
-fn the_camera_clock_within_five_milliseconds() {
+#[ignore = "not met: the camera's clock comes out 4 ms late on both bags, outside its ±1.6 ms intervals (see the doc comment)"]
+fn the_camera_clock_interval_holds_the_truth() {
     let late = calibrate("camera-late-abs", late_camera_bag(), &config((0.25, 0.0), 0.0));
     let on_time = calibrate("camera-on-time-abs", bag(), &config((0.25, 0.0), 0.0));
     let (late, on_time) = (get(&late, "camera", |s| s.time_offset_s), get(&on_time, "camera", |s| s.time_offset_s));
-    assert!((late.value + 0.04).abs() < 0.005 && late.contains(-0.04), "{late:?}");
-    assert!(on_time.value.abs() < 0.005 && on_time.contains(0.0), "{on_time:?}");
+    assert!(late.contains(-0.04), "{late:?}");
+    assert!(on_time.contains(0.0), "{on_time:?}");
 }
 
 /// The figure, not met: every interval contains the truth. Measured (2026-12-06):
