@@ -13,6 +13,7 @@ use fusemap_core::estimator::{check_fix, EstimatorInput, FixProblem, FixQuality,
 use fusemap_core::frames::FrameTree;
 use fusemap_core::geometry::{geodetic::Datum, Point2};
 use fusemap_core::time::Stamp;
+use fusemap_io::log::ros2::msgs::sensor_msgs::{NavSatFix, NavSatStatus};
 use fusemap_io::log::GnssMessage;
 
 /// The datum of the map frame `[lat°, lon°, alt m]`, where it came from, and how many
@@ -117,9 +118,9 @@ pub(crate) fn shared_datum(inv: &Inventory, bound: &Bound) -> Option<ChosenDatum
 /// The quality of a fix, for the report and the floor.
 fn quality(f: &GnssMessage) -> FixQuality {
     match f.status {
-        GnssMessage::STATUS_GBAS_FIX => FixQuality::RtkFixed,
-        GnssMessage::STATUS_SBAS_FIX => FixQuality::Sbas,
-        GnssMessage::STATUS_FIX => FixQuality::Fix,
+        NavSatStatus::STATUS_GBAS_FIX => FixQuality::RtkFixed,
+        NavSatStatus::STATUS_SBAS_FIX => FixQuality::Sbas,
+        NavSatStatus::STATUS_FIX => FixQuality::Fix,
         _ => FixQuality::Unknown,
     }
 }
@@ -204,8 +205,8 @@ pub(crate) fn gnss_inputs(
         let q = quality(f);
         // NavSatFix's covariance is ENU (east, north, up), m².
         let kind = match f.position_covariance_type {
-            GnssMessage::COVARIANCE_TYPE_UNKNOWN => GnssCovarianceKind::Unknown,
-            GnssMessage::COVARIANCE_TYPE_KNOWN => GnssCovarianceKind::Known,
+            NavSatFix::COVARIANCE_TYPE_UNKNOWN => GnssCovarianceKind::Unknown,
+            NavSatFix::COVARIANCE_TYPE_KNOWN => GnssCovarianceKind::Known,
             _ => GnssCovarianceKind::Diagonal,
         };
         let cov = floors.covariance(&f.position_covariance, kind, q);

@@ -7,7 +7,7 @@ use fusemap_core::config::{Plan, SensorKind};
 use fusemap_core::estimator::DEFAULT_ALTITUDE_RANGE_M;
 use fusemap_core::geometry::normalize_angle;
 use fusemap_core::time::Stamp;
-use fusemap_io::log::GnssMessage;
+use fusemap_io::log::ros2::msgs::sensor_msgs::NavSatStatus;
 use std::fmt::Write as _;
 
 /// GNSS fix quality over time: for each fix topic, ten equal stretches of its span with
@@ -41,8 +41,8 @@ pub fn gnss_quality(plan: &Plan, inv: &Inventory, out: &mut String, findings: &m
                 3
             } else {
                 match f.status {
-                    GnssMessage::STATUS_GBAS_FIX => 0,
-                    GnssMessage::STATUS_SBAS_FIX => 1,
+                    NavSatStatus::STATUS_GBAS_FIX => 0,
+                    NavSatStatus::STATUS_SBAS_FIX => 1,
                     _ => 2,
                 }
             };

@@ -36,6 +36,7 @@ pub use open::{detect, open_log, open_log_with, LogFormat, OpenedLog};
 use fusemap_core::geometry::{quaternion_yaw, Pose2};
 use fusemap_core::sensor::LaserScan;
 use fusemap_core::time::Stamp;
+use ros2::msgs::sensor_msgs::NavSatStatus;
 use std::collections::BTreeMap;
 
 /// A 2D laser scan with the fields of `sensor_msgs/LaserScan` fusemap uses.
@@ -212,9 +213,10 @@ pub struct GnssMessage {
     pub receive_stamp: Option<Stamp>,
     /// `header.frame_id`: the antenna's frame (its mount on the robot).
     pub frame_id: String,
-    /// `status.status`: one of the `STATUS_*` constants (other values as written).
+    /// `status.status`: one of [`NavSatStatus`]'s `STATUS_*` constants (other values as
+    /// written).
     pub status: i8,
-    /// `status.service`: a bit set of the `SERVICE_*` constants.
+    /// `status.service`: a bit set of [`NavSatStatus`]'s `SERVICE_*` constants.
     pub service: u16,
     /// Latitude, degrees, positive north of the equator.
     pub latitude: f64,
@@ -225,40 +227,15 @@ pub struct GnssMessage {
     /// Row-major 3×3 covariance of the position in the local East-North-Up tangent
     /// plane at the fix, m².
     pub position_covariance: [f64; 9],
-    /// How much of `position_covariance` is known: one of the `COVARIANCE_TYPE_*`
-    /// constants.
+    /// How much of `position_covariance` is known: one of
+    /// [`NavSatFix`](ros2::msgs::sensor_msgs::NavSatFix)'s `COVARIANCE_TYPE_*` constants.
     pub position_covariance_type: u8,
 }
 
 impl GnssMessage {
-    /// `status`: no fix; the position must not be used.
-    pub const STATUS_NO_FIX: i8 = -1;
-    /// `status`: an unaugmented fix.
-    pub const STATUS_FIX: i8 = 0;
-    /// `status`: a fix with satellite-based augmentation (WAAS, EGNOS).
-    pub const STATUS_SBAS_FIX: i8 = 1;
-    /// `status`: a fix with ground-based augmentation (RTK, DGPS).
-    pub const STATUS_GBAS_FIX: i8 = 2;
-    /// `service` bit: GPS.
-    pub const SERVICE_GPS: u16 = 1;
-    /// `service` bit: GLONASS.
-    pub const SERVICE_GLONASS: u16 = 2;
-    /// `service` bit: COMPASS / BeiDou.
-    pub const SERVICE_COMPASS: u16 = 4;
-    /// `service` bit: Galileo.
-    pub const SERVICE_GALILEO: u16 = 8;
-    /// `position_covariance_type`: nothing is known of the covariance.
-    pub const COVARIANCE_TYPE_UNKNOWN: u8 = 0;
-    /// `position_covariance_type`: approximated (e.g. from dilution of precision).
-    pub const COVARIANCE_TYPE_APPROXIMATED: u8 = 1;
-    /// `position_covariance_type`: the diagonal is known, off-diagonal terms are not.
-    pub const COVARIANCE_TYPE_DIAGONAL_KNOWN: u8 = 2;
-    /// `position_covariance_type`: the full matrix is known.
-    pub const COVARIANCE_TYPE_KNOWN: u8 = 3;
-
     /// True when the receiver reports a fix (`status >= STATUS_FIX`).
     pub fn has_fix(&self) -> bool {
-        self.status >= Self::STATUS_FIX
+        self.status >= NavSatStatus::STATUS_FIX
     }
 }
 
@@ -432,6 +409,7 @@ pub trait LogReader {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+    use ros2::msgs::sensor_msgs::NavSatFix;
     use std::f64::consts::PI;
 
     fn transform(stamp: i64) -> Transform {
@@ -516,13 +494,13 @@ mod tests {
                 stamp: Stamp(5),
                 receive_stamp: receive,
                 frame_id: "gps".into(),
-                status: GnssMessage::STATUS_FIX,
-                service: GnssMessage::SERVICE_GPS,
+                status: NavSatStatus::STATUS_FIX,
+                service: NavSatStatus::SERVICE_GPS,
                 latitude: 0.0,
                 longitude: 0.0,
                 altitude: 0.0,
                 position_covariance: [0.0; 9],
-                position_covariance_type: GnssMessage::COVARIANCE_TYPE_UNKNOWN,
+                position_covariance_type: NavSatFix::COVARIANCE_TYPE_UNKNOWN,
             }),
             LogMessage::Pose(PoseMessage {
                 topic: "/amcl_pose".into(),

@@ -3,6 +3,7 @@
 //! `sensor_msgs/Imu` and `nav_msgs/Odometry`, read through whole bags.
 
 use super::*;
+use crate::log::ros2::msgs::sensor_msgs::{NavSatFix, NavSatStatus};
 use crate::log::{GnssMessage, PoseMessage};
 use proptest::prelude::*;
 
@@ -32,11 +33,11 @@ impl Fix {
     fn sample() -> Self {
         Fix {
             stamp: (50, 250),
-            status: GnssMessage::STATUS_SBAS_FIX,
-            service: GnssMessage::SERVICE_GPS | GnssMessage::SERVICE_GALILEO,
+            status: NavSatStatus::STATUS_SBAS_FIX,
+            service: NavSatStatus::SERVICE_GPS | NavSatStatus::SERVICE_GALILEO,
             lla: [48.858_37, 2.294_481, 35.25],
             covariance: ramp(0.5),
-            covariance_type: GnssMessage::COVARIANCE_TYPE_KNOWN,
+            covariance_type: NavSatFix::COVARIANCE_TYPE_KNOWN,
         }
     }
 
@@ -115,11 +116,11 @@ fn nav_sat_fix_fields_are_read_at_their_offsets() {
 #[test]
 fn a_fix_with_nan_fields_and_no_fix_status_decodes_as_written() {
     let fix = Fix {
-        status: GnssMessage::STATUS_NO_FIX,
+        status: NavSatStatus::STATUS_NO_FIX,
         service: 0,
         lla: [f64::NAN, 2.0, f64::NAN],
         covariance: [f64::NAN; 9],
-        covariance_type: GnssMessage::COVARIANCE_TYPE_UNKNOWN,
+        covariance_type: NavSatFix::COVARIANCE_TYPE_UNKNOWN,
         ..Fix::sample()
     };
     let messages = decode_all(vec![Inner::Conn(NAVSAT), msg(NAVSAT, (1, 0), fix.payload())]);

@@ -3,6 +3,7 @@
 //! `sensor_msgs/msg/Imu` and `nav_msgs/msg/Odometry`; and a bad one in an MCAP file.
 
 use super::*;
+use crate::log::ros2::msgs::sensor_msgs::{NavSatFix, NavSatStatus};
 use crate::log::{GnssMessage, PoseMessage};
 use fusemap_core::geometry::Pose2;
 
@@ -45,11 +46,11 @@ impl Fix {
         Fix {
             sec: 60,
             nanosec: 70,
-            status: GnssMessage::STATUS_GBAS_FIX,
-            service: GnssMessage::SERVICE_GPS | GnssMessage::SERVICE_GLONASS,
+            status: NavSatStatus::STATUS_GBAS_FIX,
+            service: NavSatStatus::SERVICE_GPS | NavSatStatus::SERVICE_GLONASS,
             lla: [-33.856_784, 151.215_297, 12.5],
             covariance: ramp(0.25),
-            covariance_type: GnssMessage::COVARIANCE_TYPE_DIAGONAL_KNOWN,
+            covariance_type: NavSatFix::COVARIANCE_TYPE_DIAGONAL_KNOWN,
         }
     }
 }
@@ -107,7 +108,7 @@ fn nav_sat_fix_bytes_laid_out_by_hand() {
 #[test]
 fn a_fix_with_nan_fields_decodes_as_written() {
     let fix =
-        Fix { status: GnssMessage::STATUS_NO_FIX, lla: [f64::NAN; 3], covariance: [f64::NAN; 9], ..Fix::sample() };
+        Fix { status: NavSatStatus::STATUS_NO_FIX, lla: [f64::NAN; 3], covariance: [f64::NAN; 9], ..Fix::sample() };
     let LogMessage::Gnss(m) = decode(KnownType::NavSatFix, &nav_sat_fix_payload(&fix)) else { panic!("not a fix") };
     assert!([m.latitude, m.longitude, m.altitude].iter().all(|v| v.is_nan()));
     assert!(m.position_covariance.iter().all(|v| v.is_nan()));
