@@ -18,7 +18,7 @@
 //! reach as wide as the errors they search (a 0.2 s clock error moves a point 0.3 m at
 //! walking speed), but at the fine grids, already within a few centimetres, every point
 //! between the narrow and the wide reach is one on something the lidar's map lacks or
-//! holds elsewhere (a shelf above its plane, a face one cell behind), and a truncated
+//! holds elsewhere (a shelf above its plane, a window it sees through), and a truncated
 //! quadratic pulls hardest on exactly those. On the production line the camera's clock
 //! came out 11 ms late with 0.3 m throughout and 4 ms with 0.1 m at the fine grids, the
 //! response to a 40 ms late clock unchanged. Each minimum is the vertex of
