@@ -94,7 +94,7 @@ impl PipelineError {
     pub fn refusal_stage(&self) -> Option<Stage> {
         match self {
             Self::Refused(r) => Some(r.stage),
-            Self::Engine(fusemap_core::fusion::EngineError::MapBudget { .. }) => Some(Stage::Budget),
+            Self::Engine(e) => Stage::of_engine_error(e),
             _ => None,
         }
     }
@@ -136,6 +136,12 @@ pub enum Stage {
 }
 
 impl Stage {
+    /// The stage an engine error refuses a run at, when it is a refusal: a map past its
+    /// budget is the budget's; any other engine error is a fault, not a refusal.
+    pub fn of_engine_error(e: &fusemap_core::fusion::EngineError) -> Option<Stage> {
+        matches!(e, fusemap_core::fusion::EngineError::MapBudget { .. }).then_some(Stage::Budget)
+    }
+
     /// Its name in snake case (`"budget"`), as the Python package's exceptions carry it.
     pub fn name(self) -> &'static str {
         match self {
@@ -169,6 +175,18 @@ mod tests {
         ] {
             assert_eq!(serde_json::to_value(stage).unwrap(), stage.name(), "{stage:?}");
         }
+        use fusemap_core::fusion::{BudgetKey, EngineError};
+        let budget = EngineError::MapBudget {
+            key: BudgetKey::MemoryMib,
+            limit: 1,
+            tiles: 0,
+            tile_bytes: 0,
+            maps: 1,
+            stamp: fusemap_core::time::Stamp(0),
+        };
+        assert_eq!(PipelineError::Engine(budget).refusal_stage(), Some(Stage::Budget));
+        let fault = EngineError::UnknownSensor(fusemap_core::measurement::SensorId(3));
+        assert_eq!(PipelineError::Engine(fault).refusal_stage(), None);
         let e = PipelineError::refused(Stage::Budget, "past limits.memory_mib");
         assert_eq!((e.refusal_stage(), e.to_string().as_str()), (Some(Stage::Budget), "past limits.memory_mib"));
     }

@@ -5,7 +5,7 @@
 use crate::progress::Progress;
 use crate::{PipelineError, Stage};
 use fusemap_core::config::Plan;
-use fusemap_core::fusion::{Engine, EngineError};
+use fusemap_core::fusion::Engine;
 use fusemap_core::geometry::Pose2;
 use fusemap_core::grid::FusionGrid;
 use fusemap_core::measurement::SensorId;
@@ -45,8 +45,7 @@ pub fn map_world(
             for (k, id) in ids.iter().enumerate() {
                 let scan = simulate_scan(world, scanner, plan.lidars[k].model.mount(), *pose, stamp(i));
                 engine.insert_scan(*id, &scan, *pose).map_err(|e| {
-                    let stage = if matches!(e, EngineError::MapBudget { .. }) { Stage::Budget } else { Stage::World };
-                    PipelineError::refused(stage, format!("scan {i}: {e}"))
+                    PipelineError::refused(Stage::of_engine_error(&e).unwrap_or(Stage::World), format!("scan {i}: {e}"))
                 })?;
             }
         }
