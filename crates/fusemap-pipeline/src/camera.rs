@@ -18,7 +18,7 @@ use fusemap_core::frames::FrameTree;
 use fusemap_core::fusion::{Engine, EngineError};
 use fusemap_core::geometry::{Point2, Pose2, Pose3};
 use fusemap_core::measurement::{ObservationId, SensorId};
-use fusemap_core::sensor::camera::{Band, CameraModel, ClassTable, Pinhole, PixelCounts};
+use fusemap_core::sensor::camera::{Band, CameraModel, ClassTable, DepthImage, Pinhole, PixelCounts};
 use fusemap_core::time::{Stamp, SyncMode};
 use fusemap_io::log::{image_over_limit, ImageMessage};
 use serde::Serialize;
@@ -104,6 +104,34 @@ const BAND_MARGIN_M: f64 = 0.3;
 /// The most obstacle points a calibration keeps of one frame (evenly spread over the
 /// frame's points): enough to trace the walls it sees, and a bounded memory per frame.
 const SAMPLE_POINTS: usize = 400;
+
+/// The floor fit's points a frame keeps, at most: the pixels on a regular grid.
+const FLOOR_POINTS: usize = 300;
+/// How far from the configured floor a depth point may lie and still be kept for the floor
+/// fit, metres: a camera 5° off in pitch sees the floor 0.35 m off at 4 m.
+const FLOOR_REACH_M: f64 = 0.5;
+
+/// A frame's depth points (optical frame) on a grid of about [`FLOOR_POINTS`] pixels,
+/// within the camera's depth range and [`FLOOR_REACH_M`] of the floor as the configured
+/// mount places them: what the floor fit of `calibrate` needs, whatever their labels.
+fn floor_points(model: &CameraModel, depths: &DepthImage) -> Vec<[f32; 3]> {
+    let (pin, mount, p) = (model.pinhole(), model.base_from_optical(), model.params());
+    let stride = ((pin.pixels() as f64 / FLOOR_POINTS as f64).sqrt().ceil() as usize).max(1);
+    let mut out = Vec::new();
+    for v in (0..depths.height).step_by(stride) {
+        for u in (0..depths.width).step_by(stride) {
+            let d = f64::from(depths.at(u, v));
+            if !(d.is_finite() && d >= p.min_depth_m && d <= p.max_depth_m) {
+                continue;
+            }
+            let q = pin.ray(f64::from(u), f64::from(v)).map(|c| c * d);
+            if (mount.rotate(q)[2] + mount.translation[2]).abs() < FLOOR_REACH_M {
+                out.push(q.map(|c| c as f32));
+            }
+        }
+    }
+    out
+}
 
 /// A camera as the log lets it be built.
 pub(crate) enum BuiltCamera {
@@ -293,8 +321,9 @@ impl MappedCamera {
 
     /// Keeps the frame just projected as a calibration's sample: its obstacle points
     /// ([`ClassTable::is_static_obstacle`](fusemap_core::sensor::camera::ClassTable::is_static_obstacle),
-    /// obstacle band) back in the base frame, at most [`SAMPLE_POINTS`] of them.
-    fn sample(&mut self, engine: &Engine, stamp: Stamp, pose: Pose2) {
+    /// obstacle band) back in the base frame, at most [`SAMPLE_POINTS`] of them, and the
+    /// depth points near the configured floor ([`floor_points`]).
+    fn sample(&mut self, engine: &Engine, stamp: Stamp, pose: Pose2, depths: &DepthImage) {
         let (Some(samples), Some(model)) = (&mut self.samples, engine.camera_model(self.id)) else { return };
         let classes = model.classes();
         let (low, high) =
@@ -309,7 +338,8 @@ impl MappedCamera {
             .map(|p| to_base.transform_point(p.end))
             .collect();
         let step = obstacle.len().div_ceil(SAMPLE_POINTS).max(1);
-        samples.push(CameraSample { stamp, points: obstacle.into_iter().step_by(step).collect() });
+        let points = obstacle.into_iter().step_by(step).collect();
+        samples.push(CameraSample { stamp, points, floor: floor_points(model, depths) });
     }
 
     /// Counts images left unpaired at the end of the log.
@@ -352,7 +382,7 @@ impl MappedCamera {
         match engine.insert_camera_frame(self.id, Some(id), frame.release, &labels, &depths, pose) {
             Ok(_) => {
                 self.report.frames_used += 1;
-                self.sample(engine, stamp, pose);
+                self.sample(engine, stamp, pose, &depths);
                 Ok(())
             }
             // Another sensor's observation was applied after this frame's stamp (a clock

@@ -33,6 +33,9 @@ pub fn table(c: &Calibration) -> String {
         for (k, v, unit, f, d) in [
             ("x", &e.x, "m", 1.0, 4),
             ("y", &e.y, "m", 1.0, 4),
+            ("z", &e.z, "m", 1.0, 4),
+            ("roll", &e.roll, "°", 180.0 / std::f64::consts::PI, 3),
+            ("pitch", &e.pitch, "°", 180.0 / std::f64::consts::PI, 3),
             ("yaw", &e.yaw, "°", 180.0 / std::f64::consts::PI, 3),
             ("scale", &e.scale, "×", 1.0, 4),
             ("time_offset_s", &e.time_offset_s, "s", 1.0, 4),

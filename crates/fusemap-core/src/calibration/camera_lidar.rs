@@ -43,6 +43,9 @@ pub struct CameraSample {
     pub stamp: Stamp,
     /// Its obstacle-band points of obstacle classes, base frame (x forward, y left).
     pub points: Vec<Point2>,
+    /// Its depth points near the configured floor, optical frame: what
+    /// [`camera_floor`](super::camera_floor) fits.
+    pub floor: super::FloorPoints,
 }
 
 /// The search's grids.
@@ -389,7 +392,7 @@ mod tests {
                 let (ex, ey) = (b.x - centre.x, b.y - centre.y);
                 points.push(Point2::new(centre.x + c * ex - s * ey, centre.y + s * ex + c * ey));
             }
-            samples.push(CameraSample { stamp: Stamp(((t + late) * 1e9).round() as i64), points });
+            samples.push(CameraSample { stamp: Stamp(((t + late) * 1e9).round() as i64), points, floor: Vec::new() });
         }
         let at = move |s: Stamp| Some(pose(s.0 as f64 * 1e-9));
         (samples, at)

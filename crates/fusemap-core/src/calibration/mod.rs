@@ -2,10 +2,12 @@
 //! check by hand (mounts, clock offsets, odometry), estimated with an interval, and left
 //! undetermined, with the reason, where the log cannot fix it.
 
+mod camera_floor;
 mod camera_lidar;
 mod distance_field;
 mod lidar_odometry;
 
+pub use camera_floor::{camera_floor, FloorFit, FloorPoints};
 pub use camera_lidar::{camera_against_map, CameraLidarFit, CameraSample, CameraSearch};
 pub use distance_field::{DistanceField, SurfaceHits};
 pub use lidar_odometry::{lidar_odometry, steps_of, turn_agreement, LidarOdometry, MotionStep};

@@ -2,17 +2,19 @@
 //! the mapping pass placed them, scored on the lidar-only map of the same pass
 //! ([`fusemap_core::calibration::camera_against_map`]).
 //!
-//! The camera's pitch and height above the floor are not estimated: they change which
-//! pixels fall in the obstacle band, not only where, and need the floor's own points; the
-//! report says so.
+//! The camera's height above the floor and its tilt (the mount's z, roll and pitch) come
+//! from the floor its depth pixels see ([`fusemap_core::calibration::camera_floor`]): the
+//! lidar's map cannot give them, the floor fixes exactly them.
 
 use super::{claim, shifted, SensorCalibration};
 use crate::map_pass::MapRun;
 use crate::track::Track;
-use fusemap_core::calibration::{camera_against_map, CameraLidarFit, CameraSearch, DistanceField};
+use fusemap_core::calibration::{
+    camera_against_map, camera_floor, CameraLidarFit, CameraSearch, DistanceField, FloorFit,
+};
 use fusemap_core::config::SensorKind;
 use fusemap_core::fusion::OBSTACLE_PROBABILITY;
-use fusemap_core::geometry::{Mount3, Point2};
+use fusemap_core::geometry::{Mount3, Point2, Pose3};
 use fusemap_core::grid::logodds::logit;
 use fusemap_core::time::SyncMode;
 use std::fmt::Write;
@@ -29,6 +31,8 @@ pub(super) struct CameraEstimate {
     name: String,
     report: crate::camera::CameraReport,
     fit: CameraLidarFit,
+    /// The height and tilt from the floor, or why the floor could not give them.
+    floor: Result<FloorFit, String>,
     /// The lidar's yaw correction written beside it: the pass placed the base through the
     /// configured lidar mount, so the camera's fitted yaw is relative to a base turned by
     /// the lidar's error, and turns back with it.
@@ -77,17 +81,15 @@ pub(super) fn cameras_against_lidar(run: &MapRun, undetermined: &mut Vec<String>
                         search.yaw_span_rad.to_degrees()
                     )));
                 }
-                out.push(CameraEstimate { name: name.clone(), report: report.clone(), fit, base_turn: 0.0 });
+                let configured = Pose3::new([mount.x, mount.y, mount.z], mount.quaternion());
+                let floor = camera_floor(samples.iter().map(|s| s.floor.as_slice()), &configured);
+                if let Err(e) = &floor {
+                    undetermined.push(format!("`{name}`'s height above the floor and tilt (z, roll, pitch): {e}"));
+                }
+                out.push(CameraEstimate { name: name.clone(), report: report.clone(), fit, floor, base_turn: 0.0 });
             }
             Err(e) => undetermined.push(why(e)),
         }
-    }
-    if !out.is_empty() {
-        undetermined.push(
-            "the cameras' pitch and height above the floor: not estimated by this version (they decide which pixels \
-             are obstacles, and need the floor's points)"
-                .into(),
-        );
     }
     out
 }
@@ -113,6 +115,9 @@ impl CameraEstimate {
             x: None,
             y: None,
             yaw: f.yaw.map(|y| wrapped(shifted(y, self.mount().yaw + self.base_turn))),
+            z: self.floor.as_ref().ok().map(|f| f.z),
+            roll: self.floor.as_ref().ok().map(|f| f.roll),
+            pitch: self.floor.as_ref().ok().map(|f| f.pitch),
             time_offset_s: f.clock.map(|c| shifted(c, self.report.time_offset_s)),
             scale: None,
             wheel_base: None,
@@ -157,7 +162,31 @@ impl CameraEstimate {
                 );
             }
         }
-        let _ = writeln!(s, "#   pitch, height (z): not estimated; kept as configured");
+        match &self.floor {
+            Ok(f) => {
+                let _ = writeln!(
+                    s,
+                    "#   from the floor ({} frames, {} points; RMS height {:.4} m before, {:.4} m after):\n\
+                     #   z {:.4} m ({:.4} .. {:.4}), roll {:.5} rad ({:.5} .. {:.5}), pitch {:.5} rad ({:.5} .. {:.5})",
+                    f.frames,
+                    f.points,
+                    f.rms_before_m,
+                    f.rms_after_m,
+                    f.z.value,
+                    f.z.low,
+                    f.z.high,
+                    f.roll.value,
+                    f.roll.low,
+                    f.roll.high,
+                    f.pitch.value,
+                    f.pitch.low,
+                    f.pitch.high
+                );
+            }
+            Err(why) => {
+                let _ = writeln!(s, "#   z, roll, pitch: kept as configured; the floor does not fix them: {why}");
+            }
+        }
         let _ = writeln!(
             s,
             "[[sensor]]\nkind = \"camera\"\nname = {}\ntopic = {}\ndepth_topic = {}\ninfo_topic = {}",
@@ -169,8 +198,11 @@ impl CameraEstimate {
         let offset = e.time_offset_s.map_or(r.time_offset_s, |c| claim(c, r.time_offset_s));
         let _ = writeln!(s, "time_offset_s = {offset}");
         let yaw = e.yaw.map_or(m.yaw, |y| claim(y, m.yaw));
+        let z = e.z.map_or(m.z, |v| claim(v, m.z));
+        let roll = e.roll.map_or(m.roll, |v| claim(v, m.roll));
+        let pitch = e.pitch.map_or(m.pitch, |v| claim(v, m.pitch));
         let _ = writeln!(s, "\n[sensor.base_from_sensor]");
-        for (k, v) in [("x", m.x), ("y", m.y), ("z", m.z), ("roll", m.roll), ("pitch", m.pitch), ("yaw", yaw)] {
+        for (k, v) in [("x", m.x), ("y", m.y), ("z", z), ("roll", roll), ("pitch", pitch), ("yaw", yaw)] {
             let _ = writeln!(s, "{k} = {v}");
         }
     }

@@ -9,7 +9,9 @@
 //! their turns line up ([`fusemap_core::calibration::turn_agreement`]). It needs SLAM on
 //! a timed track and a wheel-odometry topic; without them it says so. Each camera's clock
 //! offset and mount yaw come from its wall points scored on the lidars' map of the same
-//! pass (`calibrate/camera.rs`, [`fusemap_core::calibration::camera_against_map`]); its pitch and height are not estimated, and the report says so.
+//! pass (`calibrate/camera.rs`, [`fusemap_core::calibration::camera_against_map`]); its
+//! height above the floor and its tilt from the floor its depth pixels see
+//! ([`fusemap_core::calibration::camera_floor`]).
 
 mod camera;
 mod revalidate;
@@ -70,6 +72,15 @@ pub struct SensorCalibration {
     /// The mount's yaw, radians.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub yaw: Option<Interval>,
+    /// The mount's z, metres: a camera's height above the floor (`base_link`'s z = 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub z: Option<Interval>,
+    /// The mount's roll, radians (a camera's, from the floor).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub roll: Option<Interval>,
+    /// The mount's pitch, radians (a camera's, from the floor).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pitch: Option<Interval>,
     /// The clock offset to add to its stamps, seconds (a lidar: against the odometry).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<Interval>,
@@ -397,6 +408,9 @@ fn sensors_of(
         x: lever.map(|l| l[0]),
         y: lever.map(|l| l[1]),
         yaw: Some(yaw),
+        z: None,
+        roll: None,
+        pitch: None,
         time_offset_s: est.clock,
         scale: None,
         wheel_base: None,

@@ -64,6 +64,9 @@ fn parameters(c: &Value) -> Vec<[String; 4]> {
     for (key, unit, scale) in [
         ("x", "m", 1.0),
         ("y", "m", 1.0),
+        ("z", "m", 1.0),
+        ("roll", "°", 180.0 / std::f64::consts::PI),
+        ("pitch", "°", 180.0 / std::f64::consts::PI),
         ("yaw", "°", 180.0 / std::f64::consts::PI),
         ("time_offset_s", "s", 1.0),
         ("scale", "× true distance", 1.0),
