@@ -22,6 +22,7 @@
 //! The doctor uses the mapper's own functions (the first pass, the sensor binding, the
 //! pose track), so what it says is what `fusemap map` will do.
 
+use crate::job::{plan_of, JobError};
 use crate::log_findings::{stream_findings, timing_rows, track_topic, Roles, Row};
 use crate::recording::Inventory;
 use crate::sync::Skipped;
@@ -33,7 +34,7 @@ use fusemap_core::geometry::quaternion_yaw;
 use fusemap_core::time::{PoseTrack, Stamp, SyncMode, TimingLimits};
 use fusemap_io::text::{printable, table_cell};
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// How the scan topic gets its poses.
 struct Sync {
@@ -102,6 +103,29 @@ pub struct Report {
     /// Why `fusemap map` would refuse the log, when it would: a script running the doctor
     /// must see that as a failure, not only read it in the findings.
     pub refusal: Option<String>,
+}
+
+/// `fusemap doctor [--config C] LOG`, planned: the configuration read and checked once.
+pub struct DoctorJob {
+    /// The validated configuration (its `[log]` limits judge the timing).
+    pub plan: Plan,
+    /// The log.
+    pub log: PathBuf,
+}
+
+impl DoctorJob {
+    /// The configuration's plan (or the defaults') for the log at `log`.
+    pub fn plan(config: Option<&Path>, log: &Path) -> Result<Self, JobError> {
+        Ok(Self { plan: plan_of(config)?, log: log.to_path_buf() })
+    }
+
+    /// The report ([`report`]); a reader's error names its file.
+    pub fn run(&self) -> Result<Report, JobError> {
+        report(&self.plan, &self.log).map_err(|e| match e {
+            PipelineError::Read(e) => JobError::File(e),
+            e => JobError::Pipeline(e),
+        })
+    }
 }
 
 /// The doctor's report on the log at `path`.

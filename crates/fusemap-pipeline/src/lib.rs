@@ -53,6 +53,7 @@ pub mod report;
 pub mod run;
 pub mod scenario;
 pub mod sensors;
+pub mod simulate;
 pub mod slam;
 pub mod slam_bench;
 pub mod slam_summary;

@@ -6,8 +6,7 @@ use std::path::Path;
 /// `fusemap doctor`: the report on stdout; a log `fusemap map` would refuse exits
 /// non-zero with the reason.
 pub fn run(config: Option<&Path>, path: &Path) -> Result<()> {
-    let plan = super::plan_of(config)?;
-    let report = fusemap_pipeline::doctor::report(&plan, path)?;
+    let report = fusemap_pipeline::doctor::DoctorJob::plan(config, path)?.run()?;
     print!("{}", report.text);
     match report.refusal {
         // The report is printed whole; the exit status says what a script needs to know.

@@ -1,30 +1,14 @@
 //! `fusemap simulate [SCENARIO.toml] --out DIR`: the design document's production line (or
 //! a scenario file's world) recorded as a rosbag2 bag, with its ground truth beside it.
 
-use anyhow::{Context, Result};
-use fusemap_sim::bag::SimulationError;
-use fusemap_sim::Scenario;
+use anyhow::Result;
+use fusemap_pipeline::simulate::SimulateJob;
 use std::path::Path;
 
 /// Runs the simulator and writes `DIR/bag`, `DIR/truth.yaml` + `.pgm`,
 /// `DIR/truth_semantic.yaml` + `.png`, `DIR/truth.tum`.
 pub fn run(scenario: Option<&Path>, out: &Path, resolution: f64, overwrite: bool) -> Result<()> {
-    let s = match scenario {
-        Some(p) => fusemap_sim::bag::load_scenario(p)?,
-        None => Scenario::default(),
-    };
-    if let Some(p) = scenario {
-        fusemap_io::atomic::ensure_not_input(&out.join("bag"), &[p.to_path_buf()])?;
-    }
-    // The memory budget of a run with default limits: `simulate` reads no config.
-    let memory = fusemap_core::config::LimitsConfig::default().memory_bytes();
-    let (rec, files) = match fusemap_sim::bag::simulate_to(&s, out, resolution, overwrite, memory) {
-        Ok(written) => written,
-        Err(SimulationError::Scenario(e)) => return Err(anyhow::anyhow!("scenario: {e}")),
-        Err(SimulationError::Write(e)) => {
-            return Err(e).with_context(|| format!("writing the simulation to {}", out.display()))
-        }
-    };
+    let (rec, files) = SimulateJob::plan(scenario, out, resolution, overwrite)?.run()?;
     println!("bag           {} ({} messages)", super::shown(&files.bag.dir), files.bag.message_count);
     for t in &files.bag.topics {
         println!("  {:<12}  {:<28} {}", t.name, t.type_name, t.message_count);
