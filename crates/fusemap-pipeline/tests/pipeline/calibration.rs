@@ -150,18 +150,22 @@ fn finds_a_turned_camera_mount() {
     assert!(!camera.clock_curve.is_empty() && !camera.yaw_curve.is_empty());
 }
 
-/// The camera configured 5 cm too high, pitched down 22° instead of 25° and rolled 1.5°
-/// about its optical axis: its height and tilt come back from the floor its depth pixels
-/// see. (Measured 2026-12-08: z 0.9997 m, roll 0.006° and pitch 0.003° from the truth; the
-/// 95 % intervals, about ±0.1 mm and ±0.004°, miss the truth by 0.2 mm and 0.002°: they
-/// hold the frames' random error, not what the simulated depth carries beside it.)
-#[test]
-fn finds_the_camera_height_and_tilt_from_the_floor() {
+/// The production line's configuration with the camera 5 cm too high, pitched down 22°
+/// instead of 25° and rolled 1.5° about its optical axis.
+fn tilted_camera_config() -> String {
     let right = config((0.25, 0.0), 0.0);
     let level = format!("z = 1.0\nroll = {}\npitch = 0.0\n", -(115f64).to_radians());
     let tilted = format!("z = 1.05\nroll = {}\npitch = {}\n", -(112f64).to_radians(), 1.5f64.to_radians());
     assert!(right.contains(&level), "the camera's mount as `config` writes it");
-    let c = calibrate("camera-tilt", bag(), &right.replace(&level, &tilted));
+    right.replace(&level, &tilted)
+}
+
+/// The camera's height and tilt, configured wrong ([`tilted_camera_config`]), come back
+/// from the floor its depth pixels see. (Measured 2026-12-08: z 0.9997 m, roll 0.006° and
+/// pitch 0.003° from the truth.)
+#[test]
+fn finds_the_camera_height_and_tilt_from_the_floor() {
+    let c = calibrate("camera-tilt", bag(), &tilted_camera_config());
     let (z, roll, pitch) = (get(&c, "camera", |s| s.z), get(&c, "camera", |s| s.roll), get(&c, "camera", |s| s.pitch));
     assert!((z.value - 1.0).abs() < 0.01, "{z:?}");
     assert!((roll.value + 115f64.to_radians()).abs() < 0.2f64.to_radians(), "{roll:?}");
@@ -171,6 +175,22 @@ fn finds_the_camera_height_and_tilt_from_the_floor() {
     let camera = pasted.sensor.iter().find(|s| s.name.as_deref() == Some("camera")).unwrap();
     let m = camera.base_from_sensor.unwrap();
     assert_eq!((m.z, m.roll, m.pitch), (z.value, roll.value, pitch.value));
+}
+
+/// The other figure for the camera's height and tilt, not met: each interval holds
+/// the truth. The 95 % intervals (about ±0.1 mm and ±0.004°, a jackknife over runs of
+/// frames) hold the frames' random error; the estimates sit 0.3 mm and 0.006° from the
+/// truth with the right mount and with the wrong one alike, so the intervals miss by
+/// 0.2 mm and 0.002°: an offset the simulated depth or the plane fit carries, not followed.
+#[test]
+#[ignore = "not met: the camera's floor intervals miss the truth by 0.2 mm and 0.002° (see the doc comment)"]
+fn the_camera_floor_intervals_hold_the_truth() {
+    for (name, cfg) in [("right", config((0.25, 0.0), 0.0)), ("tilted", tilted_camera_config())] {
+        let c = calibrate(&format!("camera-floor-{name}"), bag(), &cfg);
+        assert!(get(&c, "camera", |s| s.z).contains(1.0), "{name}");
+        assert!(get(&c, "camera", |s| s.roll).contains(-(115f64).to_radians()), "{name}");
+        assert!(get(&c, "camera", |s| s.pitch).contains(0.0), "{name}");
+    }
 }
 
 /// The fused map's F1 of occupied cells against the simulator's truth, mapped with `cfg`.
