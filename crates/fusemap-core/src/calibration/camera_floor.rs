@@ -41,7 +41,7 @@ pub type FloorPoints = Vec<[f32; 3]>;
 /// What the floor says of the camera's mount.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FloorFit {
-    /// Frames that gave floor points, and the floor points used.
+    /// Frames that gave floor points.
     pub frames: usize,
     /// Floor points (inliers of the last round).
     pub points: usize,
@@ -57,7 +57,8 @@ pub struct FloorFit {
     pub roll: Interval,
     /// See `roll`.
     pub pitch: Interval,
-    /// The corrected mount: the configured one tilted level, its `z` the fitted height.
+    /// The corrected mount: the configured one with the floor's roll and pitch and the
+    /// fitted height as its `z`.
     pub base_from_optical: Pose3,
 }
 
