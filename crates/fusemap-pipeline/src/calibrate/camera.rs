@@ -83,8 +83,11 @@ pub(super) fn cameras_against_lidar(run: &MapRun, undetermined: &mut Vec<String>
                 }
                 let configured = Pose3::new([mount.x, mount.y, mount.z], mount.quaternion());
                 let floor = camera_floor(samples.iter().map(|s| s.floor.as_slice()), &configured);
-                if let Err(e) = &floor {
-                    undetermined.push(format!("`{name}`'s height above the floor and tilt (z, roll, pitch): {e}"));
+                match &floor {
+                    Err(e) => {
+                        undetermined.push(format!("`{name}`'s height above the floor and tilt (z, roll, pitch): {e}"))
+                    }
+                    Ok(f) => undetermined.extend(refit_needed(name, &configured, f)),
                 }
                 out.push(CameraEstimate { name: name.clone(), report: report.clone(), fit, floor, base_turn: 0.0 });
             }
@@ -92,6 +95,33 @@ pub(super) fn cameras_against_lidar(run: &MapRun, undetermined: &mut Vec<String>
         }
     }
     out
+}
+
+/// A tilt or a height this far from the configured one moves the camera's wall points by
+/// more than the clock and yaw fits resolve (1° tilts a wall point 3 m away by 5 cm).
+const REFIT_TILT_DEG: f64 = 0.5;
+/// … metres.
+const REFIT_HEIGHT_M: f64 = 0.02;
+
+/// The clock offset and the yaw were fitted on wall points the pass placed through the
+/// configured tilt and height: when the floor puts those far off, the note that says to
+/// calibrate again with `calibration.toml`'s camera table pasted in, whose corrected mount
+/// places them right. (On the production line with the camera 5 cm high and 3° off in
+/// tilt: clock +0.0011 s and yaw −90.083° through the wrong tilt; +0.0038 s and −90.068°
+/// with the pasted table, as with the right configuration.)
+fn refit_needed(name: &str, configured: &Pose3, f: &FloorFit) -> Option<String> {
+    let up = |p: &Pose3| p.inverse().rotate([0.0, 0.0, 1.0]);
+    let (a, b) = (up(configured), up(&f.base_from_optical));
+    let tilt = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).clamp(-1.0, 1.0).acos().to_degrees();
+    let dz = f.z.value - configured.translation[2];
+    (tilt > REFIT_TILT_DEG || dz.abs() > REFIT_HEIGHT_M).then(|| {
+        format!(
+            "`{name}`'s clock offset and yaw as they would be with its tilt and height right: the floor puts the \
+             configured ones {tilt:.2}° and {:.1} cm off, and the wall points were placed through them; paste \
+             calibration.toml's camera table into the configuration and calibrate again",
+            dz.abs() * 100.0
+        )
+    })
 }
 
 /// A yaw interval moved into (−π, π] as a whole (its ends by the same turn).

@@ -170,6 +170,10 @@ fn finds_the_camera_height_and_tilt_from_the_floor() {
     assert!((z.value - 1.0).abs() < 0.01, "{z:?}");
     assert!((roll.value + 115f64.to_radians()).abs() < 0.2f64.to_radians(), "{roll:?}");
     assert!(pitch.value.abs() < 0.2f64.to_radians(), "{pitch:?}");
+    // The clock and yaw were fitted through the wrong tilt: the run says to fit again.
+    let again = |c: &Calibration| c.undetermined.iter().any(|u| u.contains("calibrate again"));
+    assert!(again(&c), "{:?}", c.undetermined);
+    assert!(!again(&calibrate("on-time", bag(), &config((0.25, 0.0), 0.0))));
     // calibration.toml writes them (the configured values lie outside their intervals).
     let pasted = fusemap_io::config_file::load_config(&out_dir("camera-tilt").join(CALIBRATION_TOML)).unwrap();
     let camera = pasted.sensor.iter().find(|s| s.name.as_deref() == Some("camera")).unwrap();
