@@ -124,15 +124,17 @@ pub fn camera_floor<'a>(
     let mut fit = [0.0, 0.0, -z0];
     let inlier =
         |fit: [f64; 3], band: f64, p: &[f64; 3]| (p[2] - (fit[0] * p[0] + fit[1] * p[1] + fit[2])).abs() < band;
-    let mut band = BANDS_M[0];
-    for &next in &BANDS_M {
-        band = next;
+    for &band in &BANDS_M {
         let inliers = relative.iter().flatten().filter(|p| inlier(fit, band, p)).copied();
         fit = plane(inliers).ok_or("the depth points near the floor do not span a plane")?;
     }
-    let kept: Vec<Vec<[f64; 3]>> =
-        relative.iter().map(|f| f.iter().filter(|p| inlier(fit, band, p)).copied().collect()).collect();
-    let used: Vec<&Vec<[f64; 3]>> = kept.iter().filter(|f| !f.is_empty()).collect();
+    // Each frame's inliers of the last round's plane, frames without any left out.
+    let band = BANDS_M[BANDS_M.len() - 1];
+    let used: Vec<Vec<[f64; 3]>> = relative
+        .iter()
+        .map(|f| f.iter().filter(|p| inlier(fit, band, p)).copied().collect::<Vec<_>>())
+        .filter(|f| !f.is_empty())
+        .collect();
     let points: usize = used.iter().map(|f| f.len()).sum();
     if used.len() < MIN_FRAMES || points < MIN_POINTS {
         return Err(format!(
@@ -157,13 +159,10 @@ pub fn camera_floor<'a>(
     let rms = |f: &dyn Fn(&[f64; 3]) -> f64| {
         (used.iter().flat_map(|p| p.iter()).map(|p| f(p).powi(2)).sum::<f64>() / points as f64).sqrt()
     };
-    let level = mount.rotation;
-    let height = mount.translation[2];
-    // After: the points' heights above the fitted floor, through the fitted mount.
-    let after = |p: &[f64; 3]| {
-        let q = configured.inverse().rotate(*p);
-        Pose3::new([0.0; 3], level).rotate(q)[2] + height
-    };
+    // After: the points' heights above the fitted floor, through the fitted mount (the
+    // points are rotated by the configured mount: turned back, then by the fitted one).
+    let refit = Pose3::new([0.0; 3], mount.rotation).compose(&Pose3::new([0.0; 3], configured.inverse().rotation));
+    let after = |p: &[f64; 3]| refit.rotate(*p)[2] + mount.translation[2];
     Ok(FloorFit {
         frames: used.len(),
         points,
